@@ -1,0 +1,33 @@
+#pragma once
+// Shared pieces of every same-run comparison: timing by medians of repetitions, and the two ways a
+// result table is printed (aligned text for people, a JSON array of objects for scripts).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace bvhkit::bench {
+
+/// Milliseconds taken by f(), median over `repetitions` runs (after one untimed warm-up when asked).
+double median_ms(int repetitions, const std::function<void()>& f, bool warm_up = true);
+
+double median(std::vector<double> values);
+
+/// One cell of a result row: text, an integer count or a real figure.
+using Value = std::variant<std::string, long long, double>;
+
+struct Row {
+    std::vector<std::pair<std::string, Value>> fields;
+    Row& set(const std::string& key, Value v);
+    const Value* get(const std::string& key) const;
+};
+
+/// Prints rows as an aligned table (columns in first-seen order; missing cells are blank).
+void print_table(std::FILE* out, const std::vector<Row>& rows);
+/// Prints rows as a JSON array of objects, one object per row.
+void print_json(std::FILE* out, const std::vector<Row>& rows);
+
+}  // namespace bvhkit::bench

@@ -1,0 +1,36 @@
+#pragma once
+// Helpers shared by every test program: where the shared meshes are, and how big a randomized test
+// should be (the sanitizer build sets BVHKIT_TEST_SCALE=small to keep CI fast; Release runs in full).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace bvhkit::test {
+
+inline std::filesystem::path data_dir() { return BVHKIT_DATA_DIR; }
+
+/// Path of a shared mesh, or an empty path when ../shared/data is absent (callers GTEST_SKIP).
+inline std::filesystem::path shared_mesh(std::string_view name) {
+    const auto p = data_dir() / std::string(name);
+    return std::filesystem::exists(p) ? p : std::filesystem::path{};
+}
+
+inline bool small_scale() {
+    const char* s = std::getenv("BVHKIT_TEST_SCALE");
+    return s && std::string_view(s) == "small";
+}
+
+/// `full` in the Release run, `full / divisor` (at least 1) under the sanitizers.
+inline std::size_t scaled(std::size_t full, std::size_t divisor = 20) {
+    return small_scale() ? std::max<std::size_t>(1, full / divisor) : full;
+}
+
+}  // namespace bvhkit::test
+
+#define BVHKIT_REQUIRE_MESH(var, name)                                                  \
+    const auto var = ::bvhkit::test::shared_mesh(name);                                 \
+    if (var.empty()) GTEST_SKIP() << "shared mesh " << name << " not found under "     \
+                                  << ::bvhkit::test::data_dir() << "; skipping"

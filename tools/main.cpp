@@ -1,0 +1,51 @@
+// The bvhkit command: `bvhkit SUBCOMMAND [ARGS...]`. Each subcommand lives in its own file and is listed
+// in the table below; `bvhkit help` (or no argument) prints the list.
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string_view>
+
+#include "bvhkit/error.hpp"
+#include "commands.hpp"
+
+namespace {
+
+struct Subcommand {
+    const char* name;
+    const char* summary;
+    int (*run)(int argc, char** argv);  // argv[0] is the subcommand's name
+};
+
+const Subcommand kSubcommands[] = {
+    {"version", "print the library version", bvhkit::tools::version_command},
+};
+
+void print_usage(std::FILE* out) {
+    std::fprintf(out, "usage: bvhkit SUBCOMMAND [ARGS...]   (bvhkit SUBCOMMAND --help for details)\n\n");
+    for (const auto& s : kSubcommands) std::fprintf(out, "  %-12s %s\n", s.name, s.summary);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2 || std::string_view(argv[1]) == "help" || std::string_view(argv[1]) == "--help" ||
+        std::string_view(argv[1]) == "-h") {
+        print_usage(argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    for (const auto& s : kSubcommands) {
+        if (std::string_view(argv[1]) != s.name) continue;
+        try {
+            return s.run(argc - 1, argv + 1);
+        } catch (const bvhkit::Error& e) {
+            std::fprintf(stderr, "bvhkit %s: error: %s\n", s.name, e.what());
+            return 1;
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "bvhkit %s: unexpected error: %s\n", s.name, e.what());
+            return 1;
+        }
+    }
+    std::fprintf(stderr, "bvhkit: unknown subcommand '%s'\n\n", argv[1]);
+    print_usage(stderr);
+    return 2;
+}
