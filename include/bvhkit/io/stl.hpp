@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string_view>
 
+#include "bvhkit/error.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 
 namespace bvhkit {
