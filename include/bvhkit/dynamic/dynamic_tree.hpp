@@ -1,0 +1,573 @@
+#pragma once
+// DynamicTree<T, N, UserData>: a bounding volume hierarchy of axis-aligned boxes that move, for the
+// broadphase of a physics engine or a game's spatial queries (N = 2 or 3, T = float or double).
+//
+//   bvhkit::DynamicTree<float, 2> tree;                       // options: fat margins, insertion
+//   ProxyId id = tree.create(box, user_data);                 // insert
+//   tree.move(id, new_box, displacement);                     // true when the tree had to change
+//   tree.find_pairs(pairs);                                   // overlapping pairs of the moved
+//   tree.query(box, [](ProxyId id) { return true; });         // also query_point, ray_cast,
+//   tree.destroy(id);                                         // box_cast, query_tree
+//
+// Layout: all nodes live in one array (a pool with a free list) and refer to each other by index,
+// so the pool can grow without invalidating anything. Each proxy has a stable id into a second
+// table holding its tight box, its user data (UserData, a std::uint64_t unless chosen otherwise: an
+// index, a handle or a pointer cast to an integer) and its leaf node.
+//
+// Fat boxes: a leaf stores the proxy's box grown by a margin and stretched along the predicted
+// displacement, so a small motion stays inside it and move() only updates the tight box.
+//
+// Insertion (tree_insertion.hpp): the sibling that minimizes the SAH cost increase, found by branch
+// and bound (or seed 000's greedy descent), then a walk up to the root refitting each ancestor and
+// applying the best of the four rotations. Removal replaces the leaf's parent by its sibling and
+// walks up alike.
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bvhkit/dynamic/small_stack.hpp"
+#include "bvhkit/dynamic/tree_insertion.hpp"
+#include "bvhkit/dynamic/tree_queries.hpp"
+#include "bvhkit/dynamic/tree_rebuild.hpp"
+#include "bvhkit/dynamic/tree_types.hpp"
+#include "bvhkit/dynamic/tree_validate.hpp"
+#include "bvhkit/error.hpp"
+
+namespace bvhkit {
+
+template <class T, std::size_t N, class UserData = std::uint64_t>
+class DynamicTree {
+    static_assert(N == 2 || N == 3, "DynamicTree is for 2D and 3D boxes");
+
+  public:
+    using Scalar = T;
+    using VecT = Vec<T, N>;
+    using Box = Aabb<T, N>;
+    using Options = DynamicTreeOptions<T>;
+    static constexpr std::size_t dimension = N;
+
+    explicit DynamicTree(const Options& options = {}) : options_(options) {
+        check_options(options);
+    }
+
+    // ---------------------------------------------------------------- proxies
+
+    /// Adds a proxy with the given (tight) box; it is in the move buffer until the next
+    /// find_pairs().
+    ProxyId create(const Box& box, const UserData& user_data = {}) {
+        dynamic_detail::check_box(box, "DynamicTree::create");
+        const ProxyId id = alloc_proxy();
+        const std::int32_t leaf = alloc_node();
+        Node& n = nodes_[leaf];
+        n.box = fat_box(box, VecT{});
+        n.parent = n.child1 = dynamic_detail::kNullNode;
+        n.child2 = id;
+        n.height = 0;
+        n.enlarged = 0;
+        Proxy& p = proxies_[id];
+        p.box = box;
+        p.user_data = user_data;
+        p.node = leaf;
+        insert_leaf(leaf);
+        buffer_move(id);
+        return id;
+    }
+
+    void destroy(ProxyId id) {
+        check_id(id, "DynamicTree::destroy");
+        Proxy& p = proxies_[id];
+        remove_leaf(p.node);
+        free_node(p.node);
+        p.node = dynamic_detail::kNullNode;
+        p.moved = false;  // a stale entry may stay in the move buffer; find_pairs() skips it
+        p.next_free = free_proxy_;
+        free_proxy_ = id;
+        --proxy_count_;
+    }
+
+    /// Gives proxy `id` a new box; `displacement` is its predicted motion until the next move (the
+    /// fat box is stretched along it). The proxy goes into the move buffer either way. The tree is
+    /// restructured (remove + insert) only when the box leaves the fat box, or when the fat box has
+    /// become far larger than a fresh one would be; returns whether that happened.
+    bool move(ProxyId id, const Box& box, const VecT& displacement = VecT{}) {
+        check_id(id, "DynamicTree::move");
+        dynamic_detail::check_box(box, "DynamicTree::move");
+        dynamic_detail::check_vector(displacement, "displacement", "DynamicTree::move");
+        Proxy& p = proxies_[id];
+        p.box = box;
+        buffer_move(id);
+        const std::int32_t leaf = p.node;
+        const Box fat = fat_box(box, displacement);
+        const Box& current = nodes_[leaf].box;
+        if (current.contains(box)) {
+            // Still inside; keep it unless it is much too large (say after a fast move that
+            // stopped): the limit is the fresh fat box grown by three more margins and predictions.
+            const VecT slack = VecT(T(3) * margin(box)) +
+                               abs(displacement) * (T(3) * options_.displacement_multiplier);
+            if (Box(fat.min - slack, fat.max + slack).contains(current)) return false;
+        }
+        remove_leaf(leaf);
+        nodes_[leaf].box = fat;
+        nodes_[leaf].enlarged = 0;
+        insert_leaf(leaf);
+        return true;
+    }
+
+    /// Like move(), but when the box leaves its fat box the leaf's fat box and its ancestors' boxes
+    /// are grown in place, without restructuring (cheap, for many moves in a row; quality suffers
+    /// until rebuild(false) rebuilds the grown part). Returns whether anything was grown.
+    bool enlarge(ProxyId id, const Box& box, const VecT& displacement = VecT{}) {
+        check_id(id, "DynamicTree::enlarge");
+        dynamic_detail::check_box(box, "DynamicTree::enlarge");
+        dynamic_detail::check_vector(displacement, "displacement", "DynamicTree::enlarge");
+        Proxy& p = proxies_[id];
+        p.box = box;
+        buffer_move(id);
+        std::int32_t i = p.node;
+        if (nodes_[i].box.contains(box)) return false;
+        const Box fat = fat_box(box, displacement);
+        nodes_[i].box = fat;
+        nodes_[i].enlarged = 1;
+        // Grow the ancestors and mark them. Invariant: the parent of an enlarged node is enlarged,
+        // so the walk can stop at the first ancestor that was enlarged already and contains the new
+        // box.
+        for (i = nodes_[i].parent; i != dynamic_detail::kNullNode; i = nodes_[i].parent) {
+            Node& n = nodes_[i];
+            if (n.enlarged && n.box.contains(fat)) break;
+            n.box.grow(fat);
+            n.enlarged = 1;
+        }
+        return true;
+    }
+
+    /// Rebuilds the tree top-down with binned SAH. full = false rebuilds only the part above the
+    /// leaves that enlarge() touched, keeping every untouched subtree as it is.
+    void rebuild(bool full = true) {
+        if (root_ == dynamic_detail::kNullNode) return;
+        auto& items = build_.items;
+        items.clear();
+        dynamic_detail::SmallStack<std::int32_t> stack;
+        stack.push(root_);
+        while (!stack.empty()) {
+            const std::int32_t i = stack.pop();
+            Node& n = nodes_[i];
+            if (n.is_leaf() || (!full && !n.enlarged)) {
+                n.enlarged = 0;
+                items.push_back({n.box.centroid(), i});
+            } else {
+                stack.push(n.child1);
+                stack.push(n.child2);
+                free_node(i);
+            }
+        }
+        // The freed internal nodes are exactly as many as the build needs, so alloc never grows the
+        // pool.
+        root_ = dynamic_detail::build_binned_sah(nodes_.data(), build_,
+                                                 [this] { return alloc_node(); });
+    }
+
+    /// Incremental optimization: removes and re-inserts the (at most) `max_reinsertions` leaves
+    /// that look worst placed, those whose parent's area is the largest relative to their own.
+    /// Returns how many.
+    int optimize(int max_reinsertions) {
+        if (max_reinsertions <= 0 || proxy_count_ < 3) return 0;
+        auto& cand = optimize_scratch_;
+        cand.clear();
+        for (std::int32_t id = 0; id < static_cast<std::int32_t>(proxies_.size()); ++id) {
+            const std::int32_t leaf = proxies_[id].node;
+            if (leaf == dynamic_detail::kNullNode || leaf == root_) continue;
+            const T own = std::max(nodes_[leaf].box.area(), std::numeric_limits<T>::min());
+            cand.push_back({nodes_[nodes_[leaf].parent].box.area() / own, leaf});
+        }
+        const std::size_t k =
+            std::min<std::size_t>(cand.size(), static_cast<std::size_t>(max_reinsertions));
+        const auto worse = [](const auto& a, const auto& b) {
+            return a.first != b.first ? a.first > b.first : a.second < b.second;
+        };
+        std::nth_element(cand.begin(), cand.begin() + static_cast<std::ptrdiff_t>(k) - 1,
+                         cand.end(), worse);
+        std::sort(cand.begin(), cand.begin() + static_cast<std::ptrdiff_t>(k), worse);
+        for (std::size_t i = 0; i < k; ++i) {
+            remove_leaf(cand[i].second);
+            insert_leaf(cand[i].second);
+        }
+        return static_cast<int>(k);
+    }
+
+    /// Removes every proxy (keeps the memory).
+    void clear() {
+        nodes_.clear();
+        proxies_.clear();
+        move_buffer_.clear();
+        root_ = free_node_ = free_proxy_ = dynamic_detail::kNullNode;
+        node_count_ = proxy_count_ = 0;
+    }
+
+    bool contains(ProxyId id) const {
+        return id >= 0 && id < static_cast<ProxyId>(proxies_.size()) &&
+               proxies_[id].node != dynamic_detail::kNullNode;
+    }
+    const Box& box(ProxyId id) const { return proxies_[checked(id, "DynamicTree::box")].box; }
+    const Box& fat_box(ProxyId id) const {
+        return nodes_[proxies_[checked(id, "DynamicTree::fat_box")].node].box;
+    }
+    const UserData& user_data(ProxyId id) const {
+        return proxies_[checked(id, "DynamicTree::user_data")].user_data;
+    }
+    UserData& user_data(ProxyId id) {
+        return proxies_[checked(id, "DynamicTree::user_data")].user_data;
+    }
+    /// Number of live proxies.
+    std::size_t size() const { return proxy_count_; }
+    bool empty() const { return proxy_count_ == 0; }
+    /// One past the largest proxy id ever handed out (ids are reused after destroy()).
+    ProxyId id_bound() const { return static_cast<ProxyId>(proxies_.size()); }
+    const Options& options() const { return options_; }
+    /// New options apply to later inserts and moves; the present fat boxes stay until they move.
+    void set_options(const Options& o) {
+        check_options(o);
+        options_ = o;
+    }
+
+    // ---------------------------------------------------------------- queries (tree_queries.hpp)
+
+    /// Every proxy whose box overlaps `box` (touching counts). callback(ProxyId) -> bool, false
+    /// stops.
+    template <class F>
+    void query(const Box& box, F&& callback, QueryStats* stats = nullptr) const {
+        dynamic_detail::query_box(view(), box, callback, stats);
+    }
+    /// Every proxy whose box contains `p`. callback(ProxyId) -> bool, false stops.
+    template <class F>
+    void query_point(const VecT& p, F&& callback, QueryStats* stats = nullptr) const {
+        dynamic_detail::query_point(view(), p, callback, stats);
+    }
+    /// The segment origin + s * direction, s in [0, max_fraction], against the proxies' boxes.
+    /// callback(ProxyId, T max_fraction) -> T: < 0 ignore and go on, 0 stop, > 0 clip to that
+    /// fraction.
+    template <class F>
+    void ray_cast(const VecT& origin, const VecT& direction, T max_fraction, F&& callback,
+                  QueryStats* stats = nullptr) const {
+        dynamic_detail::cast(view(), dynamic_detail::Segment<T, N>(origin, direction), VecT{},
+                             max_fraction, callback, stats);
+    }
+    /// `box` swept by s * translation, s in [0, max_fraction]: a ray cast from the box's centre
+    /// against every box grown by the cast box's half extents. Same callback as ray_cast().
+    template <class F>
+    void box_cast(const Box& box, const VecT& translation, T max_fraction, F&& callback,
+                  QueryStats* stats = nullptr) const {
+        dynamic_detail::cast(view(), dynamic_detail::Segment<T, N>(box.centroid(), translation),
+                             box.extent() * T(0.5), max_fraction, callback, stats);
+    }
+    /// Every pair (proxy of this tree, proxy of `other`) whose boxes overlap.
+    /// callback(ProxyId mine, ProxyId theirs) -> bool, false stops.
+    template <class U2, class F>
+    void query_tree(const DynamicTree<T, N, U2>& other, F&& callback,
+                    QueryStats* stats = nullptr) const {
+        dynamic_detail::query_tree(view(), other.view(), callback, stats);
+    }
+
+    // ---------------------------------------------------------------- pair finding
+
+    /// The overlapping pairs (of the tight boxes) that involve a proxy moved or created since the
+    /// last call, each once, as (a, b) with a < b, sorted. Clears the move buffer.
+    void find_pairs(std::vector<ProxyPair>& out) {
+        out.clear();
+        auto& buf = move_buffer_;
+        std::sort(buf.begin(), buf.end());
+        buf.erase(std::unique(buf.begin(), buf.end()), buf.end());
+        const auto v = view();
+        for (const ProxyId q : buf) {
+            if (!proxies_[q].moved) continue;  // destroyed since it was buffered
+            dynamic_detail::query_box(
+                v, proxies_[q].box,
+                [&](ProxyId o) {
+                    // Skip itself; when both moved, only the query from the smaller id reports.
+                    if (o != q && !(proxies_[o].moved && o < q))
+                        out.push_back(o < q ? ProxyPair{o, q} : ProxyPair{q, o});
+                    return true;
+                },
+                nullptr);
+        }
+        for (const ProxyId q : buf) proxies_[q].moved = false;
+        buf.clear();
+        std::sort(out.begin(), out.end());
+    }
+    /// Same pairs, handed to callback(ProxyId a, ProxyId b) in order.
+    template <class F>
+    void find_pairs(F&& callback) {
+        find_pairs(pair_scratch_);
+        for (const ProxyPair& p : pair_scratch_) callback(p.a, p.b);
+    }
+    /// Proxies waiting in the move buffer (may hold duplicates and destroyed ids).
+    std::size_t move_buffer_size() const { return move_buffer_.size(); }
+
+    // ---------------------------------------------------------------- checks and measures
+
+    /// Checks every invariant; throws bvhkit::Error naming the first one broken.
+    void validate() const {
+        dynamic_detail::validate_tree(dynamic_detail::TreeParts<T, N, UserData>{
+            nodes_, proxies_, root_, free_node_, free_proxy_, node_count_, proxy_count_});
+    }
+    int height() const { return root_ == dynamic_detail::kNullNode ? 0 : nodes_[root_].height; }
+    /// Sum of the areas (perimeters in 2D) of the internal nodes.
+    double sah_cost() const {
+        double s = 0;
+        for (const Node& n : nodes_)
+            if (n.height > 0) s += double(n.box.area());
+        return s;
+    }
+    /// sah_cost() over the root's area: how much larger than the root the internal nodes are in
+    /// all.
+    double area_ratio() const {
+        if (root_ == dynamic_detail::kNullNode || nodes_[root_].is_leaf()) return 0;
+        const double root_area = double(nodes_[root_].box.area());
+        return root_area > 0 ? sah_cost() / root_area : 0;
+    }
+    std::size_t memory_bytes() const {
+        return nodes_.capacity() * sizeof(Node) + proxies_.capacity() * sizeof(Proxy) +
+               move_buffer_.capacity() * sizeof(ProxyId) + heap_.capacity() * sizeof(heap_[0]) +
+               pair_scratch_.capacity() * sizeof(ProxyPair) +
+               build_.items.capacity() * sizeof(build_.items[0]) +
+               build_.tasks.capacity() * sizeof(build_.tasks[0]) +
+               build_.created.capacity() * sizeof(std::int32_t) +
+               optimize_scratch_.capacity() * sizeof(optimize_scratch_[0]);
+    }
+    TreeStats stats() const {
+        TreeStats s;
+        s.proxies = proxy_count_;
+        s.nodes = node_count_;
+        s.node_capacity = nodes_.size();
+        s.height = height();
+        s.sah_cost = sah_cost();
+        s.area_ratio = area_ratio();
+        s.memory_bytes = memory_bytes();
+        return s;
+    }
+    /// Moves the origin of the world to `new_origin`: every box b becomes b - new_origin (games do
+    /// this to keep coordinates small far from the start).
+    void shift_origin(const VecT& new_origin) {
+        dynamic_detail::check_vector(new_origin, "new_origin", "DynamicTree::shift_origin");
+        for (Node& n : nodes_)
+            if (n.height >= 0) n.box = Box(n.box.min - new_origin, n.box.max - new_origin);
+        for (Proxy& p : proxies_)
+            if (p.node != dynamic_detail::kNullNode)
+                p.box = Box(p.box.min - new_origin, p.box.max - new_origin);
+    }
+
+    /// Visits every node: visitor(const Box& box, int depth, bool is_leaf, ProxyId proxy) (for
+    /// drawing and debugging; depth 0 is the root).
+    template <class F>
+    void for_each_node(F&& visitor) const {
+        if (root_ == dynamic_detail::kNullNode) return;
+        struct Item {
+            std::int32_t node, depth;
+        };
+        dynamic_detail::SmallStack<Item> stack;
+        stack.push({root_, 0});
+        while (!stack.empty()) {
+            const Item it = stack.pop();
+            const Node& n = nodes_[it.node];
+            visitor(n.box, int(it.depth), n.is_leaf(), n.is_leaf() ? n.proxy() : kNullProxy);
+            if (!n.is_leaf()) {
+                stack.push({n.child2, it.depth + 1});
+                stack.push({n.child1, it.depth + 1});
+            }
+        }
+    }
+
+  private:
+    template <class, std::size_t, class>
+    friend class DynamicTree;
+    using Node = dynamic_detail::Node<T, N>;
+    using Proxy = dynamic_detail::Proxy<T, N, UserData>;
+
+    dynamic_detail::TreeView<T, N, UserData> view() const {
+        return {nodes_.data(), proxies_.data(), root_};
+    }
+
+    static void check_options(const Options& o) {
+        const auto bad = [](const char* name, T v) {
+            return Error(std::string("DynamicTree options: ") + name + " = " +
+                         dynamic_detail::format_value(double(v)) + " (must be finite and >= 0)");
+        };
+        if (!(std::isfinite(o.margin_absolute) && o.margin_absolute >= 0))
+            throw bad("margin_absolute", o.margin_absolute);
+        if (!(std::isfinite(o.margin_relative) && o.margin_relative >= 0))
+            throw bad("margin_relative", o.margin_relative);
+        if (!(std::isfinite(o.displacement_multiplier) && o.displacement_multiplier >= 0))
+            throw bad("displacement_multiplier", o.displacement_multiplier);
+    }
+
+    static VecT abs(const VecT& v) {
+        VecT r;
+        for (std::size_t i = 0; i < N; ++i) r[i] = std::abs(v[i]);
+        return r;
+    }
+    T margin(const Box& box) const {
+        return options_.margin_absolute + options_.margin_relative * max_component(box.extent());
+    }
+    /// The box grown by the margin on every side, then stretched along the predicted displacement.
+    Box fat_box(const Box& box, const VecT& displacement) const {
+        const VecT m(margin(box));
+        Box fat(box.min - m, box.max + m);
+        for (std::size_t i = 0; i < N; ++i) {
+            const T s = options_.displacement_multiplier * displacement[i];
+            if (s < 0)
+                fat.min[i] += s;
+            else
+                fat.max[i] += s;
+        }
+        return fat;
+    }
+
+    void check_id(ProxyId id, const char* where) const {
+        if (!contains(id))
+            throw Error(std::string(where) + ": proxy id " + std::to_string(id) +
+                        (id >= 0 && id < static_cast<ProxyId>(proxies_.size()) ? " was destroyed"
+                                                                               : " is unknown"));
+    }
+    ProxyId checked(ProxyId id, const char* where) const {
+        check_id(id, where);
+        return id;
+    }
+
+    void buffer_move(ProxyId id) {
+        Proxy& p = proxies_[id];
+        if (p.moved) return;
+        p.moved = true;
+        move_buffer_.push_back(id);
+    }
+
+    // ---- pools
+
+    std::int32_t alloc_node() {
+        if (free_node_ == dynamic_detail::kNullNode) {
+            // Grow the pool and chain the new nodes into the free list (indices stay valid).
+            const std::size_t old = nodes_.size();
+            const std::size_t cap = std::max<std::size_t>(16, old * 2);
+            if (cap > std::size_t(INT32_MAX)) throw Error("DynamicTree: more than 2^31 nodes");
+            nodes_.resize(cap);
+            for (std::size_t i = old; i < cap; ++i) {
+                nodes_[i].height = -1;
+                nodes_[i].parent = i + 1 < cap ? std::int32_t(i + 1) : dynamic_detail::kNullNode;
+            }
+            free_node_ = std::int32_t(old);
+        }
+        const std::int32_t i = free_node_;
+        free_node_ = nodes_[i].parent;
+        ++node_count_;
+        return i;
+    }
+    void free_node(std::int32_t i) {
+        nodes_[i].height = -1;
+        nodes_[i].enlarged = 0;
+        nodes_[i].parent = free_node_;
+        free_node_ = i;
+        --node_count_;
+    }
+    ProxyId alloc_proxy() {
+        ProxyId id = free_proxy_;
+        if (id == dynamic_detail::kNullNode) {
+            if (proxies_.size() >= std::size_t(INT32_MAX))
+                throw Error("DynamicTree: more than 2^31 proxies");
+            id = static_cast<ProxyId>(proxies_.size());
+            proxies_.emplace_back();
+        } else {
+            free_proxy_ = proxies_[id].next_free;
+        }
+        proxies_[id].next_free = dynamic_detail::kNullNode;
+        proxies_[id].moved = false;
+        ++proxy_count_;
+        return id;
+    }
+
+    // ---- structure
+
+    /// Puts the (detached) leaf into the tree next to the best sibling, then walks up.
+    void insert_leaf(std::int32_t leaf) {
+        if (root_ == dynamic_detail::kNullNode) {
+            root_ = leaf;
+            nodes_[leaf].parent = dynamic_detail::kNullNode;
+            return;
+        }
+        const std::int32_t parent = alloc_node();  // first: it may grow (move) the pool
+        const Box box = nodes_[leaf].box;
+        const std::int32_t sibling =
+            options_.insertion == InsertionStrategy::Greedy
+                ? dynamic_detail::find_sibling_greedy(nodes_.data(), root_, box)
+                : dynamic_detail::find_sibling_branch_and_bound(nodes_.data(), root_, box, heap_);
+        const std::int32_t old_parent = nodes_[sibling].parent;
+        Node& p = nodes_[parent];
+        p.parent = old_parent;
+        p.child1 = sibling;
+        p.child2 = leaf;
+        p.enlarged = 0;
+        nodes_[sibling].parent = parent;
+        nodes_[leaf].parent = parent;
+        dynamic_detail::refit(nodes_.data(), parent);
+        if (old_parent == dynamic_detail::kNullNode) {
+            root_ = parent;
+            return;
+        }
+        Node& op = nodes_[old_parent];
+        (op.child1 == sibling ? op.child1 : op.child2) = parent;
+        walk_up(old_parent);
+    }
+
+    /// Takes the leaf out of the tree (the node stays allocated): its parent is freed and replaced
+    /// by the leaf's sibling, then the ancestors are refitted and rotated.
+    void remove_leaf(std::int32_t leaf) {
+        if (leaf == root_) {
+            root_ = dynamic_detail::kNullNode;
+            return;
+        }
+        const std::int32_t parent = nodes_[leaf].parent;
+        const std::int32_t grand = nodes_[parent].parent;
+        const std::int32_t sibling =
+            nodes_[parent].child1 == leaf ? nodes_[parent].child2 : nodes_[parent].child1;
+        free_node(parent);
+        nodes_[leaf].parent = dynamic_detail::kNullNode;
+        nodes_[sibling].parent = grand;
+        if (grand == dynamic_detail::kNullNode) {
+            root_ = sibling;
+            return;
+        }
+        Node& g = nodes_[grand];
+        (g.child1 == parent ? g.child1 : g.child2) = sibling;
+        walk_up(grand);
+    }
+
+    /// Refit (and rotate, when enabled) every node from i up to the root.
+    void walk_up(std::int32_t i) {
+        Node* nodes = nodes_.data();
+        while (i != dynamic_detail::kNullNode) {
+            dynamic_detail::refit(nodes, i);
+            if (options_.rotate) dynamic_detail::rotate(nodes, i);
+            i = nodes[i].parent;
+        }
+    }
+
+    Options options_;
+    std::vector<Node> nodes_;
+    std::vector<Proxy> proxies_;
+    std::vector<ProxyId> move_buffer_;
+    std::int32_t root_ = dynamic_detail::kNullNode;
+    std::int32_t free_node_ = dynamic_detail::kNullNode;
+    std::int32_t free_proxy_ = dynamic_detail::kNullNode;
+    std::size_t node_count_ = 0;
+    std::size_t proxy_count_ = 0;
+    // Scratch storage kept between calls so that steady use allocates nothing.
+    std::vector<dynamic_detail::SiblingCandidate<T>> heap_;
+    std::vector<ProxyPair> pair_scratch_;
+    dynamic_detail::BuildScratch<T, N> build_;
+    std::vector<std::pair<T, std::int32_t>> optimize_scratch_;
+};
+
+using DynamicTree2f = DynamicTree<float, 2>;
+using DynamicTree3f = DynamicTree<float, 3>;
+using DynamicTree2d = DynamicTree<double, 2>;
+using DynamicTree3d = DynamicTree<double, 3>;
+
+}  // namespace bvhkit

@@ -1,0 +1,214 @@
+#pragma once
+// The SAH pieces of the dynamic tree that work on its node pool: choosing the sibling of a new leaf
+// (greedy descent or exact branch and bound), refitting a node, and the four tree rotations.
+//
+// Cost model (seed 000; MacDonald and Booth's SAH): the cost of a tree is the sum of the areas of
+// its internal nodes ("area" = perimeter in 2D, surface area in 3D). The root and the leaves are
+// the same in every tree over the same leaves, so only the internal nodes matter.
+//
+// Inserting leaf L as the sibling of node S creates a new parent P = S u L and grows every ancestor
+// of S to include L. The increase in tree cost is
+//     cost(S) = area(S u L)                                  -- the direct cost: the new node P
+//             + sum over ancestors A of S: area(A u L) - area(A)   -- the inherited cost
+// and the best sibling is the S that minimizes it.
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "bvhkit/dynamic/tree_types.hpp"
+
+namespace bvhkit::dynamic_detail {
+
+/// Recomputes an internal node's box, height and enlarged flag from its two children.
+template <class T, std::size_t N>
+inline void refit(Node<T, N>* nodes, std::int32_t i) {
+    Node<T, N>& n = nodes[i];
+    const Node<T, N>& c1 = nodes[n.child1];
+    const Node<T, N>& c2 = nodes[n.child2];
+    n.box = unite(c1.box, c2.box);
+    n.height = static_cast<std::int16_t>(1 + std::max(c1.height, c2.height));
+    n.enlarged = static_cast<std::uint16_t>(n.enlarged | c1.enlarged | c2.enlarged);
+}
+
+/// Ties: identical or zero-size boxes make many siblings cost exactly the same, and the first one
+/// found (the root) would win every time, stacking each new parent on top of the last: a list. So
+/// from the chosen sibling S (reached with total cost `cost`), while one of its children costs the
+/// same, go down into the tying child of smaller height: ties fill the shallowest branch.
+template <class T, std::size_t N>
+std::int32_t descend_ties(const Node<T, N>* nodes, std::int32_t s, const Aabb<T, N>& box, T cost) {
+    while (!nodes[s].is_leaf()) {
+        const Node<T, N>& n = nodes[s];
+        const T inherited = cost - n.box.area();
+        const T cost1 = unite(nodes[n.child1].box, box).area() + inherited;
+        const T cost2 = unite(nodes[n.child2].box, box).area() + inherited;
+        const bool tie1 = cost1 <= cost, tie2 = cost2 <= cost;
+        if (!tie1 && !tie2) break;
+        const bool take1 = tie1 && (!tie2 || nodes[n.child1].height <= nodes[n.child2].height);
+        s = take1 ? n.child1 : n.child2;
+        cost = take1 ? cost1 : cost2;
+    }
+    return s;
+}
+
+/// Seed 000's greedy descent. At internal node X with children C1, C2:
+///   stay here (X becomes L's sibling):  area(X u L)
+///   go into child Ci:                   area(Ci u L) + (area(X u L) - area(X))
+/// the second term being what X grows by whatever happens below it. Take the cheapest (on a tie, go
+/// down, into the shorter child); stop at a leaf. The descent costs only the height of the tree but
+/// can miss the best sibling on another path.
+template <class T, std::size_t N>
+std::int32_t find_sibling_greedy(const Node<T, N>* nodes, std::int32_t root,
+                                 const Aabb<T, N>& box) {
+    std::int32_t i = root;
+    while (!nodes[i].is_leaf()) {
+        const Node<T, N>& n = nodes[i];
+        const T stay = unite(n.box, box).area();
+        const T grow = stay - n.box.area();
+        const T cost1 = unite(nodes[n.child1].box, box).area() + grow;
+        const T cost2 = unite(nodes[n.child2].box, box).area() + grow;
+        if (stay < cost1 && stay < cost2) break;
+        const bool take1 =
+            cost1 < cost2 || (cost1 == cost2 && nodes[n.child1].height <= nodes[n.child2].height);
+        i = take1 ? n.child1 : n.child2;
+    }
+    return i;
+}
+
+/// One candidate of the branch and bound search: a node and the inherited cost of inserting
+/// anywhere below its parent, i.e. the sum of area(A u L) - area(A) over the node's ancestors.
+template <class T>
+struct SiblingCandidate {
+    std::int32_t node;
+    T inherited;
+};
+
+/// Exact best sibling by branch and bound (Bittner, Hapala, Havran 2013; Catto, GDC 2019).
+///
+/// For a candidate S reached with inherited cost I(S):
+///   cost(S)          = area(S u L) + I(S)
+///   I(child of S)    = I(S) + area(S u L) - area(S)          (S itself now grows by that much)
+/// Any node in the subtree below S costs at least
+///   lower_bound      = area(L) + I(child of S)
+/// because its direct cost area(X u L) >= area(L) and inherited costs only grow on the way down.
+/// So the search keeps the best cost found so far and:
+///   - takes the candidate with the smallest inherited cost first (a min-heap), so good regions are
+///     explored early and the best cost drops fast;
+///   - stops as soon as the smallest inherited cost + area(L) is no better than the best cost: no
+///     candidate left in the heap (nor anything below them) can win;
+///   - pushes the two children of S only when their lower bound beats the best cost.
+/// `heap` is scratch storage owned by the tree, so a steady stream of inserts allocates nothing.
+template <class T, std::size_t N>
+std::int32_t find_sibling_branch_and_bound(const Node<T, N>* nodes, std::int32_t root,
+                                           const Aabb<T, N>& box,
+                                           std::vector<SiblingCandidate<T>>& heap) {
+    const T leaf_area = box.area();
+    const auto later = [](const SiblingCandidate<T>& a, const SiblingCandidate<T>& b) {
+        return a.inherited >
+               b.inherited;  // std heap functions build a max-heap: invert for a min-heap
+    };
+    std::int32_t best = root;
+    T best_cost = unite(nodes[root].box, box).area();
+    heap.clear();
+    if (!nodes[root].is_leaf()) {
+        const T inherited = best_cost - nodes[root].box.area();
+        if (inherited + leaf_area < best_cost) {
+            heap.push_back({nodes[root].child1, inherited});
+            heap.push_back({nodes[root].child2, inherited});
+        }
+    }
+    while (!heap.empty()) {
+        std::pop_heap(heap.begin(), heap.end(), later);
+        const SiblingCandidate<T> c = heap.back();
+        heap.pop_back();
+        if (c.inherited + leaf_area >= best_cost) break;  // nothing left can beat the best
+
+        const Node<T, N>& n = nodes[c.node];
+        const T direct = unite(n.box, box).area();
+        const T cost = direct + c.inherited;
+        if (cost < best_cost) {
+            best_cost = cost;
+            best = c.node;
+        }
+        if (n.is_leaf()) continue;
+        const T child_inherited = cost - n.box.area();
+        if (child_inherited + leaf_area < best_cost) {
+            heap.push_back({n.child1, child_inherited});
+            std::push_heap(heap.begin(), heap.end(), later);
+            heap.push_back({n.child2, child_inherited});
+            std::push_heap(heap.begin(), heap.end(), later);
+        }
+    }
+    return descend_ties(nodes, best, box, best_cost);
+}
+
+/// The four rotations at node A (seed 000; Kopta et al. 2012 "Fast, effective BVH updates for
+/// animated scenes"). A has children B and C. If B is internal with children D and E, swapping C
+/// with one of B's children changes only B's box:
+///     1. swap C and D:  B becomes C u E,  cost change area(C u E) - area(B)
+///     2. swap C and E:  B becomes D u C,  cost change area(D u C) - area(B)
+/// and symmetrically, if C is internal with children F and G, swapping B with one of C's children
+/// changes only C's box:
+///     3. swap B and F:  C becomes B u G,  cost change area(B u G) - area(C)
+///     4. swap B and G:  C becomes F u B,  cost change area(F u B) - area(C)
+/// A's own box is unchanged (it holds the same leaves). The rotation that lowers the cost the most
+/// is applied; none if none lowers it. A's children must be up to date; A is refitted afterwards.
+template <class T, std::size_t N>
+void rotate(Node<T, N>* nodes, std::int32_t a) {
+    Node<T, N>& na = nodes[a];
+    const std::int32_t b = na.child1, c = na.child2;
+    Node<T, N>& nb = nodes[b];
+    Node<T, N>& nc = nodes[c];
+    if (nb.height < 1 && nc.height < 1) return;  // both leaves: nothing to rotate
+
+    int best = 0;
+    T best_delta = T(0);
+    if (!nb.is_leaf()) {
+        const T area_b = nb.box.area();
+        const T d1 = unite(nc.box, nodes[nb.child2].box).area() - area_b;
+        const T d2 = unite(nodes[nb.child1].box, nc.box).area() - area_b;
+        if (d1 < best_delta) best_delta = d1, best = 1;
+        if (d2 < best_delta) best_delta = d2, best = 2;
+    }
+    if (!nc.is_leaf()) {
+        const T area_c = nc.box.area();
+        const T d3 = unite(nb.box, nodes[nc.child2].box).area() - area_c;
+        const T d4 = unite(nodes[nc.child1].box, nb.box).area() - area_c;
+        if (d3 < best_delta) best_delta = d3, best = 3;
+        if (d4 < best_delta) best_delta = d4, best = 4;
+    }
+    switch (best) {
+        case 1: {  // C <-> D
+            const std::int32_t d = nb.child1;
+            na.child2 = d, nodes[d].parent = a;
+            nb.child1 = c, nc.parent = b;
+            refit(nodes, b);
+            break;
+        }
+        case 2: {  // C <-> E
+            const std::int32_t e = nb.child2;
+            na.child2 = e, nodes[e].parent = a;
+            nb.child2 = c, nc.parent = b;
+            refit(nodes, b);
+            break;
+        }
+        case 3: {  // B <-> F
+            const std::int32_t f = nc.child1;
+            na.child1 = f, nodes[f].parent = a;
+            nc.child1 = b, nb.parent = c;
+            refit(nodes, c);
+            break;
+        }
+        case 4: {  // B <-> G
+            const std::int32_t g = nc.child2;
+            na.child1 = g, nodes[g].parent = a;
+            nc.child2 = b, nb.parent = c;
+            refit(nodes, c);
+            break;
+        }
+        default:
+            return;
+    }
+    refit(nodes, a);
+}
+
+}  // namespace bvhkit::dynamic_detail

@@ -1,0 +1,161 @@
+#pragma once
+// The dynamic tree's queries, written against a read-only view of its arrays: box overlap, point,
+// ray cast, box cast and tree against tree. None recurses: each walks the tree depth first with a
+// SmallStack (on the caller's frame). Leaves are reported when the proxy's own (tight) box passes
+// the test; the fat boxes in the nodes only steer the descent.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "bvhkit/dynamic/small_stack.hpp"
+#include "bvhkit/dynamic/tree_types.hpp"
+
+namespace bvhkit::dynamic_detail {
+
+template <class T, std::size_t N, class U>
+struct TreeView {
+    const Node<T, N>* nodes;
+    const Proxy<T, N, U>* proxies;
+    std::int32_t root;
+};
+
+/// Box overlap: callback(ProxyId) -> bool, false stops the query.
+template <class T, std::size_t N, class U, class F>
+void query_box(const TreeView<T, N, U>& t, const Aabb<T, N>& box, F&& callback, QueryStats* stats) {
+    if (t.root == kNullNode) return;
+    std::uint64_t visited = 0, tested = 0;
+    SmallStack<std::int32_t> stack;
+    stack.push(t.root);
+    while (!stack.empty()) {
+        const Node<T, N>& n = t.nodes[stack.pop()];
+        ++visited;
+        if (!n.box.overlaps(box)) continue;
+        if (n.is_leaf()) {
+            ++tested;
+            if (t.proxies[n.proxy()].box.overlaps(box) && !callback(n.proxy())) break;
+        } else {
+            stack.push(n.child2);
+            stack.push(n.child1);
+        }
+    }
+    if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
+}
+
+/// Point: every proxy whose box contains p (boundary included). callback(ProxyId) -> bool.
+template <class T, std::size_t N, class U, class F>
+void query_point(const TreeView<T, N, U>& t, const Vec<T, N>& p, F&& callback, QueryStats* stats) {
+    query_box(t, Aabb<T, N>(p, p), callback, stats);
+}
+
+/// A segment origin + s * direction, s in [0, max_fraction], prepared for slab tests.
+template <class T, std::size_t N>
+struct Segment {
+    Vec<T, N> origin;
+    Vec<T, N> inv_dir;  // 1 / direction, zero components replaced by a tiny value of the same sign
+    Vec<T, N> far;      // +inf on the axes where the direction is zero, 0 elsewhere
+
+    Segment(const Vec<T, N>& o, const Vec<T, N>& d) : origin(o) {
+        // A zero component would give 1/0 = inf and then 0 * inf = NaN in the slab test when the
+        // origin lies on a slab plane. A tiny signed value keeps the reciprocal finite (huge) and
+        // the sign of a -0 component, so the test stays NaN free and rays parallel to a slab behave
+        // as the limit.
+        const T tiny = std::numeric_limits<T>::min() * T(16);
+        for (std::size_t i = 0; i < N; ++i) {
+            const T di = d[i] == T(0) ? std::copysign(tiny, d[i]) : d[i];
+            inv_dir[i] = T(1) / di;
+            far[i] = d[i] == T(0) ? std::numeric_limits<T>::infinity() : T(0);
+        }
+    }
+
+    /// Slab test of the segment [0, max_fraction] against `box` grown by `pad` on every side.
+    /// Returns the entry fraction (0 when the origin is inside) or a negative value on a miss. The
+    /// exit fraction is widened by a few ulps so that rounding never makes a touched box a miss
+    /// (conservative, in the manner of Ize 2013 "Robust BVH ray traversal"). On an axis where the
+    /// direction is zero, an origin exactly on a slab plane gives an exit fraction of exactly 0
+    /// (the tiny direction leaves at once), yet the true segment stays on the plane and touches the
+    /// box: there a non-negative exit is raised to +inf, so the axis passes whenever the origin is
+    /// inside.
+    T entry(const Aabb<T, N>& box, const Vec<T, N>& pad, T max_fraction) const {
+        constexpr T kWiden = T(1) + T(4) * std::numeric_limits<T>::epsilon();
+        T t_near = T(0), t_far = max_fraction;
+        for (std::size_t i = 0; i < N; ++i) {
+            const T t1 = (box.min[i] - pad[i] - origin[i]) * inv_dir[i];
+            const T t2 = (box.max[i] + pad[i] - origin[i]) * inv_dir[i];
+            const T lo = t1 < t2 ? t1 : t2;
+            T hi = t1 < t2 ? t2 : t1;
+            hi = hi >= T(0) ? std::max(hi * kWiden, far[i]) : hi / kWiden;
+            t_near = lo > t_near ? lo : t_near;
+            t_far = hi < t_far ? hi : t_far;
+        }
+        return t_near <= t_far ? t_near : T(-1);
+    }
+};
+
+/// Ray (or box) cast along segment `seg` with every box grown by `pad` (zero for a ray, the cast
+/// box's half extents for a box cast). callback(ProxyId, T max_fraction) -> T, as games expect:
+///   < 0  ignore this proxy, go on with the same max fraction
+///   == 0 stop the query
+///   > 0  go on, clipping the segment to this new max fraction
+template <class T, std::size_t N, class U, class F>
+void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, const Vec<T, N>& pad,
+          T max_fraction, F&& callback, QueryStats* stats) {
+    if (t.root == kNullNode) return;
+    std::uint64_t visited = 0, tested = 0;
+    SmallStack<std::int32_t> stack;
+    stack.push(t.root);
+    while (!stack.empty()) {
+        const Node<T, N>& n = t.nodes[stack.pop()];
+        ++visited;
+        if (seg.entry(n.box, pad, max_fraction) < T(0)) continue;
+        if (n.is_leaf()) {
+            ++tested;
+            if (seg.entry(t.proxies[n.proxy()].box, pad, max_fraction) < T(0)) continue;
+            const T value = callback(n.proxy(), max_fraction);
+            if (value == T(0)) break;
+            if (value > T(0)) max_fraction = value;
+        } else {
+            stack.push(n.child2);
+            stack.push(n.child1);
+        }
+    }
+    if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
+}
+
+/// Every pair (proxy of a, proxy of b) whose boxes overlap. callback(ProxyId a, ProxyId b) -> bool.
+/// Descent: a pair of nodes whose boxes overlap is split on the side that is internal and, when
+/// both are, on the one with the larger area (so the two boxes stay of similar size).
+template <class T, std::size_t N, class U, class V, class F>
+void query_tree(const TreeView<T, N, U>& a, const TreeView<T, N, V>& b, F&& callback,
+                QueryStats* stats) {
+    if (a.root == kNullNode || b.root == kNullNode) return;
+    struct NodePair {
+        std::int32_t a, b;
+    };
+    std::uint64_t visited = 0, tested = 0;
+    SmallStack<NodePair> stack;
+    stack.push({a.root, b.root});
+    while (!stack.empty()) {
+        const NodePair p = stack.pop();
+        const Node<T, N>& na = a.nodes[p.a];
+        const Node<T, N>& nb = b.nodes[p.b];
+        ++visited;
+        if (!na.box.overlaps(nb.box)) continue;
+        const bool leaf_a = na.is_leaf(), leaf_b = nb.is_leaf();
+        if (leaf_a && leaf_b) {
+            ++tested;
+            if (a.proxies[na.proxy()].box.overlaps(b.proxies[nb.proxy()].box) &&
+                !callback(na.proxy(), nb.proxy()))
+                break;
+        } else if (leaf_b || (!leaf_a && na.box.area() >= nb.box.area())) {
+            stack.push({na.child2, p.b});
+            stack.push({na.child1, p.b});
+        } else {
+            stack.push({p.a, nb.child2});
+            stack.push({p.a, nb.child1});
+        }
+    }
+    if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
+}
+
+}  // namespace bvhkit::dynamic_detail

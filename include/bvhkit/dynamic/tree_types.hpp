@@ -1,0 +1,100 @@
+#pragma once
+// The small types shared by the dynamic tree's parts: ids, the node and proxy records, the options
+// (fat margins, insertion strategy) and the statistics a query or the whole tree can report.
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include "bvhkit/math/aabb.hpp"
+
+namespace bvhkit {
+
+/// A proxy is one user object in a DynamicTree. Its id stays valid (and the same) until the proxy
+/// is destroyed, whatever happens to the tree: growth of the node pool, rotations, rebuilds.
+using ProxyId = std::int32_t;
+inline constexpr ProxyId kNullProxy = -1;
+
+/// How insert() picks the sibling of a new leaf.
+enum class InsertionStrategy : std::uint8_t {
+    /// Seed 000's descent: at each node go to the child whose union with the new box is smaller,
+    /// and
+    /// stop where staying is cheapest. Fast, but it only ever looks at one path.
+    Greedy,
+    /// Exact best sibling for the SAH insertion cost, found by branch and bound over the whole tree
+    /// (Bittner, Hapala, Havran 2013; Catto, GDC 2019).
+    BranchAndBound,
+};
+
+/// Options of a DynamicTree. The fat box of a leaf is its box grown on every side by
+/// `margin_absolute + margin_relative * (largest extent of the box)`, then stretched along
+/// `displacement_multiplier * displacement` when move() is given a displacement.
+template <class T>
+struct DynamicTreeOptions {
+    T margin_absolute = T(0.1);
+    T margin_relative = T(0);
+    T displacement_multiplier = T(4);
+    InsertionStrategy insertion = InsertionStrategy::BranchAndBound;
+    /// Try the four rotations while walking up after an insert or a removal (seed 000, Kopta et al.
+    /// 2012).
+    bool rotate = true;
+};
+
+/// Counters a query can fill in (pass a pointer; they are added to, never reset by the query).
+struct QueryStats {
+    std::uint64_t nodes_visited = 0;  // nodes whose box was tested
+    std::uint64_t leaves_tested = 0;  // leaves whose proxy box was tested
+};
+
+/// A pair of overlapping proxies, a < b.
+struct ProxyPair {
+    ProxyId a = kNullProxy;
+    ProxyId b = kNullProxy;
+    friend constexpr bool operator==(const ProxyPair&, const ProxyPair&) = default;
+    friend constexpr bool operator<(const ProxyPair& x, const ProxyPair& y) {
+        return x.a != y.a ? x.a < y.a : x.b < y.b;
+    }
+};
+
+/// Measures of a whole tree (DynamicTree::stats()).
+struct TreeStats {
+    std::size_t proxies = 0;
+    std::size_t nodes = 0;          // leaves + internal nodes in use
+    std::size_t node_capacity = 0;  // pool size
+    int height = 0;                 // a single leaf has height 0; empty tree: 0
+    double sah_cost = 0;            // sum of the areas of the internal nodes (perimeters in 2D)
+    double area_ratio = 0;          // sah_cost / area of the root (0 for fewer than two leaves)
+    std::size_t memory_bytes = 0;   // heap memory held by the tree
+};
+
+namespace dynamic_detail {
+
+inline constexpr std::int32_t kNullNode = -1;
+
+/// One node of the pool. 32 bytes for 2D float, 40 for 3D float. A leaf has child1 == kNullNode and
+/// keeps its proxy id in child2; a free node keeps the next free index in parent.
+template <class T, std::size_t N>
+struct Node {
+    Aabb<T, N> box;  // fat box for a leaf, union of the children for an internal node
+    std::int32_t parent = kNullNode;  // or the next free node
+    std::int32_t child1 = kNullNode;
+    std::int32_t child2 = kNullNode;  // a leaf's proxy id
+    std::int16_t height = 0;          // leaf 0, free -1
+    std::uint16_t enlarged = 0;       // set by enlarge(), cleared by rebuild()
+
+    bool is_leaf() const { return child1 == kNullNode; }
+    ProxyId proxy() const { return child2; }
+};
+
+/// What the tree keeps per proxy. A free slot has node == kNullNode and the next free id in
+/// next_free.
+template <class T, std::size_t N, class UserData>
+struct Proxy {
+    Aabb<T, N> box;  // the tight box the user gave
+    UserData user_data{};
+    std::int32_t node = kNullNode;
+    std::int32_t next_free = kNullNode;
+    bool moved = false;  // in the move buffer
+};
+
+}  // namespace dynamic_detail
+}  // namespace bvhkit
