@@ -2,5 +2,7 @@
 
 namespace bvhkit {
 // Anchors the version in the compiled library so a consumer can check what it linked.
-const char* linked_version() { return version_string; }
+const char* linked_version() {
+    return version_string;
+}
 }  // namespace bvhkit

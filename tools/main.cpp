@@ -1,5 +1,5 @@
-// The bvhkit command: `bvhkit SUBCOMMAND [ARGS...]`. Each subcommand lives in its own file and is listed
-// in the table below; `bvhkit help` (or no argument) prints the list.
+// The bvhkit command: `bvhkit SUBCOMMAND [ARGS...]`. Each subcommand lives in its own file and is
+// listed in the table below; `bvhkit help` (or no argument) prints the list.
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -21,7 +21,8 @@ const Subcommand kSubcommands[] = {
 };
 
 void print_usage(std::FILE* out) {
-    std::fprintf(out, "usage: bvhkit SUBCOMMAND [ARGS...]   (bvhkit SUBCOMMAND --help for details)\n\n");
+    std::fprintf(out,
+                 "usage: bvhkit SUBCOMMAND [ARGS...]   (bvhkit SUBCOMMAND --help for details)\n\n");
     for (const auto& s : kSubcommands) std::fprintf(out, "  %-12s %s\n", s.name, s.summary);
 }
 

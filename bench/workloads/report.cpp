@@ -89,7 +89,8 @@ void print_table(std::FILE* out, const std::vector<Row>& rows) {
             const Value* v = r.get(columns[c]);
             const std::string text = v ? to_text(*v) : "";
             const bool numeric = v && !std::holds_alternative<std::string>(*v);
-            std::fprintf(out, numeric ? "%*s  " : "%-*s  ", static_cast<int>(width[c]), text.c_str());
+            std::fprintf(out, numeric ? "%*s  " : "%-*s  ", static_cast<int>(width[c]),
+                         text.c_str());
         }
         std::fprintf(out, "\n");
     }

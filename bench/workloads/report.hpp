@@ -11,7 +11,8 @@
 
 namespace bvhkit::bench {
 
-/// Milliseconds taken by f(), median over `repetitions` runs (after one untimed warm-up when asked).
+/// Milliseconds taken by f(), median over `repetitions` runs (after one untimed warm-up when
+/// asked).
 double median_ms(int repetitions, const std::function<void()>& f, bool warm_up = true);
 
 double median(std::vector<double> values);

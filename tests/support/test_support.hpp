@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by every test program: where the shared meshes are, and how big a randomized test
-// should be (the sanitizer build sets BVHKIT_TEST_SCALE=small to keep CI fast; Release runs in full).
+// should be (the sanitizer build sets BVHKIT_TEST_SCALE=small to keep CI fast; Release runs in
+// full).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -10,7 +11,9 @@
 
 namespace bvhkit::test {
 
-inline std::filesystem::path data_dir() { return BVHKIT_DATA_DIR; }
+inline std::filesystem::path data_dir() {
+    return BVHKIT_DATA_DIR;
+}
 
 /// Path of a shared mesh, or an empty path when ../shared/data is absent (callers GTEST_SKIP).
 inline std::filesystem::path shared_mesh(std::string_view name) {
@@ -30,7 +33,8 @@ inline std::size_t scaled(std::size_t full, std::size_t divisor = 20) {
 
 }  // namespace bvhkit::test
 
-#define BVHKIT_REQUIRE_MESH(var, name)                                                  \
-    const auto var = ::bvhkit::test::shared_mesh(name);                                 \
-    if (var.empty()) GTEST_SKIP() << "shared mesh " << name << " not found under "     \
-                                  << ::bvhkit::test::data_dir() << "; skipping"
+#define BVHKIT_REQUIRE_MESH(var, name)                                                          \
+    const auto var = ::bvhkit::test::shared_mesh(name);                                         \
+    if (var.empty())                                                                            \
+    GTEST_SKIP() << "shared mesh " << name << " not found under " << ::bvhkit::test::data_dir() \
+                 << "; skipping"

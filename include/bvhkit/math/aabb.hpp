@@ -79,6 +79,16 @@ struct Aabb {
     }
     bool is_finite() const { return bvhkit::is_finite(min) && bvhkit::is_finite(max); }
 
+    /// The box of some points; if any point has a NaN or infinite coordinate the box is marked
+    /// non-finite (grow() alone would let a NaN slip away, as min/max ignore one NaN operand).
+    template <class... P>
+    static Aabb of_points(const P&... points) {
+        Aabb b;
+        (b.grow(points), ...);
+        if (!(bvhkit::is_finite(points) && ...)) b.min[0] = std::numeric_limits<T>::quiet_NaN();
+        return b;
+    }
+
     friend constexpr bool operator==(const Aabb&, const Aabb&) = default;
 };
 

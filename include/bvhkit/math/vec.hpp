@@ -23,8 +23,8 @@ struct Vec {
         for (std::size_t i = 0; i < N; ++i) v[i] = s;
     }
     template <class... A>
-        requires(sizeof...(A) == N && N > 1 && (std::is_arithmetic_v<A> && ...))
-    constexpr Vec(A... a) : v{static_cast<T>(a)...} {}
+    requires(sizeof...(A) == N && N > 1 && (std::is_arithmetic_v<A> && ...)) constexpr Vec(A... a)
+        : v{static_cast<T>(a)...} {}
     template <class U>
     constexpr explicit Vec(const Vec<U, N>& o) {
         for (std::size_t i = 0; i < N; ++i) v[i] = static_cast<T>(o[i]);
@@ -39,24 +39,28 @@ struct Vec {
 
     friend constexpr bool operator==(const Vec&, const Vec&) = default;
 
-#define BVHKIT_VEC_BINARY(op)                                                 \
-    friend constexpr Vec operator op(const Vec& a, const Vec& b) {            \
-        Vec r;                                                                \
-        for (std::size_t i = 0; i < N; ++i) r.v[i] = a.v[i] op b.v[i];        \
-        return r;                                                             \
-    }                                                                         \
-    friend constexpr Vec operator op(const Vec& a, T s) {                     \
-        Vec r;                                                                \
-        for (std::size_t i = 0; i < N; ++i) r.v[i] = a.v[i] op s;             \
-        return r;                                                             \
+#define BVHKIT_VEC_BINARY(op)                                          \
+    friend constexpr Vec operator op(const Vec& a, const Vec& b) {     \
+        Vec r;                                                         \
+        for (std::size_t i = 0; i < N; ++i) r.v[i] = a.v[i] op b.v[i]; \
+        return r;                                                      \
+    }                                                                  \
+    friend constexpr Vec operator op(const Vec& a, T s) {              \
+        Vec r;                                                         \
+        for (std::size_t i = 0; i < N; ++i) r.v[i] = a.v[i] op s;      \
+        return r;                                                      \
     }
     BVHKIT_VEC_BINARY(+)
     BVHKIT_VEC_BINARY(-)
     BVHKIT_VEC_BINARY(*)
     BVHKIT_VEC_BINARY(/)
 #undef BVHKIT_VEC_BINARY
-    friend constexpr Vec operator*(T s, const Vec& a) { return a * s; }
-    friend constexpr Vec operator-(const Vec& a) { return a * T(-1); }
+    friend constexpr Vec operator*(T s, const Vec& a) {
+        return a * s;
+    }
+    friend constexpr Vec operator-(const Vec& a) {
+        return a * T(-1);
+    }
 };
 
 template <class T, std::size_t N>

@@ -1,6 +1,7 @@
 #pragma once
-// TriangleMesh: shared vertices and index triples, the form mesh files arrive in. A triangle's index is
-// its position in `triangles` (for files: after polygons are split into fans, in file order).
+// TriangleMesh: shared vertices and index triples, the form mesh files arrive in. A triangle's
+// index is its position in `triangles` (for files: after polygons are split into fans, in file
+// order).
 #include <array>
 #include <cstdint>
 #include <vector>

@@ -1,0 +1,65 @@
+#pragma once
+// build_bvh(): the one entry point to every builder. Give it one box and one centroid per primitive
+// (or a span of any Primitive) and BuildOptions; the default is binned SAH.
+//
+// Rule for bad input: a primitive with a NaN or infinite coordinate (or an empty box) is left out
+// of the tree and listed in BuildReport::skipped; with NonFinitePolicy::Reject it is an error
+// instead. Empty input gives an empty tree; one primitive gives a single leaf.
+#include "bvhkit/build/binned_sah.hpp"
+#include "bvhkit/build/sweep_sah.hpp"
+#include "bvhkit/build/top_down.hpp"
+#include "bvhkit/primitives/primitive.hpp"
+
+namespace bvhkit {
+
+template <class T, std::size_t N>
+Bvh<Aabb<T, N>> build_bvh(std::span<const Aabb<T, N>> boxes, std::span<const Vec<T, N>> centroids,
+                          const BuildOptions& options = {}, BuildReport* report = nullptr) {
+    BuildInput<T, N> in{boxes, centroids};
+    if (report) report->skipped.clear();
+    std::vector<Vec<T, N>> fixed_centroids;
+    std::vector<std::uint32_t> indices = usable_primitives(in, fixed_centroids, options, report);
+    switch (options.builder) {
+        case Builder::BinnedSah: {
+            BinnedSahRule<T, N> rule(in, options);
+            return build_top_down(in, std::move(indices), options, rule);
+        }
+        case Builder::SweepSah: {
+            SweepSahRule<T, N> rule(in, options);
+            return build_top_down(in, std::move(indices), options, rule);
+        }
+        case Builder::TopDown: {
+            TopDownRule<T, N> rule(in, options);
+            return build_top_down(in, std::move(indices), options, rule);
+        }
+    }
+    throw Error("build_bvh: unknown builder");
+}
+
+/// Boxes and centroids of a span of primitives, in order.
+template <Primitive P>
+auto primitive_boxes(std::span<const P> primitives) {
+    using Box = decltype(primitives[0].bounds());
+    std::vector<Box> boxes(primitives.size());
+    for (std::size_t i = 0; i < primitives.size(); ++i) boxes[i] = primitives[i].bounds();
+    return boxes;
+}
+
+template <Primitive P>
+auto build_bvh(std::span<const P> primitives, const BuildOptions& options = {},
+               BuildReport* report = nullptr) {
+    using T = typename P::Scalar;
+    constexpr std::size_t N = primitive_dimension<P>;
+    const std::vector<Aabb<T, N>> boxes = primitive_boxes(primitives);
+    std::vector<Vec<T, N>> centroids(primitives.size());
+    for (std::size_t i = 0; i < primitives.size(); ++i) centroids[i] = primitives[i].centroid();
+    return build_bvh<T, N>(boxes, centroids, options, report);
+}
+
+template <Primitive P>
+auto build_bvh(const std::vector<P>& primitives, const BuildOptions& options = {},
+               BuildReport* report = nullptr) {
+    return build_bvh(std::span<const P>(primitives), options, report);
+}
+
+}  // namespace bvhkit

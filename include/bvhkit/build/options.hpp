@@ -1,0 +1,62 @@
+#pragma once
+// BuildOptions: one struct chooses the builder and its parameters. The default, binned SAH with 16
+// bins, is the right choice for ray tracing; the others are there to compare and to teach (seed
+// 001).
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/statistics.hpp"
+
+namespace bvhkit {
+
+enum class Builder {
+    BinnedSah,  // Wald 2007: SAH evaluated at bin boundaries; fast, near full-sweep quality
+    SweepSah,  // SAH evaluated between every pair of sorted centroids; slowest, best greedy quality
+    TopDown,   // the classic rules below: an axis rule and a split-point rule
+};
+
+/// Axis rules of the classic top-down builder, evaluated on the node's primitive centroids (the
+/// box's own longest axis can have all centroids equal, which gives no split).
+enum class SplitAxis { LongestExtent, LargestVariance };
+
+/// Split-point rules of the classic top-down builder.
+enum class SplitPoint {
+    ObjectMedian,   // half the primitives on each side
+    ObjectMean,     // at the mean centroid coordinate
+    SpatialMedian,  // at the middle of the node's box
+};
+
+/// What to do with a primitive whose box has a NaN or infinite coordinate.
+enum class NonFinitePolicy {
+    Skip,    // leave it out of the tree (it can never be hit) and list it in BuildReport::skipped
+    Reject,  // throw bvhkit::Error naming the first such primitive
+};
+
+struct BuildOptions {
+    Builder builder = Builder::BinnedSah;
+    std::uint32_t bin_count = 16;     // binned SAH: 2..256 (16 to 32 are good values)
+    std::uint32_t max_leaf_size = 8;  // a larger node is always split
+    std::uint32_t max_depth =
+        max_bvh_depth;  // a node at this depth becomes a leaf, whatever its size
+    SahCosts costs{};   // SAH builders: leaf cost vs split cost
+    SplitAxis axis_rule = SplitAxis::LongestExtent;
+    SplitPoint point_rule = SplitPoint::ObjectMedian;
+    NonFinitePolicy non_finite = NonFinitePolicy::Skip;
+};
+
+struct BuildReport {
+    std::vector<std::uint32_t> skipped;  // primitives left out for non-finite boxes, ascending
+};
+
+const char* to_string(Builder b);
+const char* to_string(SplitAxis a);
+const char* to_string(SplitPoint p);
+/// Parses "binned-sah", "sweep-sah", "top-down", or "median|mean|spatial[-variance]" shorthands
+/// into options; throws bvhkit::Error listing the valid names.
+BuildOptions parse_builder(std::string_view name);
+/// Every builder configuration: binned SAH, sweep SAH, and each top-down axis x point rule.
+std::vector<std::pair<std::string, BuildOptions>> all_builder_configurations();
+
+}  // namespace bvhkit

@@ -1,0 +1,81 @@
+#pragma once
+// validate(): checks every invariant of a Bvh against the primitive boxes it was built from, and
+// throws bvhkit::Error naming the first broken one. Tests call it after every build and refit.
+//
+// Invariants: children indices are in range and larger than the parent's (the layout refit relies
+// on); every node is reached exactly once from the root; depth <= max_bvh_depth; leaf runs are
+// non-empty and tile `primitive_indices` exactly; every primitive index is in range and appears
+// once; every primitive with a finite box is in the tree and none with a non-finite box is (the
+// builders' rule); each node's box encloses its children's boxes and its primitives' boxes.
+#include <span>
+#include <string>
+
+#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/error.hpp"
+
+namespace bvhkit {
+
+template <class T, std::size_t N>
+void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes) {
+    auto fail = [](const std::string& what) { throw Error("Bvh::validate: " + what); };
+    const std::size_t slot_count = bvh.primitive_indices.size();
+    std::vector<std::uint8_t> primitive_seen(primitive_boxes.size(), 0);
+    for (std::uint32_t p : bvh.primitive_indices) {
+        if (p >= primitive_boxes.size())
+            fail("primitive index " + std::to_string(p) + " out of range (" +
+                 std::to_string(primitive_boxes.size()) + " primitives)");
+        if (primitive_seen[p]++) fail("primitive " + std::to_string(p) + " appears twice");
+        if (!primitive_boxes[p].is_finite())
+            fail("primitive " + std::to_string(p) + " has a non-finite box but is in the tree");
+    }
+    for (std::size_t p = 0; p < primitive_boxes.size(); ++p)
+        if (!primitive_seen[p] && primitive_boxes[p].is_finite())
+            fail("primitive " + std::to_string(p) + " is missing from the tree");
+
+    if (bvh.nodes.empty()) {
+        if (slot_count) fail("no nodes but " + std::to_string(slot_count) + " primitive slots");
+        return;
+    }
+    std::vector<std::uint8_t> node_seen(bvh.nodes.size(), 0);
+    std::vector<std::uint8_t> slot_seen(slot_count, 0);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0u, 0u}};
+    node_seen[0] = 1;
+    while (!stack.empty()) {
+        const auto [index, depth] = stack.back();
+        stack.pop_back();
+        const auto& node = bvh.nodes[index];
+        const std::string name = "node " + std::to_string(index);
+        if (depth > max_bvh_depth) fail(name + " is deeper than " + std::to_string(max_bvh_depth));
+        if (node.is_leaf()) {
+            if (std::size_t(node.first) + node.count > slot_count)
+                fail(name + ": leaf run out of range");
+            for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+                if (slot_seen[s]++)
+                    fail(name + ": primitive slot " + std::to_string(s) + " in two leaves");
+                if (!node.bounds.contains(primitive_boxes[bvh.primitive_indices[s]]))
+                    fail(name + " does not enclose primitive " +
+                         std::to_string(bvh.primitive_indices[s]));
+            }
+            continue;
+        }
+        if (node.first <= index || std::size_t(node.first) + 1 >= bvh.nodes.size())
+            fail(name + ": children " + std::to_string(node.first) + " out of order or range");
+        for (std::uint32_t c : {node.left(), node.right()}) {
+            if (node_seen[c]++) fail("node " + std::to_string(c) + " has two parents");
+            if (!node.bounds.contains(bvh.nodes[c].bounds))
+                fail(name + " does not enclose its child " + std::to_string(c));
+            stack.emplace_back(c, depth + 1);
+        }
+    }
+    for (std::size_t i = 0; i < node_seen.size(); ++i)
+        if (!node_seen[i]) fail("node " + std::to_string(i) + " is unreachable");
+    for (std::size_t s = 0; s < slot_count; ++s)
+        if (!slot_seen[s]) fail("primitive slot " + std::to_string(s) + " is in no leaf");
+}
+
+template <class T, std::size_t N>
+void validate(const Bvh<Aabb<T, N>>& bvh, const std::vector<Aabb<T, N>>& primitive_boxes) {
+    validate(bvh, std::span<const Aabb<T, N>>(primitive_boxes));
+}
+
+}  // namespace bvhkit

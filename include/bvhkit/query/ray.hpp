@@ -1,0 +1,152 @@
+#pragma once
+// Ray queries over a Bvh of boxes: closest hit, any hit (occlusion) and all hits, each within the
+// ray's [tmin, tmax], in 2D and 3D.
+//
+// One traversal serves all three (traverse_ray): iterative, with a fixed stack of max_bvh_depth
+// entries (each internal node on the current path pushes at most one), nearer child first. A pushed
+// child remembers its entry distance, so once a closer hit has shrunk tmax the popped subtree is
+// skipped without touching its node.
+//
+// Primitive tests are the caller's: `test(slot, ray, hit)` tests the primitive in leaf slot `slot`
+// (bvh.primitive_indices[slot] is the caller's index) against `ray`, whose tmax is the closest hit
+// so far, and on a hit fills `hit` and returns true. TriangleBvh (triangle_bvh.hpp) and the span
+// overloads below supply it.
+#include <span>
+
+#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/math/ray.hpp"
+#include "bvhkit/primitives/hit.hpp"
+#include "bvhkit/primitives/primitive.hpp"
+#include "bvhkit/query/stats.hpp"
+
+namespace bvhkit {
+
+/// Walks the nodes `ray` meets, nearer first; calls on_leaf(node) for each leaf it reaches, which
+/// may shrink ray.tmax and returns true to stop the walk.
+template <class T, std::size_t N, class OnLeaf, class Stats = NoStats>
+void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
+                  Stats&& stats = {}) {
+    if (bvh.empty()) return;
+    const RaySlabData<T, N> slab(ray);
+    const auto* nodes = bvh.nodes.data();
+    {
+        T t0 = ray.tmin, t1 = ray.tmax;
+        stats.node();
+        if (!slab.clip(nodes[0].bounds, t0, t1)) return;
+    }
+    struct Entry {
+        std::uint32_t node;
+        T t_entry;
+    };
+    Entry stack[max_bvh_depth];
+    std::uint32_t size = 0;
+    std::uint32_t current = 0;
+    while (true) {
+        const auto& node = nodes[current];
+        if (node.is_leaf()) {
+            if (on_leaf(node)) return;
+        } else {
+            const std::uint32_t left = node.left(), right = node.right();
+            T l0 = ray.tmin, l1 = ray.tmax, r0 = ray.tmin, r1 = ray.tmax;
+            const bool hit_left = slab.clip(nodes[left].bounds, l0, l1);
+            const bool hit_right = slab.clip(nodes[right].bounds, r0, r1);
+            stats.node();
+            stats.node();
+            if (hit_left && hit_right) {
+                const bool left_first = l0 <= r0;
+                stack[size++] = left_first ? Entry{right, r0} : Entry{left, l0};
+                current = left_first ? left : right;
+                continue;
+            }
+            if (hit_left || hit_right) {
+                current = hit_left ? left : right;
+                continue;
+            }
+        }
+        // Pop the next subtree that can still hold something within [tmin, tmax].
+        do {
+            if (size == 0) return;
+            --size;
+        } while (stack[size].t_entry > ray.tmax);
+        current = stack[size].node;
+    }
+}
+
+/// Closest hit: `test(slot, ray, TriangleHit&)`, see above. Returns a miss (Hit::primitive ==
+/// invalid_index, t = inf) when nothing is hit within [tmin, tmax].
+template <class T, std::size_t N, class Test, class Stats = NoStats>
+Hit<T> closest_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats&& stats = {}) {
+    Hit<T> best;
+    std::uint32_t best_slot = invalid_index;
+    TriangleHit<T> h;
+    traverse_ray(
+        bvh, ray,
+        [&](const auto& leaf) {
+            for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
+                stats.primitive();
+                if (test(s, ray, h)) {
+                    ray.tmax = h.t;
+                    best.t = h.t;
+                    best.u = h.u;
+                    best.v = h.v;
+                    best_slot = s;
+                }
+            }
+            return false;
+        },
+        stats);
+    if (best_slot != invalid_index) best.primitive = bvh.primitive_indices[best_slot];
+    return best;
+}
+
+/// Any hit (occlusion): true as soon as some primitive is hit within [tmin, tmax].
+template <class T, std::size_t N, class Test, class Stats = NoStats>
+bool any_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats&& stats = {}) {
+    bool found = false;
+    TriangleHit<T> h;
+    traverse_ray(
+        bvh, ray,
+        [&](const auto& leaf) {
+            for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
+                stats.primitive();
+                if (test(s, ray, h)) return found = true;
+            }
+            return false;
+        },
+        stats);
+    return found;
+}
+
+/// All hits within [tmin, tmax], in no particular order: on_hit(const Hit<T>&) returns true to go
+/// on, false to stop.
+template <class T, std::size_t N, class Test, class OnHit, class Stats = NoStats>
+void all_hits(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, OnHit&& on_hit,
+              Stats&& stats = {}) {
+    TriangleHit<T> h;
+    traverse_ray(
+        bvh, ray,
+        [&](const auto& leaf) {
+            for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
+                stats.primitive();
+                if (test(s, ray, h) && !on_hit(Hit<T>{h.t, bvh.primitive_indices[s], h.u, h.v}))
+                    return true;
+            }
+            return false;
+        },
+        stats);
+}
+
+/// The primitive test for a span of RayPrimitives indexed as the tree was built over them.
+template <RayPrimitive P>
+auto primitive_ray_test(const Bvh<Aabb<typename P::Scalar, primitive_dimension<P>>>& bvh,
+                        std::span<const P> primitives) {
+    using T = typename P::Scalar;
+    return [&bvh, primitives](std::uint32_t slot, const Ray<T, primitive_dimension<P>>& ray,
+                              TriangleHit<T>& out) {
+        const auto h = primitives[bvh.primitive_indices[slot]].intersect(ray);
+        if (h) out = *h;
+        return h.has_value();
+    };
+}
+
+}  // namespace bvhkit

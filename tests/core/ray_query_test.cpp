@@ -1,0 +1,163 @@
+// Ray queries against brute force over every triangle: same hit or miss, same t, same triangle
+// unless two are tied at that t. For every builder, float and double, random soups and (in the mesh
+// tests) the shared meshes.
+#include <gtest/gtest.h>
+
+#include "brute_force.hpp"
+#include "bvhkit/bvh/validate.hpp"
+#include "bvhkit/primitives/segment.hpp"
+#include "bvhkit/triangle_bvh.hpp"
+#include "random_geometry.hpp"
+#include "test_support.hpp"
+
+using namespace bvhkit;
+
+template <class T>
+class RayQueries : public ::testing::Test {};
+using Scalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(RayQueries, Scalars);
+
+TYPED_TEST(RayQueries, EveryBuilderMatchesBruteForceOnRandomSoups) {
+    using T = TypeParam;
+    const auto tris = test::random_soup<T>(test::scaled(3000, 3), 1234);
+    Aabb<T, 3> box({-0.2, -0.2, -0.2}, {1.2, 1.2, 1.2});
+    const auto rays = test::random_rays<T>(test::scaled(20000), box, 77);
+    const test::BruteForce<T> reference(tris, rays);
+    for (const auto& [name, options] : all_builder_configurations()) {
+        SCOPED_TRACE(name);
+        const TriangleBvh<T> bvh(tris, options);
+        reference.check(bvh, rays);
+    }
+}
+
+TYPED_TEST(RayQueries, WatertightModeAgreesWithItsBruteForce) {
+    using T = TypeParam;
+    const auto tris = test::random_soup<T>(2000, 99);
+    const auto rays =
+        test::random_rays<T>(test::scaled(10000), Aabb<T, 3>({0, 0, 0}, {1, 1, 1}), 5);
+    const test::BruteForce<T> reference(tris, rays, TriangleTest::Watertight);
+    reference.check(TriangleBvh<T>(tris, {}, TriangleTest::Watertight), rays);
+}
+
+TYPED_TEST(RayQueries, AllHitsEqualsTheBruteForceSet) {
+    using T = TypeParam;
+    const auto tris = test::random_soup<T>(1500, 31);
+    const TriangleBvh<T> bvh(tris);
+    const auto rays = test::random_rays<T>(2000, Aabb<T, 3>({0, 0, 0}, {1, 1, 1}), 32);
+    std::size_t total = 0;
+    for (const auto& ray : rays) {
+        std::vector<std::uint32_t> got, want;
+        bvh.all_hits(ray, [&](const Hit<T>& h) {
+            got.push_back(h.primitive);
+            return true;
+        });
+        for (std::uint32_t i = 0; i < tris.size(); ++i) {
+            TriangleHit<T> h;
+            if (PrecomputedTriangle<T>(tris[i]).intersect(ray, ray.tmax, h)) want.push_back(i);
+        }
+        std::sort(got.begin(), got.end());
+        ASSERT_EQ(got, want);
+        total += want.size();
+    }
+    EXPECT_GT(total, rays.size());  // the rays must actually cross several triangles
+    // Stopping early: the callback sees exactly one hit.
+    int calls = 0;
+    bvh.all_hits(Ray<T, 3>({-1, 0.5, 0.5}, {1, 0, 0}), [&](const Hit<T>&) { return ++calls < 1; });
+    EXPECT_LE(calls, 1);
+}
+
+TYPED_TEST(RayQueries, TminTmaxWindowAndStatistics) {
+    using T = TypeParam;
+    // A stack of parallel unit squares at z = 0..9; a ray down the z axis through all of them.
+    std::vector<Triangle<T>> tris;
+    for (int z = 0; z < 10; ++z) {
+        tris.push_back({{0, 0, T(z)}, {1, 0, T(z)}, {0, 1, T(z)}});
+        tris.push_back({{1, 0, T(z)}, {1, 1, T(z)}, {0, 1, T(z)}});
+    }
+    const TriangleBvh<T> bvh(tris);
+    const Ray<T, 3> ray({0.3, 0.2, -1}, {0, 0, 1}, 0, std::numeric_limits<T>::infinity());
+    EXPECT_EQ(bvh.closest_hit(ray).primitive, 0u);
+    EXPECT_EQ(bvh.closest_hit(ray).t, T(1));
+    Ray<T, 3> window = ray;
+    window.tmin = T(4.5);
+    window.tmax = T(6.5);
+    const auto h = bvh.closest_hit(window);
+    EXPECT_EQ(h.primitive, 8u);  // the square at z = 4 (t = 5)
+    EXPECT_EQ(h.t, T(5));
+    window.tmax = T(4.9);
+    EXPECT_FALSE(bvh.closest_hit(window));
+    EXPECT_FALSE(bvh.any_hit(window));
+    TraversalStats stats;
+    bvh.closest_hit(ray, stats);
+    EXPECT_GT(stats.nodes_visited, 0u);
+    EXPECT_GE(stats.primitives_tested, 1u);
+    EXPECT_LE(stats.primitives_tested, tris.size());
+}
+
+TYPED_TEST(RayQueries, RaysWithZeroDirectionComponentsAndDegenerateTrees) {
+    using T = TypeParam;
+    const auto tris = test::random_soup<T>(3000, 8);
+    const auto rays_in =
+        test::random_rays<T>(test::scaled(6000), Aabb<T, 3>({0, 0, 0}, {1, 1, 1}), 9);
+    std::vector<Ray<T, 3>> rays;
+    for (std::size_t i = 0; i < rays_in.size(); ++i) {
+        Ray<T, 3> r = rays_in[i];
+        // zero one or two components, with either sign
+        r.direction[i % 3] = (i / 3) % 2 ? T(0) : -T(0);
+        if (i % 5 == 0) r.direction[(i + 1) % 3] = T(0);
+        rays.push_back(r);
+    }
+    const test::BruteForce<T> reference(tris, rays);
+    reference.check(TriangleBvh<T>(tris), rays);
+
+    // Empty tree: every query misses. One triangle: a single leaf that hits.
+    const TriangleBvh<T> empty(std::vector<Triangle<T>>{});
+    EXPECT_FALSE(empty.closest_hit(rays[0]));
+    EXPECT_FALSE(empty.any_hit(rays[0]));
+    const TriangleBvh<T> one(std::vector<Triangle<T>>{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}});
+    EXPECT_EQ(one.closest_hit(Ray<T, 3>({0.2, 0.2, 1}, {0, 0, -1})).primitive, 0u);
+}
+
+TYPED_TEST(RayQueries, NanTrianglesAreSkippedAndTheRestStillHit) {
+    using T = TypeParam;
+    auto tris = test::random_soup<T>(2000, 70);
+    for (std::size_t i = 0; i < tris.size(); i += 97)
+        tris[i].p1[1] = std::numeric_limits<T>::quiet_NaN();
+    const TriangleBvh<T> bvh(tris);
+    EXPECT_EQ(bvh.skipped().size(), (tris.size() + 96) / 97);
+    const auto rays =
+        test::random_rays<T>(test::scaled(5000), Aabb<T, 3>({0, 0, 0}, {1, 1, 1}), 71);
+    test::BruteForce<T>(tris, rays).check(bvh, rays);
+}
+
+TEST(RayQueries2d, SegmentsMatchBruteForce) {
+    test::Random rng(101);
+    std::vector<Segment<float>> segs(3000);
+    for (auto& s : segs) {
+        const Vec2f c{float(rng.uniform()), float(rng.uniform())};
+        const Vec2f d{float(rng.uniform(-0.05, 0.05)), float(rng.uniform(-0.05, 0.05))};
+        s = {c - d, c + d};
+    }
+    for (const auto& [name, options] : all_builder_configurations()) {
+        SCOPED_TRACE(name);
+        const auto bvh = build_bvh(segs, options);
+        const auto test_segment = primitive_ray_test(bvh, std::span<const Segment<float>>(segs));
+        for (int i = 0; i < 3000; ++i) {
+            const Vec2f o{float(rng.uniform()), float(rng.uniform())};
+            const double angle = rng.uniform(0, 6.283185307179586);
+            Vec2f d{float(std::cos(angle)), float(std::sin(angle))};
+            if (i % 7 == 0) d[i % 2] = 0;
+            const Ray2f ray(o, d);
+            const Hit<float> got = closest_hit(bvh, ray, test_segment);
+            float best = std::numeric_limits<float>::infinity();
+            std::uint32_t best_i = invalid_index;
+            for (std::uint32_t k = 0; k < segs.size(); ++k)
+                if (auto h = segs[k].intersect(ray); h && h->t < best) best = h->t, best_i = k;
+            ASSERT_EQ(bool(got), best_i != invalid_index) << i;
+            if (got) {
+                ASSERT_EQ(got.t, best);
+                ASSERT_EQ(any_hit(bvh, ray, test_segment), true);
+            }
+        }
+    }
+}

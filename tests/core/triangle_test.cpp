@@ -1,0 +1,123 @@
+#include <gtest/gtest.h>
+
+#include "bvhkit/primitives/segment.hpp"
+#include "bvhkit/primitives/triangle.hpp"
+#include "random_geometry.hpp"
+
+using namespace bvhkit;
+
+template <class T>
+class TriangleTests : public ::testing::Test {};
+using Scalars = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(TriangleTests, Scalars);
+
+TYPED_TEST(TriangleTests, ThreeTestsAgreeAndHitPointsLieOnTheTriangle) {
+    using T = TypeParam;
+    test::Random rng(3);
+    int hits = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const Triangle<T> tri{rng.point_in(Aabb<T, 3>({-1, -1, -1}, {1, 1, 1})),
+                              rng.point_in(Aabb<T, 3>({-1, -1, -1}, {1, 1, 1})),
+                              rng.point_in(Aabb<T, 3>({-1, -1, -1}, {1, 1, 1}))};
+        // Aim at a random barycentric point (sometimes outside) from a random origin.
+        const T a = T(rng.uniform(-0.2, 1.2)), b = T(rng.uniform(-0.2, 1.2));
+        const Vec<T, 3> target = tri.p0 + (tri.p1 - tri.p0) * a + (tri.p2 - tri.p0) * b;
+        const Vec<T, 3> origin = rng.point_in(Aabb<T, 3>({-3, -3, -3}, {3, 3, 3}));
+        const Ray<T, 3> ray(origin, target - origin);
+        const auto mt = tri.intersect(ray);
+        const auto wt = tri.intersect_watertight(ray);
+        TriangleHit<T> pre;
+        const bool pre_hit = PrecomputedTriangle<T>(tri).intersect(ray, ray.tmax, pre);
+        const bool inside = a >= 0 && b >= 0 && a + b <= 1;
+        // Away from the edges all three must agree with where we aimed.
+        const T margin = T(1e-3);
+        const bool clear =
+            std::min({a, b, T(1) - a - b}) > margin || std::min({a, b, T(1) - a - b}) < -margin;
+        if (tri.area() < T(1e-2) || !clear) continue;
+        ASSERT_EQ(mt.has_value(), inside) << i;
+        ASSERT_EQ(wt.has_value(), inside) << i;
+        ASSERT_EQ(pre_hit, inside) << i;
+        if (!inside) continue;
+        ++hits;
+        const T tol = std::is_same_v<T, float> ? T(2e-3) : T(1e-9);
+        EXPECT_NEAR(mt->t, T(1), tol);
+        EXPECT_NEAR(wt->t, T(1), tol);
+        EXPECT_NEAR(pre.t, T(1), tol);
+        for (const auto& h : {*mt, *wt, pre}) {
+            const Vec<T, 3> p = tri.p0 * (T(1) - h.u - h.v) + tri.p1 * h.u + tri.p2 * h.v;
+            EXPECT_NEAR(length(p - ray.at(h.t)), T(0), tol * 10);
+            EXPECT_NEAR(h.u, a, tol * 10);
+            EXPECT_NEAR(h.v, b, tol * 10);
+        }
+    }
+    EXPECT_GT(hits, 1000);
+}
+
+TYPED_TEST(TriangleTests, RespectsTminTmaxAndMissesDegenerateOnes) {
+    using T = TypeParam;
+    const Triangle<T> tri{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const Ray<T, 3> ray({T(0.25), T(0.25), 1}, {0, 0, -1});
+    ASSERT_TRUE(tri.intersect(ray));
+    Ray<T, 3> short_ray = ray;
+    short_ray.tmax = T(0.5);
+    EXPECT_FALSE(tri.intersect(short_ray));
+    EXPECT_FALSE(tri.intersect_watertight(short_ray));
+    TriangleHit<T> h;
+    EXPECT_FALSE(PrecomputedTriangle<T>(tri).intersect(short_ray, short_ray.tmax, h));
+    Ray<T, 3> late = ray;
+    late.tmin = T(1.5);
+    EXPECT_FALSE(tri.intersect(late));
+    // Zero-area triangles (a point, a segment) are never hit, even when the ray passes through
+    // them.
+    for (const Triangle<T>& flat : {Triangle<T>{{0.25, 0.25, 0}, {0.25, 0.25, 0}, {0.25, 0.25, 0}},
+                                    Triangle<T>{{0, 0.25, 0}, {1, 0.25, 0}, {0.5, 0.25, 0}}}) {
+        EXPECT_FALSE(flat.intersect(ray));
+        EXPECT_FALSE(flat.intersect_watertight(ray));
+        EXPECT_FALSE(PrecomputedTriangle<T>(flat).intersect(ray, ray.tmax, h));
+    }
+    // A ray lying in the triangle's plane misses (it never crosses it).
+    EXPECT_FALSE(tri.intersect(Ray<T, 3>({-1, T(0.1), 0}, {1, 0, 0})));
+}
+
+TEST(Watertight, RaysThroughASharedEdgeNeverSlipBetween) {
+    // A quad split along its diagonal; rays aimed exactly at points of the diagonal must hit one of
+    // the two triangles (the property Moller-Trumbore does not guarantee).
+    test::Random rng(17);
+    int fast_misses = 0;
+    for (int i = 0; i < 100000; ++i) {
+        const Vec3f a = rng.point_in(Aabb3f({-1, -1, -1}, {1, 1, 1}));
+        const Vec3f c = rng.point_in(Aabb3f({-1, -1, -1}, {1, 1, 1}));
+        const Vec3f b = rng.point_in(Aabb3f({-1, -1, -1}, {1, 1, 1}));
+        const Vec3f d = a + c - b;  // the fourth corner of a parallelogram
+        const Trianglef t1{a, b, c}, t2{a, c, d};
+        const float s = float(rng.uniform(0.05, 0.95));
+        const Vec3f on_edge = a + (c - a) * s;
+        const Vec3f origin = rng.point_in(Aabb3f({-4, -4, -4}, {4, 4, 4}));
+        const Ray3f ray(origin, on_edge - origin);
+        ASSERT_TRUE(t1.intersect_watertight(ray) || t2.intersect_watertight(ray)) << i;
+        fast_misses += !(t1.intersect(ray) || t2.intersect(ray));
+    }
+    std::printf("Moller-Trumbore slipped through a shared edge on %d of 100000 rays\n",
+                fast_misses);
+}
+
+TEST(Segment, RayHitsAgreeWithParametricSolve) {
+    test::Random rng(9);
+    int hits = 0;
+    for (int i = 0; i < 10000; ++i) {
+        const Segment<double> seg{{rng.uniform(-1, 1), rng.uniform(-1, 1)},
+                                  {rng.uniform(-1, 1), rng.uniform(-1, 1)}};
+        const double s = rng.uniform(-0.3, 1.3);
+        const Vec2d target = seg.p0 + (seg.p1 - seg.p0) * s;
+        const Vec2d origin{rng.uniform(-3, 3), rng.uniform(-3, 3)};
+        const auto h = seg.intersect(Ray2d(origin, target - origin));
+        if (std::fabs(s) < 1e-6 || std::fabs(s - 1) < 1e-6) continue;
+        ASSERT_EQ(h.has_value(), s >= 0 && s <= 1) << i;
+        if (h) {
+            ++hits;
+            EXPECT_NEAR(h->t, 1.0, 1e-9);
+            EXPECT_NEAR(h->u, s, 1e-9);
+        }
+    }
+    EXPECT_GT(hits, 3000);
+}

@@ -1,0 +1,62 @@
+#pragma once
+// Deterministic random geometry for tests: soups of triangles, rays through a box.
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "bvhkit/math/ray.hpp"
+#include "bvhkit/primitives/triangle.hpp"
+
+namespace bvhkit::test {
+
+/// Uniform in [lo, hi) from raw 32-bit draws (std::uniform_real_distribution differs across
+/// libraries).
+class Random {
+  public:
+    explicit Random(std::uint64_t seed) : engine_(static_cast<std::mt19937::result_type>(seed)) {}
+    double uniform(double lo = 0.0, double hi = 1.0) {
+        return lo + (hi - lo) * (engine_() * (1.0 / 4294967296.0));
+    }
+    std::uint32_t below(std::uint32_t n) { return static_cast<std::uint32_t>(uniform() * n) % n; }
+    template <class T>
+    Vec<T, 3> point_in(const Aabb<T, 3>& box) {
+        return {T(uniform(box.min[0], box.max[0])), T(uniform(box.min[1], box.max[1])),
+                T(uniform(box.min[2], box.max[2]))};
+    }
+    template <class T>
+    Vec<T, 3> unit_vector() {
+        while (true) {
+            const Vec<double, 3> v{uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)};
+            const double l = length(v);
+            if (l > 1e-3 && l <= 1.0) return Vec<T, 3>(v / l);
+        }
+    }
+
+  private:
+    std::mt19937 engine_;
+};
+
+/// `count` triangles with corners near random centres in the unit cube, sizes from tiny to ~0.2.
+template <class T>
+std::vector<Triangle<T>> random_soup(std::size_t count, std::uint64_t seed) {
+    Random rng(seed);
+    std::vector<Triangle<T>> out(count);
+    for (auto& tri : out) {
+        const Vec<T, 3> c = rng.point_in(Aabb<T, 3>({0, 0, 0}, {1, 1, 1}));
+        const T size = T(0.2 * std::pow(rng.uniform(), 3.0));
+        const Aabb<T, 3> around(c - Vec<T, 3>(size), c + Vec<T, 3>(size));
+        tri = {rng.point_in(around), rng.point_in(around), rng.point_in(around)};
+    }
+    return out;
+}
+
+/// Rays with origins uniform in `box` and directions uniform on the sphere (workload R2's rule).
+template <class T>
+std::vector<Ray<T, 3>> random_rays(std::size_t count, const Aabb<T, 3>& box, std::uint64_t seed) {
+    Random rng(seed);
+    std::vector<Ray<T, 3>> out(count);
+    for (auto& r : out) r = Ray<T, 3>(rng.point_in(box), rng.unit_vector<T>());
+    return out;
+}
+
+}  // namespace bvhkit::test
