@@ -256,6 +256,10 @@ class BinaryReader {
     [[noreturn]] void fail_here(const std::string& what) const {
         fail_at_offset(name_, pos_, what);
     }
+    /// An error about the value just read, naming where it starts.
+    [[noreturn]] void fail_at_value(const std::string& what) const {
+        fail_at_offset(name_, last_value_offset_, what);
+    }
     std::size_t position() const { return pos_; }
     std::string where() const { return "byte " + std::to_string(pos_); }
 
@@ -263,6 +267,7 @@ class BinaryReader {
     template <class T>
     T load() {
         if (size_ - pos_ < sizeof(T)) fail_here("the data ends early (truncated file)");
+        last_value_offset_ = pos_;
         unsigned char raw[sizeof(T)];
         std::memcpy(raw, data_ + pos_, sizeof(T));
         if (swap_) std::reverse(raw, raw + sizeof(T));
@@ -281,6 +286,7 @@ class BinaryReader {
     std::size_t pos_;
     bool swap_;
     std::string_view name_;
+    std::size_t last_value_offset_ = 0;
 };
 
 // Ascii data: whitespace-separated numbers, each range-checked against its declared type.
@@ -350,6 +356,7 @@ class AsciiReader {
     [[noreturn]] void fail_here(const std::string& what) const {
         fail_at_line(name_, cursor_.line(), what);
     }
+    [[noreturn]] void fail_at_value(const std::string& what) const { fail_here(what); }
 
   private:
     std::string_view next() {
@@ -453,8 +460,8 @@ class BodyReader {
 
     std::uint32_t checked_index(std::int64_t index) {
         if (index < 0 || static_cast<std::uint64_t>(index) >= vertex_count_)
-            r_.fail_here("vertex index " + std::to_string(index) + " is out of range (" +
-                         std::to_string(vertex_count_) + " vertices)");
+            r_.fail_at_value("vertex index " + std::to_string(index) + " is out of range (" +
+                             std::to_string(vertex_count_) + " vertices)");
         return static_cast<std::uint32_t>(index);
     }
 
@@ -475,8 +482,8 @@ class BodyReader {
                 }
                 const std::int64_t n = r_.list_count(p);
                 if (n < 3)
-                    r_.fail_here("face " + std::to_string(f) + " has " + std::to_string(n) +
-                                 " vertices; at least 3 are needed");
+                    r_.fail_at_value("face " + std::to_string(f) + " has " + std::to_string(n) +
+                                     " vertices; at least 3 are needed");
                 r_.require_items(static_cast<std::uint64_t>(n), p.type);
                 corners.clear();
                 for (std::int64_t k = 0; k < n; ++k)
