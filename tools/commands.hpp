@@ -1,8 +1,10 @@
 #pragma once
-// One function per subcommand of the bvhkit command; argv[0] is the subcommand's name. They return the
-// process exit code (0 ok, 1 error, 2 bad usage) and may throw bvhkit::Error, which main() reports.
+// One function per subcommand of the bvhkit command; argv[0] is the subcommand's name. They return
+// the process exit code (0 ok, 1 error, 2 bad usage) and may throw bvhkit::Error, which main()
+// reports.
 namespace bvhkit::tools {
 
 int version_command(int argc, char** argv);
+int bench_command(int argc, char** argv);
 
 }  // namespace bvhkit::tools

@@ -17,6 +17,8 @@ struct Subcommand {
 };
 
 const Subcommand kSubcommands[] = {
+    {"bench", "same-run benchmarks against the peers (rays, dynamic)",
+     bvhkit::tools::bench_command},
     {"version", "print the library version", bvhkit::tools::version_command},
 };
 

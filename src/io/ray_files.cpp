@@ -12,13 +12,15 @@ namespace {
 static_assert(std::endian::native == std::endian::little,
               "ray and hit files are little-endian; add byte swapping for this machine");
 
-std::vector<char> read_all(const std::filesystem::path& path, std::size_t record, const char* what) {
+std::vector<char> read_all(const std::filesystem::path& path, std::size_t record,
+                           const char* what) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path.string() + ": cannot open " + what + " file");
     std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (bytes.size() % record != 0)
-        throw Error(path.string() + ": " + std::to_string(bytes.size()) + " bytes is not a whole number of " +
-                    what + " records (" + std::to_string(record) + " bytes each)");
+        throw Error(path.string() + ": " + std::to_string(bytes.size()) +
+                    " bytes is not a whole number of " + what + " records (" +
+                    std::to_string(record) + " bytes each)");
     return bytes;
 }
 

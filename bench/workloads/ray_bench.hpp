@@ -1,0 +1,25 @@
+#pragma once
+// Workload R of ../shared/BENCHMARKS.md: build, R1 primary rays, R2 incoherent rays, R3 occlusion,
+// for bvhkit and (when installed) Embree 3 in the same process, one thread each, medians of
+// repetitions.
+#include <string>
+#include <vector>
+
+#include "report.hpp"
+
+namespace bvhkit::bench {
+
+struct RayBenchOptions {
+    std::vector<std::string> meshes;  // files or generator specs
+    int repetitions = 5;
+    std::uint32_t camera_size = 1024;   // R1: camera_size^2 rays
+    std::size_t random_rays = 1000000;  // R2, R3
+    std::string builder = "binned-sah";
+};
+
+/// One row per (workload, mesh, library); bvhkit's rows carry `speedup` = Embree ms / bvhkit ms.
+std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progress);
+
+bool have_embree();
+
+}  // namespace bvhkit::bench

@@ -1,0 +1,64 @@
+#pragma once
+// A small command-line parser shared by the subcommands: `--name value`, `--flag`, positionals.
+// Unknown options and missing values are errors that name the option.
+#include <cstdlib>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "bvhkit/error.hpp"
+
+namespace bvhkit::tools {
+
+class Args {
+  public:
+    /// `valued`: options that take a value; `flags`: options that do not.
+    Args(int argc, char** argv, std::set<std::string> valued, std::set<std::string> flags) {
+        for (int i = 1; i < argc; ++i) {
+            const std::string a = argv[i];
+            if (a == "--help" || a == "-h") {
+                help_ = true;
+            } else if (a.size() > 1 && a[0] == '-' &&
+                       !(a.size() > 1 && (std::isdigit(a[1]) || a[1] == '.'))) {
+                if (flags.count(a)) {
+                    flags_.insert(a);
+                } else if (valued.count(a)) {
+                    if (i + 1 >= argc) throw Error("option " + a + " needs a value");
+                    values_[a] = argv[++i];
+                } else {
+                    throw Error("unknown option " + a + " (see --help)");
+                }
+            } else {
+                positional_.push_back(a);
+            }
+        }
+    }
+    bool help() const { return help_; }
+    bool flag(const std::string& name) const { return flags_.count(name) != 0; }
+    bool has(const std::string& name) const { return values_.count(name) != 0; }
+    std::string value(const std::string& name, const std::string& fallback = "") const {
+        auto it = values_.find(name);
+        return it == values_.end() ? fallback : it->second;
+    }
+    long long integer(const std::string& name, long long fallback, long long lo,
+                      long long hi) const {
+        if (!has(name)) return fallback;
+        const std::string v = value(name);
+        char* end = nullptr;
+        const long long x = std::strtoll(v.c_str(), &end, 10);
+        if (v.empty() || *end != '\0' || x < lo || x > hi)
+            throw Error("option " + name + ": '" + v + "' is not an integer in [" +
+                        std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return x;
+    }
+    const std::vector<std::string>& positional() const { return positional_; }
+
+  private:
+    bool help_ = false;
+    std::set<std::string> flags_;
+    std::map<std::string, std::string> values_;
+    std::vector<std::string> positional_;
+};
+
+}  // namespace bvhkit::tools

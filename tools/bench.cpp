@@ -1,0 +1,71 @@
+// `bvhkit bench rays|dynamic ...`: the same-run comparisons against the peers.
+#include <cstdio>
+#include <filesystem>
+#include <string_view>
+
+#include "args.hpp"
+#include "commands.hpp"
+#include "ray_bench.hpp"
+
+namespace bvhkit::tools {
+namespace {
+
+constexpr const char* kRaysHelp =
+    R"(usage: bvhkit bench rays [MESH ...] [--json] [--reps N] [--rays N]
+                         [--size N] [--builder NAME]
+
+Workload R of BENCHMARKS.md for bvhkit and Embree 3 (when installed), in this process, one thread
+each: build, R1 (camera rays, SIZE x SIZE), R2 (random rays), R3 (R2 as occlusion queries).
+Times are medians of N repetitions; speedup = Embree ms / bvhkit ms (> 1: bvhkit is faster).
+MESH is a file (OBJ, PLY, STL) or a generator spec such as sphere:subdiv=7; the default is the
+shared bunny and igea meshes when present, else a procedural sphere.
+
+  --json          print a JSON array of rows instead of a table
+  --reps N        repetitions per figure (default 5)
+  --rays N        rays in R2 and R3 (default 1000000)
+  --size N        R1 image side (default 1024)
+  --builder NAME  bvhkit builder (default binned-sah)
+)";
+
+int bench_rays(int argc, char** argv) {
+    const Args args(argc, argv, {"--reps", "--rays", "--size", "--builder"}, {"--json"});
+    if (args.help()) {
+        std::fputs(kRaysHelp, stdout);
+        return 0;
+    }
+    bench::RayBenchOptions o;
+    o.meshes = args.positional();
+    if (o.meshes.empty()) {
+        for (const char* m : {"stanford-bunny.obj", "igea.ply"}) {
+            const auto p = std::filesystem::path(BVHKIT_SHARED_DATA) / m;
+            if (std::filesystem::exists(p)) o.meshes.push_back(p.string());
+        }
+        if (o.meshes.empty()) o.meshes.push_back("sphere:subdiv=7");
+    }
+    o.repetitions = int(args.integer("--reps", 5, 1, 1000));
+    o.random_rays = std::size_t(args.integer("--rays", 1000000, 1, 100000000));
+    o.camera_size = std::uint32_t(args.integer("--size", 1024, 1, 16384));
+    o.builder = args.value("--builder", "binned-sah");
+    if (!bench::have_embree())
+        std::fprintf(stderr,
+                     "Embree 3 was not found at build time (apt-get install libembree-dev): "
+                     "only bvhkit is measured\n");
+    const auto rows = bench::run_ray_bench(o, args.flag("--json") ? nullptr : stderr);
+    if (args.flag("--json"))
+        bench::print_json(stdout, rows);
+    else
+        bench::print_table(stdout, rows);
+    return 0;
+}
+
+}  // namespace
+
+int bench_command(int argc, char** argv) {
+    const std::string_view what = argc > 1 ? argv[1] : "";
+    if (what == "rays") return bench_rays(argc - 1, argv + 1);
+    std::fprintf(what == "--help" || what == "-h" ? stdout : stderr,
+                 "usage: bvhkit bench rays [...]   (bvhkit bench rays --help)\n");
+    return what == "--help" || what == "-h" ? 0 : 2;
+}
+
+}  // namespace bvhkit::tools
