@@ -6,5 +6,7 @@ namespace bvhkit::tools {
 
 int version_command(int argc, char** argv);
 int bench_command(int argc, char** argv);
+int bench_dynamic_command(int argc, char** argv);  // tools/bench_dynamic.cpp
+int draw_tree_command(int argc, char** argv);      // tools/draw_tree.cpp
 
 }  // namespace bvhkit::tools

@@ -19,6 +19,9 @@ struct Subcommand {
 const Subcommand kSubcommands[] = {
     {"bench", "same-run benchmarks against the peers (rays, dynamic)",
      bvhkit::tools::bench_command},
+    {"bench-dynamic", "dynamic tree workloads D1-D3 against Box2D and Bullet",
+     bvhkit::tools::bench_dynamic_command},
+    {"draw-tree", "draw a 2D dynamic tree as SVG", bvhkit::tools::draw_tree_command},
     {"version", "print the library version", bvhkit::tools::version_command},
 };
 

@@ -1,0 +1,24 @@
+#pragma once
+// Workloads D1, D2, D3 of ../shared/BENCHMARKS.md: the dynamic tree as a broadphase, against Box2D
+// 2.4.1's b2BroadPhase (D1, 2D) and Bullet's btDbvtBroadphase (D2, 3D) in the same process.
+#include <cstdio>
+#include <vector>
+
+#include "report.hpp"
+
+namespace bvhkit::bench {
+
+struct DynamicBenchConfig {
+    int n = 100000;  // boxes in D1 and D2 (D3 starts from n / 10)
+    int steps = 60;  // simulation steps in D1 and D2
+    int reps = 3;    // repetitions; medians are reported
+    bool d1 = true, d2 = true, d3 = true;
+};
+
+/// Runs the workloads and returns one row per (workload, library) with the fields workload,
+/// library, build_ms, step_ms, speedup (peer step ms / bvhkit step ms, on the peer's row), pairs,
+/// agree, height, sah_cost, area_ratio, touched (moves that restructured the tree). Progress goes
+/// to `log`.
+std::vector<Row> run_dynamic_bench(const DynamicBenchConfig& config, std::FILE* log);
+
+}  // namespace bvhkit::bench
