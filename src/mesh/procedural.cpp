@@ -148,14 +148,22 @@ TriangleMesh make_geodesic_sphere(std::uint32_t frequency, float displacement, s
     const std::uint64_t vertex_count = face_base + 20 * per_face;
 
     TriangleMesh mesh;
-    std::vector<Vec3d> unit(vertex_count);
-    for (int c = 0; c < 12; ++c) unit[c] = normalize(ico.corners[c]);
+    // Radial displacement keeps the surface star-shaped about the centre (radius stays positive),
+    // so it stays closed, free of self-intersections and outward-facing.
+    mesh.vertices.resize(vertex_count);
+    const Bumps bumps(seed);
+    auto place = [&](std::uint64_t id, const Vec3d& on_plane) {
+        const Vec3d unit = normalize(on_plane);
+        const double radius = displacement > 0.0f ? 1.0 + displacement * bumps(unit) : 1.0;
+        mesh.vertices[id] = to_float(unit * radius);
+    };
+    for (int c = 0; c < 12; ++c) place(static_cast<std::uint64_t>(c), ico.corners[c]);
     for (int e = 0; e < 30; ++e) {
         const Vec3d& a = ico.corners[ico.edges[e][0]];
         const Vec3d& b = ico.corners[ico.edges[e][1]];
         for (std::uint64_t t = 1; t < f; ++t)
-            unit[edge_base + e * (f - 1) + (t - 1)] =
-                normalize(a + (b - a) * (static_cast<double>(t) / static_cast<double>(f)));
+            place(edge_base + static_cast<std::uint64_t>(e) * (f - 1) + (t - 1),
+                  a + (b - a) * (static_cast<double>(t) / static_cast<double>(f)));
     }
     // Lattice point (i, j) of a face (A, B, C) is A + i/f (B - A) + j/f (C - A).
     auto interior_index = [&](std::uint64_t face, std::uint64_t i, std::uint64_t j) {
@@ -169,7 +177,8 @@ TriangleMesh make_geodesic_sphere(std::uint32_t frequency, float displacement, s
             for (std::uint64_t j = 1; i + j < f; ++j) {
                 const double u = static_cast<double>(i) / static_cast<double>(f);
                 const double w = static_cast<double>(j) / static_cast<double>(f);
-                unit[interior_index(face, i, j)] = normalize(a + (b - a) * u + (c - a) * w);
+                place(interior_index(static_cast<std::uint64_t>(face), i, j),
+                      a + (b - a) * u + (c - a) * w);
             }
     }
     auto on_edge = [&](int from, int to, std::uint64_t steps_from_first) -> std::uint64_t {
@@ -208,15 +217,6 @@ TriangleMesh make_geodesic_sphere(std::uint32_t frequency, float displacement, s
                     mesh.triangles.push_back({lattice(face, i + 1, j), lattice(face, i + 1, j + 1),
                                               lattice(face, i, j + 1)});
             }
-
-    // Radial displacement keeps the surface star-shaped about the centre (radius stays positive),
-    // so it stays closed, free of self-intersections and outward-facing.
-    mesh.vertices.resize(vertex_count);
-    const Bumps bumps(seed);
-    for (std::uint64_t v = 0; v < vertex_count; ++v) {
-        const double radius = displacement > 0.0f ? 1.0 + displacement * bumps(unit[v]) : 1.0;
-        mesh.vertices[v] = to_float(unit[v] * radius);
-    }
     return mesh;
 }
 
