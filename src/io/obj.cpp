@@ -52,6 +52,8 @@ class ObjParser {
         mesh_.vertices.reserve(bytes_.size() / 64);
         mesh_.triangles.reserve(bytes_.size() / 64);
         std::size_t pos = 0;
+        // Some Windows tools start text files with a UTF-8 byte order mark.
+        if (bytes_.starts_with("\xEF\xBB\xBF")) pos = 3;
         while (pos < bytes_.size()) {
             const void* nl = std::memchr(bytes_.data() + pos, '\n', bytes_.size() - pos);
             const std::size_t end =

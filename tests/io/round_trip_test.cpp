@@ -72,6 +72,12 @@ TEST(ObjRoundTrip, FacesMayPrecedeTheirVertices) {
     EXPECT_EQ(m.triangle_count(), 1u);
 }
 
+TEST(ObjRoundTrip, AByteOrderMarkIsSkipped) {
+    EXPECT_EQ(
+        read_obj("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bom.obj").triangle_count(),
+        1u);
+}
+
 TEST(ObjRoundTrip, NonFiniteCoordinatesAreKeptAsData) {
     const TriangleMesh m =
         read_obj("v nan 0 0\nv inf -inf 1e39\nv +1.5 -0 1e-50\nf 1 2 3\n", "nonfinite.obj");
