@@ -1,7 +1,5 @@
 #include "ray_bench.hpp"
 
-#include <cmath>
-
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/ray_sets.hpp"
@@ -21,20 +19,11 @@ std::string mesh_name(const std::string& arg) {
     return slash == std::string::npos ? arg : arg.substr(slash + 1);
 }
 
-struct Timed {
-    double ms;
-    std::size_t hits;
+struct Workload {
+    const char* name;
+    const std::vector<Ray3f>* rays;
+    bool occlusion;
 };
-
-template <class Trace>
-Timed time_rays(int reps, const std::vector<Ray3f>& rays, Trace&& trace) {
-    std::size_t hits = 0;
-    const double ms = median_ms(reps, [&] {
-        hits = 0;
-        for (const auto& r : rays) hits += trace(r);
-    });
-    return {ms, hits};
-}
 
 }  // namespace
 
@@ -46,49 +35,58 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
         const std::string name = mesh_name(arg);
         if (progress)
             std::fprintf(progress, "%s: %zu triangles\n", name.c_str(), mesh.triangle_count());
-        const auto base = [&](const char* workload, const char* library) {
+        const auto row_for = [&](const char* workload, const char* library) {
             Row r;
-            r.set("workload", workload)
-                .set("mesh", name)
-                .set("triangles", (long long)mesh.triangle_count());
-            r.set("library", library);
+            r.set("workload", workload).set("mesh", name);
+            r.set("triangles", (long long)mesh.triangle_count()).set("library", library);
             return r;
         };
         const Aabb3f bounds = mesh.bounds();
         const std::vector<Ray3f> r1 = camera_rays(bounds, options.camera_size, options.camera_size);
         const std::vector<Ray3f> r2 = random_rays(bounds, options.random_rays, 1);
 
-        // Build.
+        // Build: from a mesh in memory to a tree ready to trace, for both libraries.
         TriangleBvh<float> ours;
-        const double our_build =
-            median_ms(options.repetitions, [&] { ours = TriangleBvh<float>(mesh, build_options); });
-        const BvhStatistics stats = statistics(ours.bvh());
-        Row build_row = base("build", "bvhkit");
-        build_row.set("ms", our_build).set("sah_cost", stats.sah_cost);
+        const auto build_ours = [&] { ours = TriangleBvh<float>(mesh, build_options); };
 #if BVHKIT_HAVE_EMBREE
         EmbreeScene embree(mesh, 1);
-        const double embree_build = median_ms(
-            options.repetitions, [&] { embree.build(mesh); }, false);
-        build_row.set("speedup", embree_build / our_build);
+        const auto [our_build, peer_build] =
+            median_ms_interleaved(options.repetitions, build_ours, [&] { embree.build(mesh); });
+#else
+        const double our_build = median_ms(options.repetitions, build_ours);
+#endif
+        Row build_row = row_for("build", "bvhkit");
+        build_row.set("ms", our_build).set("sah_cost", statistics(ours.bvh()).sah_cost);
+#if BVHKIT_HAVE_EMBREE
+        build_row.set("speedup", peer_build / our_build);
         rows.push_back(build_row);
-        rows.push_back(base("build", "embree3").set("ms", embree_build));
+        rows.push_back(row_for("build", "embree3").set("ms", peer_build));
 #else
         rows.push_back(build_row);
 #endif
 
-        struct Workload {
-            const char* name;
-            const std::vector<Ray3f>* rays;
-            bool occlusion;
-        };
         for (const Workload& w :
              {Workload{"R1", &r1, false}, Workload{"R2", &r2, false}, Workload{"R3", &r2, true}}) {
             if (progress) std::fprintf(progress, "  %s ...\n", w.name);
-            const Timed our =
-                w.occlusion ? time_rays(options.repetitions, *w.rays,
-                                        [&](const Ray3f& r) { return ours.any_hit(r); })
-                            : time_rays(options.repetitions, *w.rays,
-                                        [&](const Ray3f& r) { return bool(ours.closest_hit(r)); });
+            std::size_t our_hits = 0;
+            const auto trace_ours = [&] {
+                our_hits = 0;
+                for (const auto& r : *w.rays)
+                    our_hits += w.occlusion ? ours.any_hit(r) : bool(ours.closest_hit(r));
+            };
+#if BVHKIT_HAVE_EMBREE
+            std::size_t peer_hits = 0;
+            const auto trace_peer = [&] {
+                peer_hits = 0;
+                for (const auto& r : *w.rays)
+                    peer_hits += w.occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
+            };
+            const auto [our_ms, peer_ms] =
+                median_ms_interleaved(options.repetitions, trace_ours, trace_peer);
+#else
+            const double our_ms = median_ms(options.repetitions, trace_ours);
+#endif
+            // Tree quality per ray, counted in a separate untimed pass.
             TraversalStats traversal;
             for (const auto& r : *w.rays) {
                 if (w.occlusion)
@@ -97,24 +95,18 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
                     ours.closest_hit(r, traversal);
             }
             const double n = double(w.rays->size());
-            Row row = base(w.name, "bvhkit");
-            row.set("rays", (long long)w.rays->size()).set("hits", (long long)our.hits);
-            row.set("ms", our.ms).set("mrays_per_s", n / our.ms / 1e3);
-            row.set("nodes_per_ray", traversal.nodes_visited / n);
-            row.set("tris_per_ray", traversal.primitives_tested / n);
+            Row row = row_for(w.name, "bvhkit");
+            row.set("rays", (long long)w.rays->size()).set("hits", (long long)our_hits);
+            row.set("ms", our_ms).set("mrays_per_s", n / our_ms / 1e3);
+            row.set("nodes_per_ray", double(traversal.nodes_visited) / n);
+            row.set("tris_per_ray", double(traversal.primitives_tested) / n);
 #if BVHKIT_HAVE_EMBREE
-            const Timed peer = w.occlusion
-                                   ? time_rays(options.repetitions, *w.rays,
-                                               [&](const Ray3f& r) { return embree.any_hit(r); })
-                                   : time_rays(options.repetitions, *w.rays, [&](const Ray3f& r) {
-                                         return bool(embree.closest_hit(r));
-                                     });
-            row.set("speedup", peer.ms / our.ms);
+            row.set("speedup", peer_ms / our_ms);
             rows.push_back(row);
-            Row prow = base(w.name, "embree3");
-            prow.set("rays", (long long)w.rays->size()).set("hits", (long long)peer.hits);
-            prow.set("ms", peer.ms).set("mrays_per_s", n / peer.ms / 1e3);
-            rows.push_back(prow);
+            Row peer = row_for(w.name, "embree3");
+            peer.set("rays", (long long)w.rays->size()).set("hits", (long long)peer_hits);
+            peer.set("ms", peer_ms).set("mrays_per_s", n / peer_ms / 1e3);
+            rows.push_back(peer);
 #else
             rows.push_back(row);
 #endif

@@ -24,6 +24,18 @@ double median_ms(int repetitions, const std::function<void()>& f, bool warm_up) 
     return median(times);
 }
 
+std::pair<double, double> median_ms_interleaved(int repetitions, const std::function<void()>& f,
+                                                const std::function<void()>& g) {
+    f();  // warm-up
+    g();
+    std::vector<double> tf, tg;
+    for (int r = 0; r < std::max(1, repetitions); ++r) {
+        tf.push_back(median_ms(1, f, false));
+        tg.push_back(median_ms(1, g, false));
+    }
+    return {median(tf), median(tg)};
+}
+
 Row& Row::set(const std::string& key, Value v) {
     for (auto& [k, old] : fields)
         if (k == key) {

@@ -17,6 +17,11 @@ double median_ms(int repetitions, const std::function<void()>& f, bool warm_up =
 
 double median(std::vector<double> values);
 
+/// Median milliseconds of f() and of g(), their repetitions interleaved (f, g, f, g, ...) so that a
+/// change of load on a shared machine affects both alike and their ratio stays fair.
+std::pair<double, double> median_ms_interleaved(int repetitions, const std::function<void()>& f,
+                                                const std::function<void()>& g);
+
 /// One cell of a result row: text, an integer count or a real figure.
 using Value = std::variant<std::string, long long, double>;
 

@@ -117,3 +117,44 @@ TEST(RaySlab, ConservativeForRaysThroughBoxCorners) {
         ASSERT_TRUE(intersect(ray, box, t0, t1)) << i;
     }
 }
+
+#include "bvhkit/query/ray_pair_test.hpp"
+
+TEST(RayPairTest, MatchesTheScalarSlabTestIncludingZeroDirectionsOnPlanes) {
+    // Boxes with faces on the grid, rays from grid points with +-0 components: the plane cases.
+    BvhNode<Aabb3f> pair[2];
+    pair[0].bounds = Aabb3f({-1, 0, 2}, {1, 3, 4});
+    pair[1].bounds = Aabb3f({0, -1, 0}, {2, 2, 3});
+    pair[0].first = 0x7F800000u;  // bits of +inf in the padding lanes must not matter
+    pair[1].first = 0x7FC00000u;  // nor those of a NaN
+    const float coords[] = {-2, -1, 0, 0.5f, 1, 2, 3, 4};
+    const float dirs[] = {-1.0f, -0.0f, 0.0f, 1.0f, 0.25f};
+    int both = 0;
+    for (float ox : coords)
+        for (float oy : coords)
+            for (float oz : coords)
+                for (float dx : dirs)
+                    for (float dy : dirs)
+                        for (float dz : dirs) {
+                            if (dx == 0 && dy == 0 && dz == 0) continue;
+                            const Ray3f ray({ox, oy, oz}, {dx, dy, dz}, 0.5f, 50.0f);
+                            const RayPairTest<float, 3> test(ray);
+                            float entry[2];
+                            const unsigned got = test.slab().with_octant([&](auto o) {
+                                return test.template test<decltype(o)::value>(pair, ray.tmin,
+                                                                              ray.tmax, entry);
+                            });
+                            for (int k = 0; k < 2; ++k) {
+                                float t0, t1;
+                                const bool want = intersect(ray, pair[k].bounds, t0, t1);
+                                ASSERT_EQ(bool(got >> k & 1u), want)
+                                    << "box " << k << " origin " << ox << "," << oy << "," << oz
+                                    << " dir " << dx << "," << dy << "," << dz;
+                                if (want) {
+                                    ASSERT_EQ(entry[k], t0);
+                                }
+                            }
+                            both += got == 3u;
+                        }
+    EXPECT_GT(both, 100);
+}

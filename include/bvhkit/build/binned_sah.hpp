@@ -2,8 +2,9 @@
 // Binned SAH split (Wald 2007, "On fast construction of SAH-based bounding volume hierarchies"):
 // the centroids are dropped into `bin_count` equal bins along each axis, and the SAH is evaluated
 // only at the bin boundaries, with one sweep from each side. Linear in the node's size per axis.
-#include "bvhkit/build/sah.hpp"
-#include "bvhkit/build/top_down_core.hpp"
+// A node no larger than the bin count is handed to the full sweep: there the sweep is both cheaper
+// (sorting a handful beats sweeping every bin on every axis) and exact.
+#include "bvhkit/build/sweep_sah.hpp"
 
 namespace bvhkit {
 
@@ -15,9 +16,11 @@ class BinnedSahRule {
           costs_(options.costs),
           bin_count_(std::clamp<std::uint32_t>(options.bin_count, 2, 256)),
           bins_(N * bin_count_),
-          right_area_(bin_count_) {}
+          right_area_(bin_count_),
+          small_nodes_(in, options) {}
 
     Split<T> operator()(const SplitTask<T, N>& task) {
+        if (task.indices.size() <= bin_count_) return small_nodes_(task);
         const Aabb<T, N>& cb = task.centroid_bounds;
         T scale[N];
         for (std::size_t a = 0; a < N; ++a) {
@@ -81,6 +84,7 @@ class BinnedSahRule {
     std::uint32_t bin_count_;
     std::vector<Bin> bins_;  // N rows of bin_count_ bins, reused for every node
     std::vector<T> right_area_;
+    SweepSahRule<T, N> small_nodes_;
 };
 
 }  // namespace bvhkit

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "bvhkit/bvh/node_allocator.hpp"
 #include "bvhkit/math/aabb.hpp"
 
 namespace bvhkit {
@@ -36,7 +37,7 @@ struct Bvh {
     using VolumeType = Volume;
     using Node = BvhNode<Volume>;
 
-    std::vector<Node> nodes;                       // nodes[0] is the root; empty for an empty tree
+    std::vector<Node, NodeAllocator<Node>> nodes;  // nodes[0] is the root; empty for an empty tree
     std::vector<std::uint32_t> primitive_indices;  // leaf slots -> the caller's primitive indices
 
     bool empty() const { return nodes.empty(); }

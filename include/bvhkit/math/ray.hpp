@@ -10,6 +10,8 @@
 // is scaled by 1 + 2 gamma(3) so that rounding never makes a true hit miss (the test is
 // conservative).
 #include <limits>
+#include <type_traits>
+#include <utility>
 
 #include "bvhkit/math/aabb.hpp"
 
@@ -41,34 +43,61 @@ struct Ray {
     constexpr VecT at(T t) const { return origin + direction * t; }
 };
 
-/// Per-ray values the slab test reuses for every box: reciprocal direction and, per axis, whether
-/// the ray goes towards negative values (then the box's max is the near plane). -0 counts as
-/// negative, so that its -inf reciprocal meets the planes in the right order.
+/// Per-ray values the slab test reuses for every box: reciprocal direction and the ray's octant,
+/// bit i set when the ray goes towards negative values on axis i (then the box's max is the near
+/// plane). -0 counts as negative, so that its -inf reciprocal meets the planes in the right order.
 template <class T, std::size_t N>
 struct RaySlabData {
     Vec<T, N> origin;
     Vec<T, N> inv_direction;
-    bool negative[N];
+    unsigned octant = 0;
 
     explicit RaySlabData(const Ray<T, N>& ray) : origin(ray.origin) {
         for (std::size_t i = 0; i < N; ++i) {
             inv_direction[i] = T(1) / ray.direction[i];
-            negative[i] = std::signbit(ray.direction[i]);
+            if (std::signbit(ray.direction[i])) octant |= 1u << i;
         }
     }
 
-    /// Clips [tmin, tmax] to the box. Returns true on a hit and then tmin is the entry distance.
+    /// Clips [tmin, tmax] to the box; true on a hit, and then tmin is the entry distance. `Octant`
+    /// is this ray's octant, known at compile time so the near/far planes cost nothing to choose.
+    template <unsigned Octant>
     bool clip(const Aabb<T, N>& box, T& tmin, T& tmax) const {
         constexpr T far_scale = T(1) + T(2) * rounding_gamma<T>(3);
         for (std::size_t i = 0; i < N; ++i) {
-            const T near_plane = negative[i] ? box.max[i] : box.min[i];
-            const T far_plane = negative[i] ? box.min[i] : box.max[i];
-            const T t_near = (near_plane - origin[i]) * inv_direction[i];
-            const T t_far = (far_plane - origin[i]) * inv_direction[i] * far_scale;
+            constexpr unsigned one = 1;
+            const bool negative = (Octant >> i) & one;
+            const T t_near = ((negative ? box.max[i] : box.min[i]) - origin[i]) * inv_direction[i];
+            const T t_far =
+                ((negative ? box.min[i] : box.max[i]) - origin[i]) * inv_direction[i] * far_scale;
             tmin = t_near > tmin ? t_near : tmin;  // a NaN t_near leaves tmin as it was
             tmax = t_far < tmax ? t_far : tmax;
         }
         return tmin <= tmax;
+    }
+
+    /// The same with the octant chosen at run time.
+    bool clip(const Aabb<T, N>& box, T& tmin, T& tmax) const {
+        return with_octant([&](auto o) { return clip<decltype(o)::value>(box, tmin, tmax); });
+    }
+
+    /// Calls f(std::integral_constant<unsigned, octant>{}): one instantiation of f per octant.
+    template <class F>
+    decltype(auto) with_octant(F&& f) const {
+        return dispatch(f, std::make_integer_sequence<unsigned, (1u << N)>{});
+    }
+
+  private:
+    template <class F, unsigned... O>
+    decltype(auto) dispatch(F& f, std::integer_sequence<unsigned, O...>) const {
+        using R = decltype(f(std::integral_constant<unsigned, 0>{}));
+        if constexpr (std::is_void_v<R>) {
+            ((octant == O ? (f(std::integral_constant<unsigned, O>{}), true) : false) || ...);
+        } else {
+            R r{};
+            ((octant == O ? (r = f(std::integral_constant<unsigned, O>{}), true) : false) || ...);
+            return r;
+        }
     }
 };
 

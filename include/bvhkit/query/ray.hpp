@@ -17,59 +17,65 @@
 #include "bvhkit/math/ray.hpp"
 #include "bvhkit/primitives/hit.hpp"
 #include "bvhkit/primitives/primitive.hpp"
+#include "bvhkit/query/ray_pair_test.hpp"
 #include "bvhkit/query/stats.hpp"
 
 namespace bvhkit {
 
 /// Walks the nodes `ray` meets, nearer first; calls on_leaf(node) for each leaf it reaches, which
-/// may shrink ray.tmax and returns true to stop the walk.
+/// may shrink ray.tmax and returns true to stop the walk. The loop is instantiated once per ray
+/// octant, so the slab test's choice of near and far planes is made at compile time.
 template <class T, std::size_t N, class OnLeaf, class Stats = NoStats>
 void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
                   Stats&& stats = {}) {
     if (bvh.empty()) return;
-    const RaySlabData<T, N> slab(ray);
-    const auto* nodes = bvh.nodes.data();
-    {
-        T t0 = ray.tmin, t1 = ray.tmax;
-        stats.node();
-        if (!slab.clip(nodes[0].bounds, t0, t1)) return;
-    }
-    struct Entry {
-        std::uint32_t node;
-        T t_entry;
-    };
-    Entry stack[max_bvh_depth];
-    std::uint32_t size = 0;
-    std::uint32_t current = 0;
-    while (true) {
-        const auto& node = nodes[current];
-        if (node.is_leaf()) {
-            if (on_leaf(node)) return;
-        } else {
-            const std::uint32_t left = node.left(), right = node.right();
-            T l0 = ray.tmin, l1 = ray.tmax, r0 = ray.tmin, r1 = ray.tmax;
-            const bool hit_left = slab.clip(nodes[left].bounds, l0, l1);
-            const bool hit_right = slab.clip(nodes[right].bounds, r0, r1);
+    const RayPairTest<T, N> pair_test(ray);
+    const RaySlabData<T, N>& slab = pair_test.slab();
+    slab.with_octant([&](auto octant) {
+        constexpr unsigned O = decltype(octant)::value;
+        const auto* nodes = bvh.nodes.data();
+        {
+            T t0 = ray.tmin, t1 = ray.tmax;
             stats.node();
-            stats.node();
-            if (hit_left && hit_right) {
-                const bool left_first = l0 <= r0;
-                stack[size++] = left_first ? Entry{right, r0} : Entry{left, l0};
-                current = left_first ? left : right;
-                continue;
-            }
-            if (hit_left || hit_right) {
-                current = hit_left ? left : right;
-                continue;
-            }
+            if (!slab.template clip<O>(nodes[0].bounds, t0, t1)) return;
         }
-        // Pop the next subtree that can still hold something within [tmin, tmax].
-        do {
-            if (size == 0) return;
-            --size;
-        } while (stack[size].t_entry > ray.tmax);
-        current = stack[size].node;
-    }
+        struct Entry {
+            std::uint32_t node;
+            T t_entry;
+        };
+        Entry stack[max_bvh_depth];
+        std::uint32_t size = 0;
+        std::uint32_t current = 0;
+        while (true) {
+            const auto& node = nodes[current];
+            if (node.is_leaf()) {
+                if (on_leaf(node)) return;
+            } else {
+                const std::uint32_t left = node.left();  // the right child is left + 1
+                T entry[2];
+                const unsigned hits =
+                    pair_test.template test<O>(nodes + left, ray.tmin, ray.tmax, entry);
+                stats.node();
+                stats.node();
+                if (hits) {
+                    // Descend without data-dependent branches (they mispredict on incoherent rays):
+                    // the far child is always written to the stack, and kept only when both hit.
+                    const bool both = hits == 3u;
+                    const bool right_first = hits == 2u || (both && entry[1] < entry[0]);
+                    stack[size] = Entry{left + !right_first, entry[right_first ? 0 : 1]};
+                    size += both;
+                    current = left + right_first;
+                    continue;
+                }
+            }
+            // Pop the next subtree that can still hold something within [tmin, tmax].
+            do {
+                if (size == 0) return;
+                --size;
+            } while (stack[size].t_entry > ray.tmax);
+            current = stack[size].node;
+        }
+    });
 }
 
 /// Closest hit: `test(slot, ray, TriangleHit&)`, see above. Returns a miss (Hit::primitive ==

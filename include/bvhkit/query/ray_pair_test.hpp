@@ -1,0 +1,102 @@
+#pragma once
+// The ray's test against a sibling pair: both children's boxes at once, since the traversal always
+// needs both and they share one cache line.
+//
+// For 3D float boxes on x86 the pair is tested in SSE2 registers. The 12 plane coordinates are
+// gathered per axis as (L.min, L.max, R.min, R.max); one subtract and one multiply per axis give
+// plane distances, with the per-ray multipliers already carrying the sign and the conservative
+// scale of the far planes (so after a shuffle the lanes hold (L.near, R.near, -s L.far, -s R.far)).
+// A single chain of maxps then yields both entries and both negated exits. maxps returns its second
+// operand when either is NaN, and the accumulator (second operand) never is, so a 0 * inf plane
+// distance is dropped exactly as the scalar test drops it (see math/ray.hpp). Elsewhere the scalar
+// slab test runs twice.
+#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/math/ray.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace bvhkit {
+
+template <class T, std::size_t N>
+class RayPairTest {
+  public:
+    explicit RayPairTest(const Ray<T, N>& ray) : slab_(ray) {}
+    const RaySlabData<T, N>& slab() const { return slab_; }
+
+    /// Bit 0: the ray meets pair[0] within [tmin, tmax], entering at entry[0]; bit 1: pair[1].
+    template <unsigned Octant>
+    unsigned test(const BvhNode<Aabb<T, N>>* pair, T tmin, T tmax, T entry[2]) const {
+        T t1 = tmax, t3 = tmax;
+        entry[0] = entry[1] = tmin;
+        const bool l = slab_.template clip<Octant>(pair[0].bounds, entry[0], t1);
+        const bool r = slab_.template clip<Octant>(pair[1].bounds, entry[1], t3);
+        return unsigned(l) | unsigned(r) << 1;
+    }
+
+  private:
+    RaySlabData<T, N> slab_;
+};
+
+#if defined(__SSE2__)
+template <>
+class RayPairTest<float, 3> {
+  public:
+    explicit RayPairTest(const Ray<float, 3>& ray) : slab_(ray) {
+        constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
+        for (int i = 0; i < 3; ++i) {
+            origin_[i] = _mm_set1_ps(ray.origin[i]);
+            const float inv = slab_.inv_direction[i];
+            // Lanes hold (L.min, L.max, R.min, R.max) planes; far planes get -s * inv.
+            const bool negative = (slab_.octant >> i) & 1u;
+            const float on_min = negative ? -s * inv : inv, on_max = negative ? inv : -s * inv;
+            scale_[i] = _mm_setr_ps(on_min, on_max, on_min, on_max);
+        }
+    }
+    const RaySlabData<float, 3>& slab() const { return slab_; }
+
+    template <unsigned Octant>
+    unsigned test(const BvhNode<Aabb3f>* pair, float tmin, float tmax, float entry[2]) const {
+        const float* p = reinterpret_cast<const float*>(pair);
+        const __m128 a = _mm_loadu_ps(p), b = _mm_loadu_ps(p + 4);  // L: min xyz, max x | max yz ..
+        const __m128 c = _mm_loadu_ps(p + 8), d = _mm_loadu_ps(p + 12);
+        const __m128 x = _mm_shuffle_ps(a, c, _MM_SHUFFLE(3, 0, 3, 0));
+        const __m128 y =
+            _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
+                           _mm_shuffle_ps(c, d, _MM_SHUFFLE(0, 0, 1, 1)), _MM_SHUFFLE(2, 0, 2, 0));
+        const __m128 z =
+            _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
+                           _mm_shuffle_ps(c, d, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 2, 0));
+        // Accumulator (tmin, tmin, -tmax, -tmax): never NaN.
+        __m128 acc = _mm_shuffle_ps(_mm_set1_ps(tmin), _mm_set1_ps(-tmax), 0);
+        acc = _mm_max_ps(
+            near_far<(Octant >> 0) & 1u>(_mm_mul_ps(_mm_sub_ps(x, origin_[0]), scale_[0])), acc);
+        acc = _mm_max_ps(
+            near_far<(Octant >> 1) & 1u>(_mm_mul_ps(_mm_sub_ps(y, origin_[1]), scale_[1])), acc);
+        acc = _mm_max_ps(
+            near_far<(Octant >> 2) & 1u>(_mm_mul_ps(_mm_sub_ps(z, origin_[2]), scale_[2])), acc);
+        const __m128 exits =
+            _mm_xor_ps(_mm_shuffle_ps(acc, acc, _MM_SHUFFLE(3, 2, 3, 2)), _mm_set1_ps(-0.0f));
+        entry[0] = _mm_cvtss_f32(acc);
+        entry[1] = _mm_cvtss_f32(_mm_shuffle_ps(acc, acc, _MM_SHUFFLE(1, 1, 1, 1)));
+        return unsigned(_mm_movemask_ps(_mm_cmple_ps(acc, exits))) & 3u;
+    }
+
+  private:
+    // (L.min, L.max, R.min, R.max) distances -> (L.near, R.near, L.far', R.far').
+    template <unsigned Negative>
+    static __m128 near_far(__m128 t) {
+        if constexpr (Negative)
+            return _mm_shuffle_ps(t, t, _MM_SHUFFLE(2, 0, 3, 1));
+        else
+            return _mm_shuffle_ps(t, t, _MM_SHUFFLE(3, 1, 2, 0));
+    }
+
+    RaySlabData<float, 3> slab_;
+    __m128 origin_[3];
+    __m128 scale_[3];
+};
+#endif
+
+}  // namespace bvhkit
