@@ -260,8 +260,6 @@ class BinaryReader {
     [[noreturn]] void fail_at_value(const std::string& what) const {
         fail_at_offset(name_, last_value_offset_, what);
     }
-    std::size_t position() const { return pos_; }
-    std::string where() const { return "byte " + std::to_string(pos_); }
 
   private:
     template <class T>
