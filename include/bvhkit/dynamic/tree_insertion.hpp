@@ -19,6 +19,31 @@
 
 namespace bvhkit::dynamic_detail {
 
+/// Area (perimeter in 2D) of a box known to be non-empty: Aabb::area() without its clamp at zero.
+template <class T, std::size_t N>
+inline T box_area(const Aabb<T, N>& a) {
+    if constexpr (N == 2) {
+        return T(2) * ((a.max[0] - a.min[0]) + (a.max[1] - a.min[1]));
+    } else {
+        const T x = a.max[0] - a.min[0], y = a.max[1] - a.min[1], z = a.max[2] - a.min[2];
+        return T(2) * (x * y + y * z + z * x);
+    }
+}
+
+/// area(a u b) for two non-empty boxes, without building the union.
+template <class T, std::size_t N>
+inline T union_area(const Aabb<T, N>& a, const Aabb<T, N>& b) {
+    T e[N];
+    for (std::size_t i = 0; i < N; ++i)
+        e[i] = (a.max[i] > b.max[i] ? a.max[i] : b.max[i]) -
+               (a.min[i] < b.min[i] ? a.min[i] : b.min[i]);
+    if constexpr (N == 2) {
+        return T(2) * (e[0] + e[1]);
+    } else {
+        return T(2) * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+    }
+}
+
 /// Recomputes an internal node's box, height and enlarged flag from its two children.
 template <class T, std::size_t N>
 inline void refit(Node<T, N>* nodes, std::int32_t i) {
@@ -38,9 +63,9 @@ template <class T, std::size_t N>
 std::int32_t descend_ties(const Node<T, N>* nodes, std::int32_t s, const Aabb<T, N>& box, T cost) {
     while (!nodes[s].is_leaf()) {
         const Node<T, N>& n = nodes[s];
-        const T inherited = cost - n.box.area();
-        const T cost1 = unite(nodes[n.child1].box, box).area() + inherited;
-        const T cost2 = unite(nodes[n.child2].box, box).area() + inherited;
+        const T inherited = cost - box_area(n.box);
+        const T cost1 = union_area(nodes[n.child1].box, box) + inherited;
+        const T cost2 = union_area(nodes[n.child2].box, box) + inherited;
         const bool tie1 = cost1 <= cost, tie2 = cost2 <= cost;
         if (!tie1 && !tie2) break;
         const bool take1 = tie1 && (!tie2 || nodes[n.child1].height <= nodes[n.child2].height);
@@ -62,10 +87,10 @@ std::int32_t find_sibling_greedy(const Node<T, N>* nodes, std::int32_t root,
     std::int32_t i = root;
     while (!nodes[i].is_leaf()) {
         const Node<T, N>& n = nodes[i];
-        const T stay = unite(n.box, box).area();
-        const T grow = stay - n.box.area();
-        const T cost1 = unite(nodes[n.child1].box, box).area() + grow;
-        const T cost2 = unite(nodes[n.child2].box, box).area() + grow;
+        const T stay = union_area(n.box, box);
+        const T grow = stay - box_area(n.box);
+        const T cost1 = union_area(nodes[n.child1].box, box) + grow;
+        const T cost2 = union_area(nodes[n.child2].box, box) + grow;
         if (stay < cost1 && stay < cost2) break;
         const bool take1 =
             cost1 < cost2 || (cost1 == cost2 && nodes[n.child1].height <= nodes[n.child2].height);
@@ -74,8 +99,8 @@ std::int32_t find_sibling_greedy(const Node<T, N>* nodes, std::int32_t root,
     return i;
 }
 
-/// One candidate of the branch and bound search: a node and the inherited cost of inserting
-/// anywhere below its parent, i.e. the sum of area(A u L) - area(A) over the node's ancestors.
+/// An internal node waiting to be expanded by the branch and bound search, with the inherited cost
+/// of inserting anywhere below it: sum of area(A u L) - area(A) over the node and its ancestors.
 template <class T>
 struct SiblingCandidate {
     std::int32_t node;
@@ -84,58 +109,56 @@ struct SiblingCandidate {
 
 /// Exact best sibling by branch and bound (Bittner, Hapala, Havran 2013; Catto, GDC 2019).
 ///
-/// For a candidate S reached with inherited cost I(S):
-///   cost(S)          = area(S u L) + I(S)
-///   I(child of S)    = I(S) + area(S u L) - area(S)          (S itself now grows by that much)
-/// Any node in the subtree below S costs at least
-///   lower_bound      = area(L) + I(child of S)
-/// because its direct cost area(X u L) >= area(L) and inherited costs only grow on the way down.
-/// So the search keeps the best cost found so far and:
-///   - takes the candidate with the smallest inherited cost first (a min-heap), so good regions are
-///     explored early and the best cost drops fast;
-///   - stops as soon as the smallest inherited cost + area(L) is no better than the best cost: no
-///     candidate left in the heap (nor anything below them) can win;
-///   - pushes the two children of S only when their lower bound beats the best cost.
+/// For a node C whose ancestors give inherited cost I:
+///   cost(C)                 = area(C u L) + I
+///   inherited below C       = I + area(C u L) - area(C)  = cost(C) - area(C)
+///   lower bound below C     = area(L) + inherited below C
+/// since any node X below C has a direct cost area(X u L) >= area(L) and inherited costs only grow
+/// on the way down. The search keeps the best cost found so far and a min-heap of internal nodes
+/// keyed by their inherited-below cost:
+///   - expanding node X evaluates both children's costs at once (so leaves never enter the heap)
+///   and
+///     pushes a child only when its lower bound beats the best cost;
+///   - the node with the smallest inherited cost is expanded first, so good regions come early and
+///   the
+///     best cost drops fast;
+///   - as soon as the smallest key + area(L) is no better than the best cost, nothing left in the
+///   heap
+///     (nor anything below it) can win and the search stops.
 /// `heap` is scratch storage owned by the tree, so a steady stream of inserts allocates nothing.
 template <class T, std::size_t N>
 std::int32_t find_sibling_branch_and_bound(const Node<T, N>* nodes, std::int32_t root,
                                            const Aabb<T, N>& box,
                                            std::vector<SiblingCandidate<T>>& heap) {
-    const T leaf_area = box.area();
+    const T leaf_area = box_area(box);
     const auto later = [](const SiblingCandidate<T>& a, const SiblingCandidate<T>& b) {
         return a.inherited >
                b.inherited;  // std heap functions build a max-heap: invert for a min-heap
     };
+    // The root as sibling: a new root above it, no ancestors to grow.
     std::int32_t best = root;
-    T best_cost = unite(nodes[root].box, box).area();
+    T best_cost = union_area(nodes[root].box, box);
     heap.clear();
-    if (!nodes[root].is_leaf()) {
-        const T inherited = best_cost - nodes[root].box.area();
-        if (inherited + leaf_area < best_cost) {
-            heap.push_back({nodes[root].child1, inherited});
-            heap.push_back({nodes[root].child2, inherited});
-        }
-    }
+    if (!nodes[root].is_leaf()) heap.push_back({root, best_cost - box_area(nodes[root].box)});
     while (!heap.empty()) {
         std::pop_heap(heap.begin(), heap.end(), later);
         const SiblingCandidate<T> c = heap.back();
         heap.pop_back();
         if (c.inherited + leaf_area >= best_cost) break;  // nothing left can beat the best
-
         const Node<T, N>& n = nodes[c.node];
-        const T direct = unite(n.box, box).area();
-        const T cost = direct + c.inherited;
-        if (cost < best_cost) {
-            best_cost = cost;
-            best = c.node;
-        }
-        if (n.is_leaf()) continue;
-        const T child_inherited = cost - n.box.area();
-        if (child_inherited + leaf_area < best_cost) {
-            heap.push_back({n.child1, child_inherited});
-            std::push_heap(heap.begin(), heap.end(), later);
-            heap.push_back({n.child2, child_inherited});
-            std::push_heap(heap.begin(), heap.end(), later);
+        for (const std::int32_t child : {n.child1, n.child2}) {
+            const Node<T, N>& cn = nodes[child];
+            const T cost = union_area(cn.box, box) + c.inherited;
+            if (cost < best_cost) {
+                best_cost = cost;
+                best = child;
+            }
+            if (cn.is_leaf()) continue;
+            const T below = cost - box_area(cn.box);
+            if (below + leaf_area < best_cost) {
+                heap.push_back({child, below});
+                std::push_heap(heap.begin(), heap.end(), later);
+            }
         }
     }
     return descend_ties(nodes, best, box, best_cost);
@@ -163,16 +186,16 @@ void rotate(Node<T, N>* nodes, std::int32_t a) {
     int best = 0;
     T best_delta = T(0);
     if (!nb.is_leaf()) {
-        const T area_b = nb.box.area();
-        const T d1 = unite(nc.box, nodes[nb.child2].box).area() - area_b;
-        const T d2 = unite(nodes[nb.child1].box, nc.box).area() - area_b;
+        const T area_b = box_area(nb.box);
+        const T d1 = union_area(nc.box, nodes[nb.child2].box) - area_b;
+        const T d2 = union_area(nodes[nb.child1].box, nc.box) - area_b;
         if (d1 < best_delta) best_delta = d1, best = 1;
         if (d2 < best_delta) best_delta = d2, best = 2;
     }
     if (!nc.is_leaf()) {
-        const T area_c = nc.box.area();
-        const T d3 = unite(nb.box, nodes[nc.child2].box).area() - area_c;
-        const T d4 = unite(nodes[nc.child1].box, nb.box).area() - area_c;
+        const T area_c = box_area(nc.box);
+        const T d3 = union_area(nb.box, nodes[nc.child2].box) - area_c;
+        const T d4 = union_area(nodes[nc.child1].box, nb.box) - area_c;
         if (d3 < best_delta) best_delta = d3, best = 3;
         if (d4 < best_delta) best_delta = d4, best = 4;
     }

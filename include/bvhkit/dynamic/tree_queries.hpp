@@ -20,24 +20,28 @@ struct TreeView {
     std::int32_t root;
 };
 
-/// Box overlap: callback(ProxyId) -> bool, false stops the query.
+/// Box overlap: callback(ProxyId) -> bool, false stops the query. A node's children are tested
+/// before they are pushed, so the stack only ever holds nodes that overlap.
 template <class T, std::size_t N, class U, class F>
 void query_box(const TreeView<T, N, U>& t, const Aabb<T, N>& box, F&& callback, QueryStats* stats) {
     if (t.root == kNullNode) return;
-    std::uint64_t visited = 0, tested = 0;
+    std::uint64_t visited = 1, tested = 0;
+    if (!t.nodes[t.root].box.overlaps(box)) {
+        if (stats) stats->nodes_visited += visited;
+        return;
+    }
     SmallStack<std::int32_t> stack;
     stack.push(t.root);
     while (!stack.empty()) {
         const Node<T, N>& n = t.nodes[stack.pop()];
-        ++visited;
-        if (!n.box.overlaps(box)) continue;
         if (n.is_leaf()) {
             ++tested;
             if (t.proxies[n.proxy()].box.overlaps(box) && !callback(n.proxy())) break;
-        } else {
-            stack.push(n.child2);
-            stack.push(n.child1);
+            continue;
         }
+        visited += 2;
+        if (t.nodes[n.child2].box.overlaps(box)) stack.push(n.child2);
+        if (t.nodes[n.child1].box.overlaps(box)) stack.push(n.child1);
     }
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
 }
