@@ -10,7 +10,7 @@ namespace bvhkit::bench {
 
 struct DynamicBenchConfig {
     int n = 100000;  // boxes in D1 and D2 (D3 starts from n / 10)
-    int steps = 60;  // simulation steps in D1 and D2
+    int steps = 40;  // simulation steps in D1 and D2 (D3: rounds of 1,000 operations)
     int reps = 3;    // repetitions; medians are reported
     bool d1 = true, d2 = true, d3 = true;
 };
