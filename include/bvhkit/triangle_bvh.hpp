@@ -26,20 +26,15 @@ class TriangleBvh {
     template <class U>
     explicit TriangleBvh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {},
                          TriangleTest test = TriangleTest::Fast)
-        : TriangleBvh(mesh_triangles<U>(mesh), options, test) {}
-
-    explicit TriangleBvh(std::vector<Triangle<T>> triangles, const BuildOptions& options = {},
-                         TriangleTest test = TriangleTest::Fast)
         : triangle_test_(test) {
-        std::vector<Aabb<T, 3>> boxes(triangles.size());
-        std::vector<Vec<T, 3>> centroids(triangles.size());
-        for (std::size_t i = 0; i < triangles.size(); ++i) {
-            boxes[i] = triangles[i].bounds();
-            centroids[i] = boxes[i].centroid();
-        }
-        bvh_ = build_bvh<T, 3>(boxes, centroids, options, &report_);
-        triangle_count_ = triangles.size();
-        lay_out(triangles);
+        check_indices(mesh);
+        build([&](std::size_t i) { return triangle_of(mesh, i); }, mesh.triangles.size(), options);
+    }
+
+    explicit TriangleBvh(const std::vector<Triangle<T>>& triangles,
+                         const BuildOptions& options = {}, TriangleTest test = TriangleTest::Fast)
+        : triangle_test_(test) {
+        build([&](std::size_t i) { return triangles[i]; }, triangles.size(), options);
     }
 
     Hit<T> closest_hit(const Ray<T, 3>& ray) const { return closest_hit(ray, NoStats{}); }
@@ -70,12 +65,14 @@ class TriangleBvh {
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
     template <class U>
     void refit(const BasicTriangleMesh<U>& mesh) {
-        std::vector<Triangle<T>> triangles = mesh_triangles<U>(mesh);
-        if (triangles.size() != triangle_count_)
-            throw Error("TriangleBvh::refit: the mesh has " + std::to_string(triangles.size()) +
+        if (mesh.triangles.size() != triangle_count_)
+            throw Error("TriangleBvh::refit: the mesh has " +
+                        std::to_string(mesh.triangles.size()) +
                         " triangles, the tree was built over " + std::to_string(triangle_count_));
-        bvhkit::refit(bvh_, [&](std::uint32_t i) { return triangles[i].bounds(); });
-        lay_out(triangles);
+        check_indices(mesh);
+        const auto triangle = [&](std::size_t i) { return triangle_of(mesh, i); };
+        bvhkit::refit(bvh_, [&](std::uint32_t i) { return triangle(i).bounds(); });
+        lay_out(triangle);
     }
 
     const AabbBvh<T, 3>& bvh() const { return bvh_; }
@@ -83,30 +80,49 @@ class TriangleBvh {
     const std::vector<std::uint32_t>& skipped() const { return report_.skipped; }
     std::size_t triangle_count() const { return triangle_count_; }
 
+    /// Throws bvhkit::Error naming the first triangle that names a vertex the mesh does not have.
     template <class U>
-    static std::vector<Triangle<T>> mesh_triangles(const BasicTriangleMesh<U>& mesh) {
-        std::vector<Triangle<T>> out(mesh.triangles.size());
-        for (std::size_t i = 0; i < out.size(); ++i) {
-            const auto& t = mesh.triangles[i];
-            for (std::uint32_t k : t)
+    static void check_indices(const BasicTriangleMesh<U>& mesh) {
+        for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+            for (std::uint32_t k : mesh.triangles[i])
                 if (k >= mesh.vertices.size())
                     throw Error("triangle " + std::to_string(i) + " names vertex " +
                                 std::to_string(k) + " of " + std::to_string(mesh.vertices.size()));
-            out[i] = {Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
-                      Vec<T, 3>(mesh.vertices[t[2]])};
-        }
-        return out;
     }
 
   private:
-    void lay_out(const std::vector<Triangle<T>>& triangles) {
+    template <class U>
+    static Triangle<T> triangle_of(const BasicTriangleMesh<U>& mesh, std::size_t i) {
+        const auto& t = mesh.triangles[i];
+        return {Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
+                Vec<T, 3>(mesh.vertices[t[2]])};
+    }
+
+    template <class TriangleAt>
+    void build(TriangleAt&& triangle, std::size_t count, const BuildOptions& options) {
+        std::vector<Aabb<T, 3>> boxes;
+        std::vector<Vec<T, 3>> centroids;
+        boxes.reserve(count);
+        centroids.reserve(count);
+        for (std::size_t i = 0; i < count; ++i) {
+            boxes.push_back(triangle(i).bounds());
+            centroids.push_back(boxes.back().centroid());
+        }
+        bvh_ = build_bvh<T, 3>(boxes, centroids, options, &report_);
+        triangle_count_ = count;
+        lay_out(triangle);
+    }
+
+    template <class TriangleAt>
+    void lay_out(TriangleAt&& triangle) {
         const auto& order = bvh_.primitive_indices;
-        fast_.resize(order.size());
-        for (std::size_t s = 0; s < order.size(); ++s)
-            fast_[s] = PrecomputedTriangle<T>(triangles[order[s]]);
+        fast_.clear();
+        fast_.reserve(order.size());
+        for (std::uint32_t i : order) fast_.emplace_back(triangle(i));
+        exact_.clear();
         if (triangle_test_ == TriangleTest::Watertight) {
-            exact_.resize(order.size());
-            for (std::size_t s = 0; s < order.size(); ++s) exact_[s] = triangles[order[s]];
+            exact_.reserve(order.size());
+            for (std::uint32_t i : order) exact_.push_back(triangle(i));
         }
     }
     auto fast_test() const {

@@ -27,12 +27,12 @@ class SweepSahRule {
             std::sort(order_.begin(), order_.end(), [&](std::uint32_t i, std::uint32_t j) {
                 return c[i][a] < c[j][a] || (c[i][a] == c[j][a] && i < j);
             });
-            Aabb<T, N> acc;
+            BoxAccumulator<T, N> acc;
             for (std::uint32_t k = count; k-- > 1;) {
                 acc.grow(in_.boxes[order_[k]]);
                 right_area_[k] = acc.area();  // area of primitives [k, count)
             }
-            acc = Aabb<T, N>();
+            acc = BoxAccumulator<T, N>();
             for (std::uint32_t k = 1; k < count; ++k) {  // left = [0, k)
                 acc.grow(in_.boxes[order_[k - 1]]);
                 const T cost = sah_partial_cost(acc.area(), k, right_area_[k], count - k);

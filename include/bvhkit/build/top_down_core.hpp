@@ -11,6 +11,7 @@
 #include <span>
 #include <string>
 
+#include "bvhkit/build/box_accumulator.hpp"
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/error.hpp"
 
@@ -96,43 +97,58 @@ std::vector<std::uint32_t> usable_primitives(BuildInput<T, N>& in, std::vector<V
     return indices;
 }
 
-/// Reorders `range` so the primitives going left come first; returns how many go left.
+/// Bounds of a range of primitives: their boxes and their centroids.
+template <class T, std::size_t N>
+struct RangeBounds {
+    BoxAccumulator<T, N> boxes, centroids;
+    void add(const BuildInput<T, N>& in, std::uint32_t i) {
+        boxes.grow(in.boxes[i]);
+        centroids.grow_point(in.centroids[i]);
+    }
+};
+
+/// Reorders `range` so the primitives going left come first, gathering both sides' bounds on the
+/// way (each primitive is classified and grown exactly once); returns how many go left.
 template <class T, std::size_t N>
 std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
-                                   const Split<T>& s) {
+                                   const Split<T>& s, RangeBounds<T, N>& left,
+                                   RangeBounds<T, N>& right) {
     using Kind = typename Split<T>::Kind;
     const auto& c = in.centroids;
     const std::uint32_t a = s.axis;
-    auto goes_left = [&](std::uint32_t i) {
+    if (s.kind == Kind::Leaf) return 0;
+    if (s.kind == Kind::AtCount) {
+        const auto k =
+            static_cast<std::uint32_t>(std::min<std::size_t>(s.left_count, range.size()));
+        std::nth_element(range.begin(), range.begin() + k, range.end(),
+                         [&](std::uint32_t i, std::uint32_t j) {
+                             return c[i][a] < c[j][a] || (c[i][a] == c[j][a] && i < j);
+                         });
+        for (std::uint32_t i = 0; i < range.size(); ++i) (i < k ? left : right).add(in, range[i]);
+        return k;
+    }
+    const auto goes_left = [&](std::uint32_t i) {
         if (s.kind == Kind::AtPosition) return c[i][a] < s.position;
         return bin_of(c[i][a], s.bin_origin, s.bin_scale, s.bin_count) <= s.bin;
     };
-    switch (s.kind) {
-        case Kind::Leaf:
-            return 0;
-        case Kind::AtPosition:
-        case Kind::AtBin:
-            return static_cast<std::uint32_t>(
-                std::partition(range.begin(), range.end(), goes_left) - range.begin());
-        case Kind::AtCount: {
-            const auto k =
-                static_cast<std::uint32_t>(std::min<std::size_t>(s.left_count, range.size()));
-            std::nth_element(range.begin(), range.begin() + k, range.end(),
-                             [&](std::uint32_t i, std::uint32_t j) {
-                                 return c[i][a] < c[j][a] || (c[i][a] == c[j][a] && i < j);
-                             });
-            return k;
+    std::uint32_t* first = range.data();
+    std::uint32_t* last = range.data() + range.size();
+    while (first < last) {
+        if (goes_left(*first)) {
+            left.add(in, *first++);
+        } else {
+            std::swap(*first, *--last);
+            right.add(in, *last);
         }
     }
-    return 0;
+    return static_cast<std::uint32_t>(first - range.data());
 }
 
 /// Builds over `indices` (from usable_primitives) with `rule` deciding each split.
 template <class T, std::size_t N, class SplitRule>
 Bvh<Aabb<T, N>> build_top_down(const BuildInput<T, N>& in, std::vector<std::uint32_t> indices,
                                const BuildOptions& options, SplitRule& rule) {
-    using Box = Aabb<T, N>;
-    Bvh<Box> bvh;
+    Bvh<Aabb<T, N>> bvh;
     bvh.primitive_indices = std::move(indices);
     std::vector<std::uint32_t>& idx = bvh.primitive_indices;
     if (idx.empty()) return bvh;
@@ -144,16 +160,16 @@ Bvh<Aabb<T, N>> build_top_down(const BuildInput<T, N>& in, std::vector<std::uint
 
     struct Work {
         std::uint32_t node, begin, end, depth;
+        RangeBounds<T, N> bounds;  // of the range's boxes and centroids, gathered by the parent
     };
-    std::vector<Work> stack{{0, 0, static_cast<std::uint32_t>(idx.size()), 0}};
+    Work root{0, 0, static_cast<std::uint32_t>(idx.size()), 0, {}};
+    for (std::uint32_t i : idx) root.bounds.add(in, i);
+    std::vector<Work> stack{root};
     while (!stack.empty()) {
         const Work w = stack.back();
         stack.pop_back();
-        Box bounds, centroid_bounds;
-        for (std::uint32_t i = w.begin; i < w.end; ++i) {
-            bounds.grow(in.boxes[idx[i]]);
-            centroid_bounds.grow(in.centroids[idx[i]]);
-        }
+        const Aabb<T, N> bounds = w.bounds.boxes.box();
+        const Aabb<T, N> centroid_bounds = w.bounds.centroids.box();
         bvh.nodes[w.node].bounds = bounds;
         const std::uint32_t count = w.end - w.begin;
         auto make_leaf = [&] {
@@ -165,19 +181,22 @@ Bvh<Aabb<T, N>> build_top_down(const BuildInput<T, N>& in, std::vector<std::uint
             continue;
         }
         std::span<std::uint32_t> range(idx.data() + w.begin, count);
-        Split<T> split = rule(SplitTask<T, N>{range, bounds, centroid_bounds, w.depth});
+        const Split<T> split = rule(SplitTask<T, N>{range, bounds, centroid_bounds, w.depth});
         if (split.kind == Split<T>::Kind::Leaf && count <= max_leaf) {
             make_leaf();
             continue;
         }
-        std::uint32_t left_count = partition_primitives(in, range, split);
+        RangeBounds<T, N> left, right;
+        std::uint32_t left_count = partition_primitives(in, range, split, left, right);
         if (left_count == 0 || left_count == count) {
             // The rule gave no split (or could not split). Fall back to the object median on the
             // centroids' longest axis; if all centroids coincide the order is arbitrary, so halve.
+            left = right = RangeBounds<T, N>{};
             left_count = partition_primitives(
                 in, range,
                 Split<T>::at_count(static_cast<std::uint32_t>(centroid_bounds.largest_axis()),
-                                   count / 2));
+                                   count / 2),
+                left, right);
         }
         const auto first_child = static_cast<std::uint32_t>(bvh.nodes.size());
         bvh.nodes[w.node].first = first_child;
@@ -185,8 +204,8 @@ Bvh<Aabb<T, N>> build_top_down(const BuildInput<T, N>& in, std::vector<std::uint
         bvh.nodes.emplace_back();
         bvh.nodes.emplace_back();
         // Right pushed first so the left subtree is laid out first (depth-first order).
-        stack.push_back({first_child + 1, w.begin + left_count, w.end, w.depth + 1});
-        stack.push_back({first_child, w.begin, w.begin + left_count, w.depth + 1});
+        stack.push_back({first_child + 1, w.begin + left_count, w.end, w.depth + 1, right});
+        stack.push_back({first_child, w.begin, w.begin + left_count, w.depth + 1, left});
     }
     return bvh;
 }
