@@ -57,9 +57,12 @@ class BoxAccumulator<float, 3> {
         // extent = hi - lo with lanes aligned: shift hi down one lane.
         const __m128 e = _mm_max_ps(
             _mm_sub_ps(_mm_shuffle_ps(hi_, hi_, _MM_SHUFFLE(3, 3, 2, 1)), lo_), _mm_setzero_ps());
-        alignas(16) float x[4];
-        _mm_store_ps(x, e);
-        return 2.0f * (x[0] * x[1] + x[1] * x[2] + x[2] * x[0]);
+        // (ex ey, ey ez, ez ex) in lanes 0-2, then their sum.
+        const __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));
+        const float sum =
+            _mm_cvtss_f32(_mm_add_ss(_mm_add_ss(p, _mm_shuffle_ps(p, p, _MM_SHUFFLE(1, 1, 1, 1))),
+                                     _mm_shuffle_ps(p, p, _MM_SHUFFLE(2, 2, 2, 2))));
+        return 2.0f * sum;
     }
     Aabb3f box() const {
         alignas(16) float l[4], h[4];

@@ -16,25 +16,28 @@ class SweepSahRule {
 
     Split<T> operator()(const SplitTask<T, N>& task) {
         const auto count = static_cast<std::uint32_t>(task.indices.size());
-        order_.assign(task.indices.begin(), task.indices.end());
-        right_area_.resize(count);
+        if (order_.size() < count) {
+            order_.resize(count);
+            right_area_.resize(count);
+        }
         T best_cost = std::numeric_limits<T>::infinity();
         Split<T> best = Split<T>::leaf();
         for (std::size_t a = 0; a < N; ++a) {
             if (!(task.centroid_bounds.max[a] > task.centroid_bounds.min[a])) continue;
-            // The same order partition_primitives uses for AtCount: centroid, then index.
-            const auto& c = in_.centroids;
-            std::sort(order_.begin(), order_.end(), [&](std::uint32_t i, std::uint32_t j) {
-                return c[i][a] < c[j][a] || (c[i][a] == c[j][a] && i < j);
-            });
+            // Sorted by (centroid, index): the order partition_primitives uses for AtCount.
+            for (std::uint32_t k = 0; k < count; ++k) {
+                const std::uint32_t i = task.indices[k];
+                order_[k] = {in_.centroids[i][a], i};
+            }
+            std::sort(order_.begin(), order_.begin() + count);
             BoxAccumulator<T, N> acc;
             for (std::uint32_t k = count; k-- > 1;) {
-                acc.grow(in_.boxes[order_[k]]);
+                acc.grow(in_.boxes[order_[k].second]);
                 right_area_[k] = acc.area();  // area of primitives [k, count)
             }
             acc = BoxAccumulator<T, N>();
             for (std::uint32_t k = 1; k < count; ++k) {  // left = [0, k)
-                acc.grow(in_.boxes[order_[k - 1]]);
+                acc.grow(in_.boxes[order_[k - 1].second]);
                 const T cost = sah_partial_cost(acc.area(), k, right_area_[k], count - k);
                 if (cost < best_cost) {
                     best_cost = cost;
@@ -51,7 +54,7 @@ class SweepSahRule {
   private:
     BuildInput<T, N> in_;
     SahCosts costs_;
-    std::vector<std::uint32_t> order_;  // scratch, reused for every node
+    std::vector<std::pair<T, std::uint32_t>> order_;  // (centroid, index), reused for every node
     std::vector<T> right_area_;
 };
 
