@@ -20,6 +20,20 @@ struct TreeView {
     std::int32_t root;
 };
 
+template <class T, std::size_t N, class U>
+inline void prefetch_next(const TreeView<T, N, U>& t, const Node<T, N>& n) {
+#if defined(__GNUC__)
+    if (n.is_leaf()) {
+        __builtin_prefetch(&t.proxies[n.proxy()]);
+    } else {
+        __builtin_prefetch(&t.nodes[n.child1]);
+        __builtin_prefetch(&t.nodes[n.child2]);
+    }
+#else
+    (void)t, (void)n;
+#endif
+}
+
 /// Box overlap: callback(ProxyId) -> bool, false stops the query. A node's children are tested
 /// before they are pushed, so the stack only ever holds nodes that overlap.
 template <class T, std::size_t N, class U, class F>
@@ -40,8 +54,14 @@ void query_box(const TreeView<T, N, U>& t, const Aabb<T, N>& box, F&& callback, 
             continue;
         }
         visited += 2;
-        if (t.nodes[n.child2].box.overlaps(box)) stack.push(n.child2);
-        if (t.nodes[n.child1].box.overlaps(box)) stack.push(n.child1);
+        for (const std::int32_t c : {n.child2, n.child1}) {
+            const Node<T, N>& cn = t.nodes[c];
+            if (!cn.box.overlaps(box)) continue;
+            stack.push(c);
+            // The tree is scattered in memory: ask for what the pushed node will read when it is
+            // popped (its children, or its proxy) now, so the loads overlap with other work.
+            prefetch_next(t, cn);
+        }
     }
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
 }
