@@ -13,6 +13,7 @@ class BruteForce {
     BruteForce(const std::vector<Triangle<T>>& tris, const std::vector<Ray<T, 3>>& rays,
                TriangleTest test = TriangleTest::Fast)
         : tris_(tris), test_(test) {
+        for (const auto& t : tris) fast_.emplace_back(t);
         closest_.resize(rays.size());
         for (std::size_t r = 0; r < rays.size(); ++r) {
             Hit<T> best;
@@ -27,7 +28,7 @@ class BruteForce {
     std::optional<TriangleHit<T>> intersect(std::uint32_t i, const Ray<T, 3>& ray) const {
         if (test_ == TriangleTest::Watertight) return tris_[i].intersect_watertight(ray);
         TriangleHit<T> h;
-        if (PrecomputedTriangle<T>(tris_[i]).intersect(ray, ray.tmax, h)) return h;
+        if (fast_[i].intersect(ray, ray.tmax, h)) return h;
         return std::nullopt;
     }
 
@@ -62,6 +63,7 @@ class BruteForce {
 
   private:
     const std::vector<Triangle<T>>& tris_;
+    std::vector<PrecomputedTriangle<T>> fast_;
     TriangleTest test_;
     std::vector<Hit<T>> closest_;
 };

@@ -4,6 +4,7 @@
 // full).
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -26,10 +27,27 @@ inline bool small_scale() {
     return s && std::string_view(s) == "small";
 }
 
+/// BVHKIT_TEST_SCALE=full: the acceptance-size runs (slow brute-force references), not run in CI.
+inline bool full_scale() {
+    const char* s = std::getenv("BVHKIT_TEST_SCALE");
+    return s && std::string_view(s) == "full";
+}
+
 /// `full` in the Release run, `full / divisor` (at least 1) under the sanitizers.
 inline std::size_t scaled(std::size_t full, std::size_t divisor = 20) {
     return small_scale() ? std::max<std::size_t>(1, full / divisor) : full;
 }
+
+/// Test names for tests parameterized by a mesh file name ("teapot.obj" -> "teapot_obj").
+struct MeshFileName {
+    template <class Info>
+    std::string operator()(const Info& p) const {
+        std::string n = p.param;
+        for (char& c : n)
+            if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+        return n;
+    }
+};
 
 }  // namespace bvhkit::test
 
