@@ -63,8 +63,10 @@ int bench_rays(int argc, char** argv) {
 int bench_command(int argc, char** argv) {
     const std::string_view what = argc > 1 ? argv[1] : "";
     if (what == "rays") return bench_rays(argc - 1, argv + 1);
+    if (what == "dynamic") return bench_dynamic_command(argc - 1, argv + 1);
     std::fprintf(what == "--help" || what == "-h" ? stdout : stderr,
-                 "usage: bvhkit bench rays [...]   (bvhkit bench rays --help)\n");
+                 "usage: bvhkit bench rays|dynamic [...]   (bvhkit bench rays --help, "
+                 "bvhkit bench dynamic --help)\n");
     return what == "--help" || what == "-h" ? 0 : 2;
 }
 

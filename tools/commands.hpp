@@ -6,6 +6,9 @@ namespace bvhkit::tools {
 
 int version_command(int argc, char** argv);
 int bench_command(int argc, char** argv);
+int info_command(int argc, char** argv);
+int render_command(int argc, char** argv);
+int trace_command(int argc, char** argv);
 int bench_dynamic_command(int argc, char** argv);  // tools/bench_dynamic.cpp
 int draw_tree_command(int argc, char** argv);      // tools/draw_tree.cpp
 

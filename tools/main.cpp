@@ -22,6 +22,10 @@ const Subcommand kSubcommands[] = {
     {"bench-dynamic", "dynamic tree workloads D1-D3 against Box2D and Bullet",
      bvhkit::tools::bench_dynamic_command},
     {"draw-tree", "draw a 2D dynamic tree as SVG", bvhkit::tools::draw_tree_command},
+    {"info", "a mesh and the trees each builder makes of it", bvhkit::tools::info_command},
+    {"render", "a shaded picture or a traversal-cost heat map (PNG)",
+     bvhkit::tools::render_command},
+    {"trace", "trace a ray file through a mesh, write the hits", bvhkit::tools::trace_command},
     {"version", "print the library version", bvhkit::tools::version_command},
 };
 

@@ -1,0 +1,69 @@
+// `bvhkit trace`: the user's rays through the user's mesh, hits written in the BENCHMARKS.md
+// format.
+#include <chrono>
+#include <cstdio>
+#include <limits>
+
+#include "args.hpp"
+#include "bvhkit/io/ray_files.hpp"
+#include "bvhkit/mesh/load_mesh.hpp"
+#include "bvhkit/triangle_bvh.hpp"
+#include "commands.hpp"
+
+namespace bvhkit::tools {
+namespace {
+
+constexpr const char* kHelp =
+    R"(usage: bvhkit trace MESH --rays FILE --out FILE [--any-hit] [--builder NAME]
+
+Traces every ray of FILE (8 float32 per ray: origin xyz, direction xyz, tmin, tmax) through MESH and
+writes, per ray, float32 t (+inf on a miss) and uint32 triangle index (0xFFFFFFFF on a miss); the
+index is the triangle's position in the mesh file, polygons split into fans in file order.
+With --any-hit each ray stops at the first triangle found (an occlusion query): the hit written is
+a hit within [tmin, tmax], not necessarily the closest.
+)";
+
+}  // namespace
+
+int trace_command(int argc, char** argv) {
+    const Args args(argc, argv, {"--rays", "--out", "--builder"}, {"--any-hit"});
+    if (args.help()) {
+        std::fputs(kHelp, stdout);
+        return 0;
+    }
+    if (args.positional().size() != 1) throw Error("trace takes one mesh (see --help)");
+    if (!args.has("--rays") || !args.has("--out"))
+        throw Error("trace needs --rays FILE and --out FILE");
+    const TriangleMesh mesh = load_mesh(args.positional()[0]);
+    const std::vector<Ray3f> rays = read_rays(args.value("--rays"));
+    const TriangleBvh<float> bvh(mesh, parse_builder(args.value("--builder", "binned-sah")));
+    const bool any = args.flag("--any-hit");
+    std::vector<FileHit> hits(rays.size());
+    std::size_t hit_count = 0;
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        Hit<float> h;
+        if (any) {
+            bvh.all_hits(rays[i], [&](const Hit<float>& found) {
+                h = found;
+                return false;  // the first one will do
+            });
+        } else {
+            h = bvh.closest_hit(rays[i]);
+        }
+        hits[i] = h ? FileHit{h.t, h.primitive}
+                    : FileHit{std::numeric_limits<float>::infinity(), invalid_index};
+        hit_count += bool(h);
+    }
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    write_hits(args.value("--out"), hits);
+    std::fprintf(stderr, "%zu rays, %zu hits, %.1f ms (%s); wrote %s\n", rays.size(), hit_count, ms,
+                 any ? "any hit" : "closest hit", args.value("--out").c_str());
+    if (!bvh.skipped().empty())
+        std::fprintf(stderr, "note: %zu triangles with non-finite coordinates were left out\n",
+                     bvh.skipped().size());
+    return 0;
+}
+
+}  // namespace bvhkit::tools
