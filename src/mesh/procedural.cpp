@@ -1,5 +1,7 @@
 #include "bvhkit/mesh/procedural.hpp"
 
+#include "bvhkit/math/random.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <initializer_list>
@@ -10,36 +12,7 @@ namespace bvhkit {
 
 namespace {
 
-// splitmix64 (Steele, Lea, Flood: "Fast splittable pseudorandom number generators", 2014): small,
-// deterministic everywhere; floats are made from the top bits so no <random> distribution is
-// needed.
-class Rng {
-  public:
-    explicit Rng(std::uint64_t seed) : state_(seed) {}
-    std::uint64_t next() {
-        std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
-    /// Uniform in [0, 1).
-    double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-    double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-    /// Uniform in [0, n).
-    std::uint32_t below(std::uint32_t n) {
-        return static_cast<std::uint32_t>((next() >> 32) * n >> 32);
-    }
-    Vec3d unit_vector() {
-        // Uniform on the sphere: z uniform in [-1, 1], angle uniform (Archimedes).
-        const double z = uniform(-1.0, 1.0);
-        const double a = uniform(0.0, 2.0 * std::numbers::pi);
-        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-        return {r * std::cos(a), r * std::sin(a), z};
-    }
-
-  private:
-    std::uint64_t state_;
-};
+using Rng = SplitMix64;  // deterministic on every machine (math/random.hpp)
 
 Vec3f to_float(const Vec3d& v) {
     return Vec3f(v);

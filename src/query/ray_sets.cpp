@@ -36,10 +36,7 @@ std::vector<Ray3f> random_rays(const Aabb3f& bounds, std::size_t count, std::uin
     for (std::size_t i = 0; i < count; ++i) {
         Vec3f o;
         for (int k = 0; k < 3; ++k) o[k] = float(rng.uniform(bounds.min[k], bounds.max[k]));
-        // Uniform on the sphere: z uniform in [-1, 1], angle uniform (Archimedes' hat-box theorem).
-        const double z = rng.uniform(-1.0, 1.0), phi = rng.uniform(0.0, 6.283185307179586);
-        const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-        rays.emplace_back(o, Vec3f(float(s * std::cos(phi)), float(s * std::sin(phi)), float(z)));
+        rays.emplace_back(o, Vec3f(rng.unit_vector()));
     }
     return rays;
 }

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "bvhkit/dynamic/small_stack.hpp"
+#include "bvhkit/math/ray.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
 
 namespace bvhkit::dynamic_detail {
@@ -72,47 +73,19 @@ void query_point(const TreeView<T, N, U>& t, const Vec<T, N>& p, F&& callback, Q
     query_box(t, Aabb<T, N>(p, p), callback, stats);
 }
 
-/// A segment origin + s * direction, s in [0, max_fraction], prepared for slab tests.
+/// A segment origin + s * direction, s in [0, max_fraction], tested with the library's slab test
+/// (math/ray.hpp: exact for +0/-0 direction components, conservative after Ize 2013) against boxes
+/// grown by a pad (zero for a ray cast, the cast box's half extents for a box cast).
 template <class T, std::size_t N>
 struct Segment {
-    Vec<T, N> origin;
-    Vec<T, N> inv_dir;  // 1 / direction, zero components replaced by a tiny value of the same sign
-    Vec<T, N> far;      // +inf on the axes where the direction is zero, 0 elsewhere
+    RaySlabData<T, N> slab;
 
-    Segment(const Vec<T, N>& o, const Vec<T, N>& d) : origin(o) {
-        // A zero component would give 1/0 = inf and then 0 * inf = NaN in the slab test when the
-        // origin lies on a slab plane. A tiny signed value keeps the reciprocal finite (huge) and
-        // the sign of a -0 component, so the test stays NaN free and rays parallel to a slab behave
-        // as the limit.
-        const T tiny = std::numeric_limits<T>::min() * T(16);
-        for (std::size_t i = 0; i < N; ++i) {
-            const T di = d[i] == T(0) ? std::copysign(tiny, d[i]) : d[i];
-            inv_dir[i] = T(1) / di;
-            far[i] = d[i] == T(0) ? std::numeric_limits<T>::infinity() : T(0);
-        }
-    }
+    Segment(const Vec<T, N>& o, const Vec<T, N>& d) : slab(Ray<T, N>(o, d)) {}
 
-    /// Slab test of the segment [0, max_fraction] against `box` grown by `pad` on every side.
-    /// Returns the entry fraction (0 when the origin is inside) or a negative value on a miss. The
-    /// exit fraction is widened by a few ulps so that rounding never makes a touched box a miss
-    /// (conservative, in the manner of Ize 2013 "Robust BVH ray traversal"). On an axis where the
-    /// direction is zero, an origin exactly on a slab plane gives an exit fraction of exactly 0
-    /// (the tiny direction leaves at once), yet the true segment stays on the plane and touches the
-    /// box: there a non-negative exit is raised to +inf, so the axis passes whenever the origin is
-    /// inside.
+    /// The entry fraction (0 when the origin is inside), or a negative value on a miss.
     T entry(const Aabb<T, N>& box, const Vec<T, N>& pad, T max_fraction) const {
-        constexpr T kWiden = T(1) + T(4) * std::numeric_limits<T>::epsilon();
-        T t_near = T(0), t_far = max_fraction;
-        for (std::size_t i = 0; i < N; ++i) {
-            const T t1 = (box.min[i] - pad[i] - origin[i]) * inv_dir[i];
-            const T t2 = (box.max[i] + pad[i] - origin[i]) * inv_dir[i];
-            const T lo = t1 < t2 ? t1 : t2;
-            T hi = t1 < t2 ? t2 : t1;
-            hi = hi >= T(0) ? std::max(hi * kWiden, far[i]) : hi / kWiden;
-            t_near = lo > t_near ? lo : t_near;
-            t_far = hi < t_far ? hi : t_far;
-        }
-        return t_near <= t_far ? t_near : T(-1);
+        T t0 = T(0), t1 = max_fraction;
+        return slab.clip(Aabb<T, N>(box.min - pad, box.max + pad), t0, t1) ? t0 : T(-1);
     }
 };
 
