@@ -15,6 +15,9 @@ enum class Builder {
     BinnedSah,  // Wald 2007: SAH evaluated at bin boundaries; fast, near full-sweep quality
     SweepSah,  // SAH evaluated between every pair of sorted centroids; slowest, best greedy quality
     TopDown,   // the classic rules below: an axis rule and a split-point rule
+    BottomUp,  // PLOC (Meister and Bittner 2018): agglomerative clustering in Morton order
+    Insertion,  // one primitive at a time, branch-and-bound SAH with rotations (seed 000)
+    Lbvh,       // Karras 2012: the Morton-code hierarchy; the fastest build, lower quality
 };
 
 /// Axis rules of the classic top-down builder, evaluated on the node's primitive centroids (the
@@ -44,6 +47,13 @@ struct BuildOptions {
     SplitAxis axis_rule = SplitAxis::LongestExtent;
     SplitPoint point_rule = SplitPoint::ObjectMedian;
     NonFinitePolicy non_finite = NonFinitePolicy::Skip;
+    /// Run the reinsertion optimizer (Bittner et al. 2013, build/reinsertion.hpp) after the build;
+    /// it keeps the built tree when it finds no cheaper one.
+    bool optimize = false;
+    /// Threads for the builders that run in parallel (bottom-up, LBVH) when bvhkit was built with
+    /// oneTBB: 0 = all, 1 = serial. The tree is the same for every value.
+    unsigned threads = 0;
+    std::uint32_t ploc_radius = 16;  // bottom-up: neighbours searched on each side
 };
 
 struct BuildReport {
@@ -53,10 +63,12 @@ struct BuildReport {
 const char* to_string(Builder b);
 const char* to_string(SplitAxis a);
 const char* to_string(SplitPoint p);
-/// Parses "binned-sah", "sweep-sah", "top-down", or "median|mean|spatial[-variance]" shorthands
-/// into options; throws bvhkit::Error listing the valid names.
+/// Parses "binned-sah", "sweep-sah", "top-down", "median|mean|spatial-longest|variance",
+/// "bottom-up", "insertion", "lbvh", each optionally followed by "+opt" (the reinsertion
+/// optimizer), into options; throws bvhkit::Error listing the valid names.
 BuildOptions parse_builder(std::string_view name);
-/// Every builder configuration: binned SAH, sweep SAH, and each top-down axis x point rule.
+/// Every builder configuration: binned SAH, sweep SAH, each top-down axis x point rule, bottom-up,
+/// insertion and LBVH; then each of those again with "+opt" (the reinsertion optimizer).
 std::vector<std::pair<std::string, BuildOptions>> all_builder_configurations();
 
 }  // namespace bvhkit

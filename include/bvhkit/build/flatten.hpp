@@ -1,0 +1,151 @@
+#pragma once
+// From a binary tree built in any order (bottom-up clustering, Morton-code hierarchy, insertion)
+// to the Bvh layout: sibling pairs adjacent, depth-first, children after parents.
+//
+// The builders that make such trees (bottom_up, lbvh, insertion, reinsertion) give one primitive
+// (or one run of primitives) per leaf and no depth limit. Flattening does the two things they
+// share:
+//   - collapse: a subtree becomes one leaf when that is cheaper by the SAH (leaf cost C_isect * n
+//     against C_trav + the children's best costs, all weighted by area) and it holds no more than
+//     max_leaf_size primitives; the usual post-pass of bottom-up builders (Karras 2012, Meister and
+//     Bittner 2018);
+//   - depth: a node at max_depth becomes a leaf holding everything below it, so no tree is deeper
+//     than the fixed traversal stack (max_bvh_depth), whatever the builder did.
+// Boxes are recomputed from the leaves, so the builders need not keep internal boxes exact.
+#include <algorithm>
+#include <span>
+#include <vector>
+
+#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/statistics.hpp"
+
+namespace bvhkit {
+
+inline constexpr std::uint32_t no_child = 0xFFFFFFFFu;
+
+/// A binary tree as the builders make it: node i is internal when left[i] != no_child (then
+/// right[i] is its other child), else a leaf holding the run [first[i], first[i] + count[i]) of
+/// `order` (the primitive indices in any order the builder likes).
+struct BinaryTree {
+    std::vector<std::uint32_t> left, right, first, count;
+    std::vector<std::uint32_t> order;
+    std::uint32_t root = no_child;
+
+    std::uint32_t add_leaf(std::uint32_t run_first, std::uint32_t run_count) {
+        left.push_back(no_child);
+        right.push_back(no_child);
+        first.push_back(run_first);
+        count.push_back(run_count);
+        return static_cast<std::uint32_t>(left.size() - 1);
+    }
+    std::uint32_t add_internal(std::uint32_t l, std::uint32_t r) {
+        left.push_back(l);
+        right.push_back(r);
+        first.push_back(0);
+        count.push_back(0);
+        return static_cast<std::uint32_t>(left.size() - 1);
+    }
+    std::size_t size() const { return left.size(); }
+    void reserve(std::size_t n) {
+        left.reserve(n), right.reserve(n), first.reserve(n), count.reserve(n);
+    }
+};
+
+struct FlattenOptions {
+    std::uint32_t max_leaf_size = 8;  // collapse only subtrees at most this large (1: never)
+    std::uint32_t max_depth = max_bvh_depth;
+    SahCosts costs{};
+};
+
+/// Lays `tree` out as a Bvh; `boxes` are the primitive boxes, indexed by the entries of `order`.
+template <class T, std::size_t N>
+Bvh<Aabb<T, N>> flatten(const BinaryTree& tree, std::span<const Aabb<T, N>> boxes,
+                        const FlattenOptions& options = {}) {
+    Bvh<Aabb<T, N>> bvh;
+    if (tree.root == no_child) return bvh;
+    const std::size_t n = tree.size();
+    // Post-order pass (children before parents, from an explicit pre-order list reversed): boxes,
+    // primitive counts and whether the subtree is cheapest as one leaf.
+    std::vector<std::uint32_t> preorder;
+    preorder.reserve(n);
+    preorder.push_back(tree.root);
+    for (std::size_t i = 0; i < preorder.size(); ++i) {
+        const std::uint32_t v = preorder[i];
+        if (tree.left[v] != no_child) {
+            preorder.push_back(tree.left[v]);
+            preorder.push_back(tree.right[v]);
+        }
+    }
+    std::vector<Aabb<T, N>> box(n);
+    std::vector<std::uint32_t> prims(n);
+    std::vector<double> cost(n);  // best SAH cost of the subtree, in area units
+    std::vector<std::uint8_t> collapse(n, 0);
+    for (std::size_t k = preorder.size(); k-- > 0;) {
+        const std::uint32_t v = preorder[k];
+        if (tree.left[v] == no_child) {
+            Aabb<T, N> b;
+            for (std::uint32_t s = tree.first[v]; s < tree.first[v] + tree.count[v]; ++s)
+                b.grow(boxes[tree.order[s]]);
+            box[v] = b;
+            prims[v] = tree.count[v];
+            cost[v] = options.costs.intersection * prims[v] * double(b.area());
+            collapse[v] = 1;
+            continue;
+        }
+        const std::uint32_t l = tree.left[v], r = tree.right[v];
+        box[v] = unite(box[l], box[r]);
+        prims[v] = prims[l] + prims[r];
+        const double area = double(box[v].area());
+        const double split = options.costs.traversal * area + cost[l] + cost[r];
+        const double leaf = options.costs.intersection * prims[v] * area;
+        if (prims[v] <= options.max_leaf_size && leaf <= split) {
+            collapse[v] = 1;
+            cost[v] = leaf;
+        } else {
+            cost[v] = split;
+        }
+    }
+
+    const std::uint32_t max_depth = std::min(options.max_depth, max_bvh_depth);
+    bvh.nodes.reserve(2 * std::size_t(prims[tree.root]));
+    bvh.primitive_indices.reserve(prims[tree.root]);
+    std::vector<std::uint32_t> gather;  // reused stack for collecting a collapsed subtree's leaves
+    struct Work {
+        std::uint32_t source, target, depth;
+    };
+    std::vector<Work> stack{{tree.root, 0, 0}};
+    bvh.nodes.emplace_back();
+    while (!stack.empty()) {
+        const Work w = stack.back();
+        stack.pop_back();
+        auto& node = bvh.nodes[w.target];
+        node.bounds = box[w.source];
+        if (collapse[w.source] || w.depth >= max_depth) {
+            node.first = static_cast<std::uint32_t>(bvh.primitive_indices.size());
+            node.count = prims[w.source];
+            gather.assign(1, w.source);
+            while (!gather.empty()) {
+                const std::uint32_t v = gather.back();
+                gather.pop_back();
+                if (tree.left[v] == no_child) {
+                    for (std::uint32_t s = tree.first[v]; s < tree.first[v] + tree.count[v]; ++s)
+                        bvh.primitive_indices.push_back(tree.order[s]);
+                } else {
+                    gather.push_back(tree.right[v]);
+                    gather.push_back(tree.left[v]);
+                }
+            }
+            continue;
+        }
+        const auto child = static_cast<std::uint32_t>(bvh.nodes.size());
+        node.first = child;
+        node.count = 0;
+        bvh.nodes.emplace_back();
+        bvh.nodes.emplace_back();
+        stack.push_back({tree.right[w.source], child + 1, w.depth + 1});
+        stack.push_back({tree.left[w.source], child, w.depth + 1});
+    }
+    return bvh;
+}
+
+}  // namespace bvhkit

@@ -1,0 +1,63 @@
+#pragma once
+// The one place bvhkit touches threads: parallel_for over fixed chunks, on oneTBB when the library
+// was built with it (BVHKIT_HAVE_TBB), else a plain loop. Chunks have a fixed size and each index
+// is handled by exactly one call, so code that writes only its own indices gives the same result
+// with any number of threads: that is the rule every parallel path here follows (and the tests
+// check it against threads = 1).
+//
+// `threads`: 0 uses every core TBB offers, 1 runs serially on the calling thread, k limits TBB to
+// k threads (a task arena).
+#include <algorithm>
+#include <cstddef>
+
+#if defined(BVHKIT_HAVE_TBB)
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+#endif
+
+namespace bvhkit {
+
+/// True when parallel_for really runs in parallel (the library was built with oneTBB).
+constexpr bool have_parallel() {
+#if defined(BVHKIT_HAVE_TBB)
+    return true;
+#else
+    return false;
+#endif
+}
+
+/// Calls body(begin, end) on consecutive chunks of [0, count), each of `grain` indices (the last
+/// may be shorter), possibly at the same time on several threads.
+template <class Body>
+void parallel_for(std::size_t count, std::size_t grain, unsigned threads, Body&& body) {
+    if (count == 0) return;
+    grain = std::max<std::size_t>(1, grain);
+#if defined(BVHKIT_HAVE_TBB)
+    if (threads != 1 && count > grain) {
+        const std::size_t chunks = (count + grain - 1) / grain;
+        auto run = [&] {
+            tbb::parallel_for(
+                tbb::blocked_range<std::size_t>(0, chunks, 1),
+                [&](const tbb::blocked_range<std::size_t>& r) {
+                    for (std::size_t c = r.begin(); c != r.end(); ++c)
+                        body(c * grain, std::min(count, (c + 1) * grain));
+                },
+                tbb::simple_partitioner());
+        };
+        if (threads == 0) {
+            run();
+        } else {
+            tbb::task_arena arena(static_cast<int>(threads));
+            arena.execute(run);
+        }
+        return;
+    }
+#else
+    (void)threads;
+#endif
+    for (std::size_t b = 0; b < count; b += grain) body(b, std::min(count, b + grain));
+}
+
+}  // namespace bvhkit
