@@ -1,0 +1,193 @@
+#pragma once
+// Nearest-primitive queries over a Bvh of boxes: the closest primitive to a point, the k closest,
+// and all within a radius (seed 003's "distancing" query, done right).
+//
+// Closest and k closest walk best-first (the lecture seed's rule for nearest queries): a min-heap
+// of nodes keyed by the squared distance from the point to their box, and a search radius that
+// shrinks as closer primitives are found; a node farther than the radius is never opened, and the
+// walk ends when the nearest node left is. Popping a node descends straight into its nearer child
+// and only queues the farther one, which halves the heap traffic. The heap lives in a
+// NearestScratch the caller keeps (one per thread), so queries allocate nothing once it has grown.
+//
+// The primitive's distance is the caller's: `distance(slot, point)` returns the squared distance
+// from `point` to the primitive in leaf slot `slot` (bvh.primitive_indices[slot] is the caller's
+// index). ClosestPointMesh (closest_point_mesh.hpp) supplies it for triangles.
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/primitives/hit.hpp"
+#include "bvhkit/query/stats.hpp"
+
+namespace bvhkit {
+
+/// A node waiting in the best-first heap.
+template <class T>
+struct NearestEntry {
+    T distance_squared;
+    std::uint32_t node;
+};
+
+/// Reusable storage of the nearest queries: keep one per thread.
+template <class T>
+struct NearestScratch {
+    std::vector<NearestEntry<T>> heap;
+    std::vector<std::pair<T, std::uint32_t>> best;  // k nearest: (squared distance, slot)
+};
+
+/// The result of a nearest query: the leaf slot of the primitive (invalid_index when none lies
+/// within the search radius) and its squared distance.
+template <class T>
+struct NearestSlot {
+    std::uint32_t slot = invalid_index;
+    T distance_squared = std::numeric_limits<T>::infinity();
+    explicit operator bool() const { return slot != invalid_index; }
+};
+
+namespace nearest_detail {
+
+template <class T>
+inline bool heap_after(const NearestEntry<T>& a, const NearestEntry<T>& b) {
+    return a.distance_squared > b.distance_squared;  // std heaps are max-heaps: invert
+}
+
+/// The best-first walk. `radius2()` is the current squared search radius (it shrinks as
+/// on_slot(slot, d2) finds closer primitives).
+template <class T, std::size_t N, class Radius, class OnSlot, class Stats>
+void best_first(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, NearestScratch<T>& scratch,
+                Radius&& radius2, OnSlot&& on_slot, Stats&& stats) {
+    if (bvh.empty()) return;
+    const auto* nodes = bvh.nodes.data();
+    auto& heap = scratch.heap;
+    heap.clear();
+    stats.node();
+    const T root_d2 = nodes[0].bounds.distance_squared(p);
+    if (root_d2 > radius2()) return;
+    heap.push_back({root_d2, 0});
+    while (!heap.empty()) {
+        std::pop_heap(heap.begin(), heap.end(), heap_after<T>);
+        const NearestEntry<T> e = heap.back();
+        heap.pop_back();
+        if (e.distance_squared > radius2()) break;  // every node left is farther still
+        std::uint32_t current = e.node;
+        while (true) {
+            const auto& node = nodes[current];
+            if (node.is_leaf()) {
+                for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+                    stats.primitive();
+                    on_slot(s);
+                }
+                break;
+            }
+            const std::uint32_t l = node.left();
+            T dl = nodes[l].bounds.distance_squared(p);
+            T dr = nodes[l + 1].bounds.distance_squared(p);
+            stats.node();
+            stats.node();
+            std::uint32_t near = l, far = l + 1;
+            if (dr < dl) std::swap(dl, dr), std::swap(near, far);
+            const T r2 = radius2();
+            if (dr <= r2) {
+                heap.push_back({dr, far});
+                std::push_heap(heap.begin(), heap.end(), heap_after<T>);
+            }
+            if (dl > r2) break;
+            current = near;
+        }
+    }
+}
+
+}  // namespace nearest_detail
+
+/// The primitive nearest to `p` within sqrt(max_distance_squared) (inclusive). Of primitives at
+/// exactly the same distance, the one found first wins.
+template <class T, std::size_t N, class Distance, class Stats = NoStats>
+NearestSlot<T> nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, Distance&& distance,
+                       NearestScratch<T>& scratch,
+                       T max_distance_squared = std::numeric_limits<T>::infinity(),
+                       Stats&& stats = {}) {
+    NearestSlot<T> best;
+    T radius2 = max_distance_squared;
+    nearest_detail::best_first(
+        bvh, p, scratch, [&] { return radius2; },
+        [&](std::uint32_t s) {
+            const T d2 = distance(s, p);
+            if (d2 < best.distance_squared && d2 <= radius2) {
+                best = {s, d2};
+                radius2 = d2;
+            }
+        },
+        stats);
+    return best;
+}
+
+/// The k primitives nearest to `p` (fewer when the tree holds fewer), nearest first, as (squared
+/// distance, leaf slot) in `out`.
+template <class T, std::size_t N, class Distance, class Stats = NoStats>
+void k_nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, std::size_t k, Distance&& distance,
+               NearestScratch<T>& scratch, std::vector<std::pair<T, std::uint32_t>>& out,
+               T max_distance_squared = std::numeric_limits<T>::infinity(),
+               Stats&& stats = {}) {
+    out.clear();
+    if (k == 0) return;
+    auto& best = scratch.best;  // a max-heap of the k best so far
+    best.clear();
+    T radius2 = max_distance_squared;
+    nearest_detail::best_first(
+        bvh, p, scratch, [&] { return radius2; },
+        [&](std::uint32_t s) {
+            const T d2 = distance(s, p);
+            if (d2 > radius2) return;
+            if (best.size() == k) {
+                if (!(d2 < best.front().first)) return;
+                std::pop_heap(best.begin(), best.end());
+                best.pop_back();
+            }
+            best.emplace_back(d2, s);
+            std::push_heap(best.begin(), best.end());
+            if (best.size() == k) radius2 = std::min(radius2, best.front().first);
+        },
+        stats);
+    out.assign(best.begin(), best.end());
+    std::sort(out.begin(), out.end());
+}
+
+/// Every primitive within `radius` of `p` (inclusive): on_found(slot, squared distance) returns
+/// true to go on, false to stop. Depth first with a fixed stack (the order does not matter here).
+template <class T, std::size_t N, class Distance, class OnFound, class Stats = NoStats>
+bool within_radius(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, T radius, Distance&& distance,
+                   OnFound&& on_found, Stats&& stats = {}) {
+    if (bvh.empty()) return true;
+    const T r2 = radius * radius;
+    const auto* nodes = bvh.nodes.data();
+    stats.node();
+    if (nodes[0].bounds.distance_squared(p) > r2) return true;
+    std::uint32_t stack[max_bvh_depth];
+    std::uint32_t size = 0, current = 0;
+    while (true) {
+        const auto& node = nodes[current];
+        if (node.is_leaf()) {
+            for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+                stats.primitive();
+                const T d2 = distance(s, p);
+                if (d2 <= r2 && !on_found(s, d2)) return false;
+            }
+        } else {
+            const std::uint32_t l = node.left();
+            stats.node();
+            stats.node();
+            const bool hl = nodes[l].bounds.distance_squared(p) <= r2;
+            const bool hr = nodes[l + 1].bounds.distance_squared(p) <= r2;
+            if (hl || hr) {
+                if (hl && hr) stack[size++] = l + 1;
+                current = hl ? l : l + 1;
+                continue;
+            }
+        }
+        if (size == 0) return true;
+        current = stack[--size];
+    }
+}
+
+}  // namespace bvhkit

@@ -1,0 +1,141 @@
+#pragma once
+// Signed distance to a closed triangle mesh, and inside/outside: the distance from the closest
+// point (ClosestPointMesh), the sign from the angle-weighted pseudonormal of the feature the
+// closest point lies on (Baerentzen and Aanaes 2005, "Signed distance computation using the angle
+// weighted pseudonormal"): the face normal inside a face, the sum of the two face normals on an
+// edge, the sum of the incident face normals weighted by their angles at a vertex. The point is
+// outside (positive) when it lies on the side the pseudonormal points to.
+//
+// The sign is exact for a closed, consistently oriented (outward, counter-clockwise) manifold
+// mesh; for a mesh with holes or flipped triangles use the winding number (winding_number.hpp).
+// Corners that sit at the same position are welded first (many files split vertices at seams),
+// so the edges and vertices of the pseudonormals are the geometric ones.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "bvhkit/query/closest_point_mesh.hpp"
+
+namespace bvhkit {
+
+template <class T>
+struct SignedDistance {
+    T distance = 0;  // negative inside
+    MeshPoint<T> closest;
+};
+
+template <class T>
+class SignedDistanceMesh {
+  public:
+    template <class U>
+    explicit SignedDistanceMesh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {})
+        : closest_(mesh, options) {
+        const std::size_t nt = mesh.triangles.size();
+        // Weld corners by exact position: sort vertex ids by coordinates, give equal ones one id.
+        std::vector<std::uint32_t> by_position(mesh.vertices.size());
+        for (std::uint32_t i = 0; i < by_position.size(); ++i) by_position[i] = i;
+        const auto key = [&](std::uint32_t i) {
+            const auto& v = mesh.vertices[i];
+            return std::array<double, 3>{double(v[0]), double(v[1]), double(v[2])};
+        };
+        std::sort(by_position.begin(), by_position.end(),
+                  [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+        std::vector<std::uint32_t> weld(mesh.vertices.size());
+        std::uint32_t ids = 0;
+        for (std::size_t k = 0; k < by_position.size(); ++k) {
+            if (k > 0 && key(by_position[k]) != key(by_position[k - 1])) ++ids;
+            weld[by_position[k]] = ids;
+        }
+        vertex_normals_.assign(mesh.vertices.empty() ? 0 : ids + 1, Vec<T, 3>{});
+        face_normals_.resize(nt);
+        corners_.resize(nt);
+        // Edge pseudonormals: the sum of the unit normals of the faces on each (welded) edge,
+        // found by sorting the 3 nt directed edges by their undirected key.
+        struct EdgeRef {
+            std::uint64_t key;
+            std::uint32_t face;
+            std::uint8_t edge;  // 0: p0-p1, 1: p1-p2, 2: p2-p0
+        };
+        std::vector<EdgeRef> edges;
+        edges.reserve(3 * nt);
+        for (std::uint32_t f = 0; f < nt; ++f) {
+            const auto& t = mesh.triangles[f];
+            const std::array<std::uint32_t, 3> c{weld[t[0]], weld[t[1]], weld[t[2]]};
+            corners_[f] = c;
+            const Vec<double, 3> p[3] = {Vec<double, 3>(mesh.vertices[t[0]]),
+                                         Vec<double, 3>(mesh.vertices[t[1]]),
+                                         Vec<double, 3>(mesh.vertices[t[2]])};
+            const Vec<double, 3> n = cross(p[1] - p[0], p[2] - p[0]);
+            const double len = length(n);
+            const Vec<double, 3> unit = len > 0 ? n / len : Vec<double, 3>{};
+            face_normals_[f] = Vec<T, 3>(unit);
+            for (int k = 0; k < 3; ++k) {
+                const Vec<double, 3> a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
+                const double la = length(a), lb = length(b);
+                const double angle =
+                    la > 0 && lb > 0 ? std::acos(std::clamp(dot(a, b) / (la * lb), -1.0, 1.0))
+                                     : 0.0;
+                vertex_normals_[c[k]] += Vec<T, 3>(unit * angle);
+                const std::uint32_t lo = std::min(c[k], c[(k + 1) % 3]);
+                const std::uint32_t hi = std::max(c[k], c[(k + 1) % 3]);
+                edges.push_back({std::uint64_t(lo) << 32 | hi, f, std::uint8_t(k)});
+            }
+        }
+        std::sort(edges.begin(), edges.end(),
+                  [](const EdgeRef& a, const EdgeRef& b) { return a.key < b.key; });
+        edge_normals_.assign(nt, {});
+        for (std::size_t b = 0; b < edges.size();) {
+            std::size_t e = b;
+            Vec<T, 3> sum{};
+            while (e < edges.size() && edges[e].key == edges[b].key) sum += face_normals_[edges[e++].face];
+            for (std::size_t k = b; k < e; ++k) edge_normals_[edges[k].face][edges[k].edge] = sum;
+            b = e;
+        }
+    }
+
+    /// Signed distance: negative inside. The sign is decided by the pseudonormal at the closest
+    /// point (see above).
+    SignedDistance<T> signed_distance(const Vec<T, 3>& p, NearestScratch<T>& scratch) const {
+        SignedDistance<T> r;
+        r.closest = closest_.closest_point(p, scratch);
+        if (!r.closest) return {std::numeric_limits<T>::infinity(), r.closest};
+        const T d = std::sqrt(r.closest.distance_squared);
+        r.distance = dot(p - r.closest.point, pseudonormal(r.closest)) < T(0) ? -d : d;
+        return r;
+    }
+    SignedDistance<T> signed_distance(const Vec<T, 3>& p) const {
+        thread_local NearestScratch<T> scratch;
+        return signed_distance(p, scratch);
+    }
+    bool inside(const Vec<T, 3>& p) const { return signed_distance(p).distance < T(0); }
+
+    const ClosestPointMesh<T>& closest_point_mesh() const { return closest_; }
+
+  private:
+    /// The pseudonormal of the feature (face, edge or vertex) the closest point lies on, told by
+    /// which barycentric coordinates vanish (closest_point returns them exactly 0 or 1 in the
+    /// vertex and edge regions; the p1-p2 edge's third weight is 1 - u - v, so a tolerance).
+    Vec<T, 3> pseudonormal(const MeshPoint<T>& c) const {
+        const std::uint32_t f = c.triangle;
+        const T eps = T(16) * std::numeric_limits<T>::epsilon();
+        const T w0 = T(1) - c.u - c.v;
+        const bool z0 = w0 <= eps, z1 = c.u <= eps, z2 = c.v <= eps;
+        const auto& corner = corners_[f];
+        if (z1 && z2) return vertex_normals_[corner[0]];
+        if (z0 && z2) return vertex_normals_[corner[1]];
+        if (z0 && z1) return vertex_normals_[corner[2]];
+        if (z2) return edge_normals_[f][0];  // p0-p1
+        if (z0) return edge_normals_[f][1];  // p1-p2
+        if (z1) return edge_normals_[f][2];  // p2-p0
+        return face_normals_[f];
+    }
+
+    ClosestPointMesh<T> closest_;
+    std::vector<Vec<T, 3>> face_normals_;                   // unit, by mesh triangle
+    std::vector<std::array<Vec<T, 3>, 3>> edge_normals_;    // by triangle, edges p0p1 p1p2 p2p0
+    std::vector<Vec<T, 3>> vertex_normals_;                 // by welded vertex
+    std::vector<std::array<std::uint32_t, 3>> corners_;     // welded vertex ids by triangle
+};
+
+}  // namespace bvhkit
