@@ -1,0 +1,185 @@
+#pragma once
+// Obb<T>: an oriented box (centre, three unit axes as the rows of `axes`, half extents along
+// them). Fitted by the covariance of the triangles' surfaces: the eigenvectors of the
+// area-weighted covariance matrix are the axes (Gottschalk, Lin, Manocha 1996, "OBBTree"); the
+// matrix is diagonalized by cyclic Jacobi rotations. Overlap under a pose: the exact 15-axis
+// separating-axis test. Distance lower bound: the largest gap along the 6 face normals.
+#include "bvhkit/volumes/bounding_volume.hpp"
+
+namespace bvhkit {
+
+template <class T>
+struct Obb {
+    using Scalar = T;
+    Vec<T, 3> center{};
+    Mat3<T> axes{};            // row i is the i-th axis (unit, orthogonal)
+    Vec<T, 3> extents{T(-1)};  // half extents; negative: empty
+};
+
+namespace detail {
+
+/// Eigenvectors of a symmetric 3x3 matrix by cyclic Jacobi rotations; returned as the rows.
+inline Mat3<double> symmetric_eigenvectors(Mat3<double> a) {
+    Mat3<double> v;  // columns: eigenvectors so far
+    for (int sweep = 0; sweep < 32; ++sweep) {
+        const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        const double diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if (off <= 1e-30 * diag || off == 0.0) break;
+        for (int p = 0; p < 2; ++p)
+            for (int q = p + 1; q < 3; ++q) {
+                if (a[p][q] == 0.0) continue;
+                const double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                const double t =
+                    (theta >= 0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1.0));
+                const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; ++k) {  // a = Jᵀ a J
+                    const double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    const double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    const double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - s * vkq;
+                    v[k][q] = s * vkp + c * vkq;
+                }
+            }
+    }
+    Mat3<double> rows = v.transposed();
+    // Re-orthonormalize (Gram-Schmidt, then a right-handed third axis) against drift.
+    rows[0] = normalize(rows[0]);
+    rows[1] = normalize(rows[1] - rows[0] * dot(rows[0], rows[1]));
+    rows[2] = cross(rows[0], rows[1]);
+    return rows;
+}
+
+/// The box with the given axes around some points (in double, then padded and rounded out).
+template <class T, class ForEachPoint>
+Obb<T> obb_around(const Mat3<double>& axes, ForEachPoint&& for_each_point) {
+    Vec3d lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    for_each_point([&](const Vec3d& p) {
+        const Vec3d q = axes * p;
+        lo = min(lo, q);
+        hi = max(hi, q);
+    });
+    Obb<T> o;
+    if (!(lo[0] <= hi[0])) return o;
+    const Vec3d mid = (lo + hi) * 0.5;
+    const Vec3d c = axes.transpose_times(mid);
+    const double scale = max_component(max(hi, -lo)) + max_component(max(c, -c));
+    const Vec3d e = (hi - lo) * 0.5 + Vec3d(scale * double(fit_pad<T>));
+    o.center = Vec<T, 3>(c);
+    o.axes = Mat3<T>(axes);
+    o.extents = Vec<T, 3>(e);
+    return o;
+}
+
+}  // namespace detail
+
+template <class T>
+struct VolumeTraits<Obb<T>> {
+    using V = Obb<T>;
+    using Prepared = PreparedPose<T>;
+    static constexpr bool merge_is_tight = false;
+
+    static V fit(std::span<const Triangle<T>> tris) {
+        if (tris.empty()) return {};
+        // Centre on the first vertex so the sums do not lose the small spread to a large offset.
+        const Vec3d o(tris[0].p0);
+        double area = 0;
+        Vec3d mean{};
+        double m[3][3] = {};
+        for (const auto& t : tris) {
+            const Vec3d p = Vec3d(t.p0) - o, q = Vec3d(t.p1) - o, r = Vec3d(t.p2) - o;
+            const double a = 0.5 * length(cross(q - p, r - p));
+            const Vec3d c = (p + q + r) * (1.0 / 3.0);
+            area += a;
+            mean += c * a;
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    m[i][j] +=
+                        a / 12.0 * (9.0 * c[i] * c[j] + p[i] * p[j] + q[i] * q[j] + r[i] * r[j]);
+        }
+        Mat3<double> cov;
+        if (area > 0) {
+            mean = mean * (1.0 / area);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) cov[i][j] = m[i][j] / area - mean[i] * mean[j];
+        } else {  // zero total area: the covariance of the vertices
+            double n = 0;
+            Vec3d s{};
+            double s2[3][3] = {};
+            for (const auto& t : tris)
+                for (const Vec3d& p : {Vec3d(t.p0) - o, Vec3d(t.p1) - o, Vec3d(t.p2) - o}) {
+                    n += 1;
+                    s += p;
+                    for (int i = 0; i < 3; ++i)
+                        for (int j = 0; j < 3; ++j) s2[i][j] += p[i] * p[j];
+                }
+            s = s * (1.0 / n);
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) cov[i][j] = s2[i][j] / n - s[i] * s[j];
+        }
+        const Mat3<double> axes = detail::symmetric_eigenvectors(cov);
+        return detail::obb_around<T>(axes, [&](auto&& f) {
+            for (const auto& t : tris) {
+                f(Vec3d(t.p0));
+                f(Vec3d(t.p1));
+                f(Vec3d(t.p2));
+            }
+        });
+    }
+    /// A box with the larger box's axes around both boxes' corners.
+    static V merge(const V& a, const V& b) {
+        if (a.extents[0] < 0) return b;
+        if (b.extents[0] < 0) return a;
+        const V& big = size(a) >= size(b) ? a : b;
+        return detail::obb_around<T>(Mat3<double>(big.axes), [&](auto&& f) {
+            for (const V* v : {&a, &b})
+                for (int k = 0; k < 8; ++k) {
+                    Vec3d p(v->center);
+                    for (int i = 0; i < 3; ++i)
+                        p += Vec3d(v->axes[i]) *
+                             double((k >> i & 1) ? v->extents[i] : -v->extents[i]);
+                    f(p);
+                }
+        });
+    }
+    static bool overlaps(const V& a, const V& b) {
+        return overlaps(a, b, prepare(Transform<T>::identity(), T(0)));
+    }
+    static Prepared prepare(const Transform<T>& pose, T slack) { return {pose, slack}; }
+    /// b's axes and centre in a's box frame, then the 15-axis test.
+    static bool overlaps(const V& a, const V& b, const Prepared& p) {
+        Mat3<T> c, abs_c;
+        Vec<T, 3> t;
+        relative(a, b, p, c, abs_c, t);
+        return !detail::boxes_separated(c, abs_c, t, a.extents, b.extents, p.slack);
+    }
+    static T size(const V& v) { return length_squared(v.extents); }
+    static T distance_lower_bound(const V& a, const V& b, const Prepared& p) {
+        Mat3<T> c, abs_c;
+        Vec<T, 3> t;
+        relative(a, b, p, c, abs_c, t);
+        return std::max(T(0), detail::boxes_gap(c, abs_c, t, a.extents, b.extents) - p.slack);
+    }
+
+  private:
+    static void relative(const V& a, const V& b, const Prepared& p, Mat3<T>& c, Mat3<T>& abs_c,
+                         Vec<T, 3>& t) {
+        constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
+        const Mat3<T> ar = a.axes * p.r;  // a's axes expressed in B's model frame, as rows
+        for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t j = 0; j < 3; ++j) {
+                c[i][j] = dot(ar[i], b.axes[j]);
+                abs_c[i][j] = std::fabs(c[i][j]) + eps;
+            }
+        t = a.axes * (p.r * b.center + p.t - a.center);
+    }
+};
+
+}  // namespace bvhkit
