@@ -1,10 +1,11 @@
-// `bvhkit bench rays|dynamic ...`: the same-run comparisons against the peers.
+// `bvhkit bench rays|dynamic|nearest ...`: the same-run comparisons against the peers.
 #include <cstdio>
 #include <filesystem>
 #include <string_view>
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "nearest_bench.hpp"
 #include "ray_bench.hpp"
 
 namespace bvhkit::tools {
@@ -58,15 +59,65 @@ int bench_rays(int argc, char** argv) {
     return 0;
 }
 
+constexpr const char* kNearestHelp =
+    R"(usage: bvhkit bench nearest [MESH ...] [--json] [--reps N] [--points N] [--builder NAME]
+                            [--scaling]
+
+Workload N1 of BENCHMARKS.md for bvhkit and CGAL 5.5's AABB_tree (when installed), in this process,
+one thread each: closest point, squared distance and triangle for N points uniform in the mesh's
+box grown by 10%. Query times are medians of N interleaved repetitions (bvhkit, CGAL, bvhkit, ...);
+speedup = bvhkit queries/s over CGAL's. Default meshes: the shared bunny and igea when present.
+
+  --json          print a JSON array of rows instead of a table
+  --reps N        repetitions per figure (default 5)
+  --points N      query points (default 100000)
+  --builder NAME  bvhkit builder (default binned-sah)
+  --scaling       also bvhkit on one thread against all threads (oneTBB): batched N1 queries,
+                  bottom-up and LBVH builds (interleaved medians)
+)";
+
+int bench_nearest(int argc, char** argv) {
+    const Args args(argc, argv, {"--reps", "--points", "--builder"}, {"--json", "--scaling"});
+    if (args.help()) {
+        std::fputs(kNearestHelp, stdout);
+        return 0;
+    }
+    bench::NearestBenchOptions o;
+    o.meshes = args.positional();
+    if (o.meshes.empty()) {
+        for (const char* m : {"stanford-bunny.obj", "igea.ply"}) {
+            const auto p = std::filesystem::path(BVHKIT_SHARED_DATA) / m;
+            if (std::filesystem::exists(p)) o.meshes.push_back(p.string());
+        }
+        if (o.meshes.empty()) o.meshes.push_back("sphere:subdiv=7");
+    }
+    o.repetitions = int(args.integer("--reps", 5, 1, 1000));
+    o.points = std::size_t(args.integer("--points", 100000, 1, 100000000));
+    o.builder = args.value("--builder", "binned-sah");
+    o.scaling = args.flag("--scaling");
+    if (!bench::have_cgal())
+        std::fprintf(stderr,
+                     "CGAL was not found at build time (apt-get install libcgal-dev): only "
+                     "bvhkit is measured\n");
+    const auto rows = bench::run_nearest_bench(o, args.flag("--json") ? nullptr : stderr);
+    if (args.flag("--json"))
+        bench::print_json(stdout, rows);
+    else
+        bench::print_table(stdout, rows);
+    return 0;
+}
+
 }  // namespace
 
 int bench_command(int argc, char** argv) {
     const std::string_view what = argc > 1 ? argv[1] : "";
     if (what == "rays") return bench_rays(argc - 1, argv + 1);
     if (what == "dynamic") return bench_dynamic_command(argc - 1, argv + 1);
+    if (what == "collide") return bench_collide_command(argc - 1, argv + 1);
+    if (what == "nearest") return bench_nearest(argc - 1, argv + 1);
     std::fprintf(what == "--help" || what == "-h" ? stdout : stderr,
-                 "usage: bvhkit bench rays|dynamic [...]   (bvhkit bench rays --help, "
-                 "bvhkit bench dynamic --help)\n");
+                 "usage: bvhkit bench rays|dynamic|nearest [...]   (bvhkit bench rays --help, "
+                 "bvhkit bench dynamic --help, bvhkit bench nearest --help)\n");
     return what == "--help" || what == "-h" ? 0 : 2;
 }
 

@@ -56,7 +56,8 @@ TEST(Builders, EveryNewBuilderMatchesBruteForceOnASoup) {
 }
 
 TEST(Builders, EveryNewBuilderMatchesBruteForceOnASphere) {
-    check_builders(triangles_of<float>(make_sphere(test::small_scale() ? 3 : 5)), test::scaled(2000, 5));
+    check_builders(triangles_of<float>(make_sphere(test::small_scale() ? 3 : 5)),
+                   test::scaled(2000, 5));
 }
 
 TEST(Builders, SharedTeapot) {

@@ -91,8 +91,7 @@ TEST(Inside, FastWindingNumberAgreesOnTheOpenBunny) {
     // Boundary edges (one triangle only): the holes.
     std::map<std::pair<std::uint32_t, std::uint32_t>, int> edge_count;
     for (const auto& t : bunny.triangles)
-        for (int k = 0; k < 3; ++k)
-            ++edge_count[std::minmax(t[k], t[(k + 1) % 3])];
+        for (int k = 0; k < 3; ++k) ++edge_count[std::minmax(t[k], t[(k + 1) % 3])];
     std::vector<Triangled> boundary;  // each boundary edge as a degenerate triangle
     for (const auto& [e, c] : edge_count)
         if (c == 1)
@@ -108,8 +107,7 @@ TEST(Inside, FastWindingNumberAgreesOnTheOpenBunny) {
     for (std::size_t i = 0; i < test::scaled(400, 10); ++i) {
         const Vec3d q(rng.point_in(box));
         double hole = std::numeric_limits<double>::infinity();
-        for (const auto& b : boundary)
-            hole = std::min(hole, length(closest_point(b, q).point - q));
+        for (const auto& b : boundary) hole = std::min(hole, length(closest_point(b, q).point - q));
         if (hole < 0.1 * diag || brute_distance(bunny, q) < 1e-3 * diag) continue;
         const double want = brute_winding(bunny, q);
         const double got = wn.fast(Vec3f(q));
@@ -154,8 +152,8 @@ TEST(Overlap, BoxSphereAndPointEqualBruteForce) {
             radii.push_back(r);
         }
         const BatchHits by_box = query_boxes(bvh, pb, std::span<const Aabb3f>(qboxes));
-        const BatchHits by_sphere = query_spheres(bvh, pb, std::span<const Vec3f>(centers),
-                                                  std::span<const float>(radii));
+        const BatchHits by_sphere =
+            query_spheres(bvh, pb, std::span<const Vec3f>(centers), std::span<const float>(radii));
         const BatchHits by_point = query_points(bvh, pb, std::span<const Vec3f>(centers), 1);
         for (int q = 0; q < 200; ++q) {
             std::vector<std::uint32_t> want_box, want_sphere, want_point;

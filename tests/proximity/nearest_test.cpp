@@ -138,8 +138,7 @@ TEST(Nearest, SoupsWithEveryBuilder) {
 TEST(Nearest, EmptyOneAndRadiusLimit) {
     const ClosestPointMesh<float> empty(std::vector<Trianglef>{});
     EXPECT_FALSE(empty.closest_point(Vec3f(0.0f)));
-    const ClosestPointMesh<float> one(
-        std::vector<Trianglef>{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}});
+    const ClosestPointMesh<float> one(std::vector<Trianglef>{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}});
     const auto c = one.closest_point(Vec3f(0.25f, 0.25f, 2.0f));
     ASSERT_TRUE(c);
     EXPECT_EQ(c.triangle, 0u);

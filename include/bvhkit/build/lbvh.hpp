@@ -79,8 +79,7 @@ BinaryTree build_lbvh_tree(std::span<const Vec<T, N>> centroids,
 }
 
 template <class T, std::size_t N>
-Bvh<Aabb<T, N>> build_lbvh(std::span<const Aabb<T, N>> boxes,
-                           std::span<const Vec<T, N>> centroids,
+Bvh<Aabb<T, N>> build_lbvh(std::span<const Aabb<T, N>> boxes, std::span<const Vec<T, N>> centroids,
                            std::span<const std::uint32_t> indices, const BuildOptions& options) {
     const BinaryTree tree = build_lbvh_tree(centroids, indices, options.threads);
     return flatten(tree, boxes, {options.max_leaf_size, options.max_depth, options.costs});

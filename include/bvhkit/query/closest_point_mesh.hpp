@@ -60,8 +60,7 @@ class ClosestPointMesh {
     MeshPoint<T> closest_point(const Vec<T, 3>& p, NearestScratch<T>& scratch,
                                T max_distance_squared = std::numeric_limits<T>::infinity(),
                                Stats&& stats = {}) const {
-        const NearestSlot<T> n =
-            nearest(bvh_, p, distance(), scratch, max_distance_squared, stats);
+        const NearestSlot<T> n = nearest(bvh_, p, distance(), scratch, max_distance_squared, stats);
         return n ? point_of(n.slot, p) : MeshPoint<T>{};
     }
     MeshPoint<T> closest_point(const Vec<T, 3>& p) const {
@@ -119,8 +118,18 @@ class ClosestPointMesh {
         triangle_count_ = tris.size();
     }
     auto distance() const {
-        return [tris = tris_.data()](std::uint32_t slot, const Vec<T, 3>& p) {
-            return length_squared(bvhkit::closest_point(tris[slot], p).point - p);
+        return [tris = tris_.data()](std::uint32_t slot, const Vec<T, 3>& p, T bound) {
+            const Triangle<T>& t = tris[slot];
+            // The triangle's box is a cheap lower bound: most triangles of a leaf fail it.
+            T box_d2 = 0;
+            for (std::size_t a = 0; a < 3; ++a) {
+                const T lo = std::min(t.p0[a], std::min(t.p1[a], t.p2[a]));
+                const T hi = std::max(t.p0[a], std::max(t.p1[a], t.p2[a]));
+                const T g = std::max(lo - p[a], p[a] - hi);
+                if (g > T(0)) box_d2 += g * g;
+            }
+            if (box_d2 > bound) return box_d2;
+            return length_squared(bvhkit::closest_point(t, p).point - p);
         };
     }
     MeshPoint<T> point_of(std::uint32_t slot, const Vec<T, 3>& p) const {

@@ -9,9 +9,11 @@
 // and only queues the farther one, which halves the heap traffic. The heap lives in a
 // NearestScratch the caller keeps (one per thread), so queries allocate nothing once it has grown.
 //
-// The primitive's distance is the caller's: `distance(slot, point)` returns the squared distance
-// from `point` to the primitive in leaf slot `slot` (bvh.primitive_indices[slot] is the caller's
-// index). ClosestPointMesh (closest_point_mesh.hpp) supplies it for triangles.
+// The primitive's distance is the caller's: `distance(slot, point, bound)` returns the squared
+// distance from `point` to the primitive in leaf slot `slot` (bvh.primitive_indices[slot] is the
+// caller's index), or any value above `bound` when it is farther than `bound` (so a cheap test
+// can reject it without the exact distance). ClosestPointMesh (closest_point_mesh.hpp) supplies it
+// for triangles.
 #include <algorithm>
 #include <limits>
 #include <vector>
@@ -112,7 +114,7 @@ NearestSlot<T> nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, Distance&
     nearest_detail::best_first(
         bvh, p, scratch, [&] { return radius2; },
         [&](std::uint32_t s) {
-            const T d2 = distance(s, p);
+            const T d2 = distance(s, p, radius2);
             if (d2 < best.distance_squared && d2 <= radius2) {
                 best = {s, d2};
                 radius2 = d2;
@@ -127,8 +129,7 @@ NearestSlot<T> nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, Distance&
 template <class T, std::size_t N, class Distance, class Stats = NoStats>
 void k_nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, std::size_t k, Distance&& distance,
                NearestScratch<T>& scratch, std::vector<std::pair<T, std::uint32_t>>& out,
-               T max_distance_squared = std::numeric_limits<T>::infinity(),
-               Stats&& stats = {}) {
+               T max_distance_squared = std::numeric_limits<T>::infinity(), Stats&& stats = {}) {
     out.clear();
     if (k == 0) return;
     auto& best = scratch.best;  // a max-heap of the k best so far
@@ -137,7 +138,7 @@ void k_nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, std::size_t k, Di
     nearest_detail::best_first(
         bvh, p, scratch, [&] { return radius2; },
         [&](std::uint32_t s) {
-            const T d2 = distance(s, p);
+            const T d2 = distance(s, p, radius2);
             if (d2 > radius2) return;
             if (best.size() == k) {
                 if (!(d2 < best.front().first)) return;
@@ -170,7 +171,7 @@ bool within_radius(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, T radius, Dis
         if (node.is_leaf()) {
             for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
                 stats.primitive();
-                const T d2 = distance(s, p);
+                const T d2 = distance(s, p, r2);
                 if (d2 <= r2 && !on_found(s, d2)) return false;
             }
         } else {

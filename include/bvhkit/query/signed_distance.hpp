@@ -73,9 +73,9 @@ class SignedDistanceMesh {
             for (int k = 0; k < 3; ++k) {
                 const Vec<double, 3> a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
                 const double la = length(a), lb = length(b);
-                const double angle =
-                    la > 0 && lb > 0 ? std::acos(std::clamp(dot(a, b) / (la * lb), -1.0, 1.0))
-                                     : 0.0;
+                const double angle = la > 0 && lb > 0
+                                         ? std::acos(std::clamp(dot(a, b) / (la * lb), -1.0, 1.0))
+                                         : 0.0;
                 vertex_normals_[c[k]] += Vec<T, 3>(unit * angle);
                 const std::uint32_t lo = std::min(c[k], c[(k + 1) % 3]);
                 const std::uint32_t hi = std::max(c[k], c[(k + 1) % 3]);
@@ -88,7 +88,8 @@ class SignedDistanceMesh {
         for (std::size_t b = 0; b < edges.size();) {
             std::size_t e = b;
             Vec<T, 3> sum{};
-            while (e < edges.size() && edges[e].key == edges[b].key) sum += face_normals_[edges[e++].face];
+            while (e < edges.size() && edges[e].key == edges[b].key)
+                sum += face_normals_[edges[e++].face];
             for (std::size_t k = b; k < e; ++k) edge_normals_[edges[k].face][edges[k].edge] = sum;
             b = e;
         }
@@ -132,10 +133,10 @@ class SignedDistanceMesh {
     }
 
     ClosestPointMesh<T> closest_;
-    std::vector<Vec<T, 3>> face_normals_;                   // unit, by mesh triangle
-    std::vector<std::array<Vec<T, 3>, 3>> edge_normals_;    // by triangle, edges p0p1 p1p2 p2p0
-    std::vector<Vec<T, 3>> vertex_normals_;                 // by welded vertex
-    std::vector<std::array<std::uint32_t, 3>> corners_;     // welded vertex ids by triangle
+    std::vector<Vec<T, 3>> face_normals_;                 // unit, by mesh triangle
+    std::vector<std::array<Vec<T, 3>, 3>> edge_normals_;  // by triangle, edges p0p1 p1p2 p2p0
+    std::vector<Vec<T, 3>> vertex_normals_;               // by welded vertex
+    std::vector<std::array<std::uint32_t, 3>> corners_;   // welded vertex ids by triangle
 };
 
 }  // namespace bvhkit
