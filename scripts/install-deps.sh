@@ -3,7 +3,7 @@
 # already there. Needs root (or sudo) only when something is missing.
 set -euo pipefail
 packages=(cmake ninja-build g++ make pkg-config libgtest-dev libbenchmark-dev
-          libembree-dev libbox2d-dev libbullet-dev libpng-dev clang libclang-rt-14-dev
+          libembree-dev libbox2d-dev libbullet-dev libpng-dev libfcl-dev clang libclang-rt-14-dev
           libcgal-dev libtbb-dev)
 missing=()
 for p in "${packages[@]}"; do
