@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -355,6 +356,26 @@ RunResult median_run(int reps, F&& run) {
     return last;
 }
 
+/// Medians of f() and g() with their repetitions interleaved (f, g, f, g, ...), so that a change of
+/// load on a shared machine affects both alike.
+template <class F, class G>
+std::pair<RunResult, RunResult> median_runs_interleaved(int reps, F&& f, G&& g) {
+    std::vector<RunResult> a, b;
+    for (int k = 0; k < std::max(1, reps); ++k) {
+        a.push_back(f());
+        b.push_back(g());
+    }
+    const auto collapse = [](std::vector<RunResult>& runs) {
+        std::vector<double> build, step;
+        for (const auto& r : runs) build.push_back(r.build_ms), step.push_back(r.step_ms);
+        RunResult out = runs.back();
+        out.build_ms = median(build);
+        out.step_ms = median(step);
+        return out;
+    };
+    return {collapse(a), collapse(b)};
+}
+
 long long total_pairs(const RunResult& r) {
     long long s = 0;
     for (std::size_t k = 1; k < r.per_step.size(); ++k) s += r.per_step[k].count;
@@ -390,10 +411,36 @@ void crowd(const char* workload, int dim, const DynamicBenchConfig& c, std::FILE
            std::vector<Row>& rows) {
     const Motion m = make_motion(c.n, dim, c.steps, dim == 2 ? 1001 : 2002);
     std::fprintf(log, "%s: %d boxes, %d steps, %d repetitions\n", workload, c.n, c.steps, c.reps);
-    const auto bnb = median_run(c.reps, [&] {
+    const auto run_ours = [&] {
         return dim == 2 ? run_bvhkit<2>(m, InsertionStrategy::BranchAndBound)
                         : run_bvhkit<3>(m, InsertionStrategy::BranchAndBound);
-    });
+    };
+    // bvhkit and the peer alternate repetitions; without the peer, bvhkit runs alone.
+    RunResult bnb;
+    std::optional<std::pair<const char*, RunResult>> peer;
+#ifdef BVHKIT_HAVE_BOX2D
+    if (dim == 2) {
+        auto [ours, theirs] =
+            median_runs_interleaved(c.reps, run_ours, [&] { return run_box2d(m); });
+        bnb = ours;
+        peer.emplace("box2d-2.4.1", theirs);
+    }
+#else
+    if (dim == 2)
+        std::fprintf(log, "%s: Box2D not built in (libbox2d-dev missing); skipped\n", workload);
+#endif
+#ifdef BVHKIT_HAVE_BULLET
+    if (dim == 3) {
+        auto [ours, theirs] =
+            median_runs_interleaved(c.reps, run_ours, [&] { return run_bullet(m); });
+        bnb = ours;
+        peer.emplace("bullet-dbvt", theirs);
+    }
+#else
+    if (dim == 3)
+        std::fprintf(log, "%s: Bullet not built in (libbullet-dev missing); skipped\n", workload);
+#endif
+    if (!peer) bnb = median_run(c.reps, run_ours);
     rows.push_back(make_row(workload, "bvhkit", bnb, nullptr));
     // The greedy descent builds much costlier trees (see sah_cost) and runs an order of magnitude
     // slower here, so it gets a single repetition to keep the whole bench near a minute.
@@ -402,22 +449,7 @@ void crowd(const char* workload, int dim, const DynamicBenchConfig& c, std::FILE
                         : run_bvhkit<3>(m, InsertionStrategy::Greedy);
     });
     rows.push_back(make_row(workload, "bvhkit-greedy", greedy, &bnb));
-#ifdef BVHKIT_HAVE_BOX2D
-    if (dim == 2)
-        rows.push_back(make_row(workload, "box2d-2.4.1",
-                                median_run(c.reps, [&] { return run_box2d(m); }), &bnb));
-#else
-    if (dim == 2)
-        std::fprintf(log, "%s: Box2D not built in (libbox2d-dev missing); skipped\n", workload);
-#endif
-#ifdef BVHKIT_HAVE_BULLET
-    if (dim == 3)
-        rows.push_back(make_row(workload, "bullet-dbvt",
-                                median_run(c.reps, [&] { return run_bullet(m); }), &bnb));
-#else
-    if (dim == 3)
-        std::fprintf(log, "%s: Bullet not built in (libbullet-dev missing); skipped\n", workload);
-#endif
+    if (peer) rows.push_back(make_row(workload, peer->first, peer->second, &bnb));
 }
 
 /// D3: churn. Starts from n / 10 boxes; then rounds of 1,000 operations (inserts, removes, moves in
