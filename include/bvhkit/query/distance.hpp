@@ -75,8 +75,16 @@ DistanceResult<typename V::Scalar> distance(
                 if (is_degenerate(ta[sa])) continue;
                 for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
                     if (is_degenerate(tb[sb])) continue;
+                    const Triangle<T> tri_b = transformed(tb[sb], pose_of_b_in_a);
+                    // Cheap rejection by the triangles' spheres about their first corners.
+                    const T ra = std::sqrt(std::max(length_squared(ta[sa].p1 - ta[sa].p0),
+                                                    length_squared(ta[sa].p2 - ta[sa].p0)));
+                    const T rb = std::sqrt(std::max(length_squared(tri_b.p1 - tri_b.p0),
+                                                    length_squared(tri_b.p2 - tri_b.p0)));
+                    const T reach = best + ra + rb;
+                    if (length_squared(ta[sa].p0 - tri_b.p0) > reach * reach) continue;
                     result.stats.primitive();
-                    const auto d = triangle_distance(ta[sa], transformed(tb[sb], pose_of_b_in_a));
+                    const auto d = triangle_distance(ta[sa], tri_b);
                     if (d.distance_squared < best * best) {
                         best = std::sqrt(d.distance_squared);
                         result.distance = best;
