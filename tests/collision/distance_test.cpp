@@ -85,14 +85,14 @@ void check_all(const TriangleMesh& fa, const TriangleMesh& fb, std::size_t count
 TEST(Distance, SuzanneMatchesBruteForce) {
     BVHKIT_REQUIRE_MESH(path, "suzanne.obj");
     const auto m = read_mesh(path);
-    check_all(m, m, separated_count(3), 21);
+    check_all(m, m, separated_count(10), 21);
 }
 
 TEST(Distance, RandomSoupsMatchBruteForce) {
     for (std::uint64_t s = 0; s < 2; ++s) {
         const auto a = random_soup<float>(200, 0.1, 700 + s),
                    b = random_soup<float>(150, 0.1, 800 + s);
-        check_all(a, b, separated_count(3), 900 + s);
+        check_all(a, b, separated_count(10), 900 + s);
     }
 }
 
@@ -102,7 +102,7 @@ TEST(Distance, FloatModelsAgreeWithDoubleBruteForce) {
     const auto md = converted<double>(m);
     const auto td = triangles_of(md);
     const CollisionModel<Obb<float>> model(m);
-    const auto poses = separated_poses(td, td, md.bounds(), separated_count(2), 31);
+    const auto poses = separated_poses(td, td, md.bounds(), separated_count(5), 31);
     for (const auto& p : poses) {
         const double truth = brute_force_distance(td, td, p);
         const auto d = distance(model, model, Transform<float>(p));

@@ -80,17 +80,17 @@ void check_meshes(const TriangleMesh& ma, const TriangleMesh& mb, std::size_t co
 TEST(Pairs, SuzanneMatchesBruteForce) {
     BVHKIT_REQUIRE_MESH(path, "suzanne.obj");
     const auto m = read_mesh(path);
-    check_meshes(m, m, pose_count(4), 11);
+    check_meshes(m, m, pose_count(20), 11);
 }
 
 TEST(Pairs, TeapotMatchesBruteForce) {
     BVHKIT_REQUIRE_MESH(path, "teapot.obj");
     const auto m = read_mesh(path);
-    check_meshes(m, m, pose_count(2), 12);
+    check_meshes(m, m, pose_count(20), 12);
 }
 
 TEST(Pairs, RandomSoupsMatchBruteForce) {
-    const std::size_t count = pose_count(4);
+    const std::size_t count = pose_count(20);
     for (std::uint64_t s = 0; s < 3; ++s) {
         const auto a = random_soup<float>(300, 0.15, 100 + s);
         const auto b = random_soup<float>(200, 0.2, 200 + s);
@@ -107,7 +107,7 @@ TEST(Pairs, DifferentMeshesMatchBruteForce) {
     const float s = length(ma.bounds().extent()) / length(mb.bounds().extent());
     const Vec3f ca = ma.bounds().centroid(), cb = mb.bounds().centroid();
     for (auto& v : mb.vertices) v = (v - cb) * s + ca;
-    check_meshes(ma, mb, pose_count(2), 13);
+    check_meshes(ma, mb, pose_count(20), 13);
 }
 
 template <class V>
