@@ -43,11 +43,14 @@ Bvh<Aabb<T, N>> build_bottom_up(std::span<const Aabb<T, N>> boxes,
             for (std::size_t i = b; i < e; ++i) {
                 const std::size_t lo = i > radius ? i - radius : 0;
                 const std::size_t hi = std::min(m - 1, i + radius);
-                T best = std::numeric_limits<T>::infinity();
-                std::size_t best_j = i;
-                // Scanning j upwards and keeping only strictly smaller areas picks, among equal
-                // areas, the smallest j: the tie rule above, seen from i.
-                for (std::size_t j = lo; j <= hi; ++j) {
+                // Start from the first neighbour, never from i itself: with areas that overflow to
+                // inf (coordinates near 1e20 and beyond) no area is smaller than another, and a
+                // cluster naming itself would be dropped. Scanning j upwards and keeping only
+                // strictly smaller areas picks, among equal areas, the smallest j: the tie rule
+                // above, seen from i.
+                std::size_t best_j = lo == i ? lo + 1 : lo;
+                T best = unite(box[i], box[best_j]).area();
+                for (std::size_t j = best_j + 1; j <= hi; ++j) {
                     if (j == i) continue;
                     const T a = unite(box[i], box[j]).area();
                     if (a < best) best = a, best_j = j;

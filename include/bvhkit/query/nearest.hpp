@@ -18,7 +18,7 @@
 #include <limits>
 #include <vector>
 
-#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/sibling_pair.hpp"
 #include "bvhkit/primitives/hit.hpp"
 #include "bvhkit/query/stats.hpp"
 
@@ -83,12 +83,13 @@ void best_first(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, NearestScratch<T
                 break;
             }
             const std::uint32_t l = node.left();
-            T dl = nodes[l].bounds.distance_squared(p);
-            T dr = nodes[l + 1].bounds.distance_squared(p);
+            T d[2];
+            pair_distances_squared(nodes + l, p, d);
             stats.node();
             stats.node();
-            std::uint32_t near = l, far = l + 1;
-            if (dr < dl) std::swap(dl, dr), std::swap(near, far);
+            const bool right_nearer = d[1] < d[0];
+            const std::uint32_t near = l + right_nearer, far = l + !right_nearer;
+            const T dl = d[right_nearer], dr = d[!right_nearer];
             const T r2 = radius2();
             if (dr <= r2) {
                 heap.push_back({dr, far});

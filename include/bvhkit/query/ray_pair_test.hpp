@@ -10,7 +10,7 @@
 // operand when either is NaN, and the accumulator (second operand) never is, so a 0 * inf plane
 // distance is dropped exactly as the scalar test drops it (see math/ray.hpp). Elsewhere the scalar
 // slab test runs twice.
-#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/sibling_pair.hpp"
 #include "bvhkit/math/ray.hpp"
 
 #if defined(__SSE2__)
@@ -58,16 +58,8 @@ class RayPairTest<float, 3> {
 
     template <unsigned Octant>
     unsigned test(const BvhNode<Aabb3f>* pair, float tmin, float tmax, float entry[2]) const {
-        const float* p = reinterpret_cast<const float*>(pair);
-        const __m128 a = _mm_loadu_ps(p), b = _mm_loadu_ps(p + 4);  // L: min xyz, max x | max yz ..
-        const __m128 c = _mm_loadu_ps(p + 8), d = _mm_loadu_ps(p + 12);
-        const __m128 x = _mm_shuffle_ps(a, c, _MM_SHUFFLE(3, 0, 3, 0));
-        const __m128 y =
-            _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
-                           _mm_shuffle_ps(c, d, _MM_SHUFFLE(0, 0, 1, 1)), _MM_SHUFFLE(2, 0, 2, 0));
-        const __m128 z =
-            _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
-                           _mm_shuffle_ps(c, d, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 2, 0));
+        const PairPlanes planes = gather_pair_planes(pair);
+        const __m128 x = planes.axis[0], y = planes.axis[1], z = planes.axis[2];
         // Accumulator (tmin, tmin, -tmax, -tmax): never NaN.
         __m128 acc = _mm_shuffle_ps(_mm_set1_ps(tmin), _mm_set1_ps(-tmax), 0);
         acc = _mm_max_ps(
