@@ -141,8 +141,8 @@ TEST(RayPairTest, MatchesTheScalarSlabTestIncludingZeroDirectionsOnPlanes) {
                             const RayPairTest<float, 3> test(ray);
                             float entry[2];
                             const unsigned got = test.slab().with_octant([&](auto o) {
-                                return test.template test<decltype(o)::value>(pair, ray.tmin,
-                                                                              ray.tmax, entry);
+                                return test.template test<decltype(o)::value>(
+                                    pair, test.interval(ray.tmin, ray.tmax), entry);
                             });
                             for (int k = 0; k < 2; ++k) {
                                 float t0, t1;

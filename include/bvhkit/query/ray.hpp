@@ -34,7 +34,9 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
     slab.with_octant([&](auto octant) {
         constexpr unsigned O = decltype(octant)::value;
         const auto* nodes = bvh.nodes.data();
-        {
+        // The root's own box needs a test only when it is a leaf: an internal root's children lie
+        // inside it, so testing them decides as much.
+        if (nodes[0].is_leaf()) {
             T t0 = ray.tmin, t1 = ray.tmax;
             stats.node();
             if (!slab.template clip<O>(nodes[0].bounds, t0, t1)) return;
@@ -46,15 +48,16 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
         Entry stack[max_bvh_depth];
         std::uint32_t size = 0;
         std::uint32_t current = 0;
+        auto interval = pair_test.interval(ray.tmin, ray.tmax);  // made again after each leaf
         while (true) {
             const auto& node = nodes[current];
             if (node.is_leaf()) {
                 if (on_leaf(node)) return;
+                interval = pair_test.interval(ray.tmin, ray.tmax);
             } else {
                 const std::uint32_t left = node.left();  // the right child is left + 1
                 T entry[2];
-                const unsigned hits =
-                    pair_test.template test<O>(nodes + left, ray.tmin, ray.tmax, entry);
+                const unsigned hits = pair_test.template test<O>(nodes + left, interval, entry);
                 stats.node();
                 stats.node();
                 if (hits) {

@@ -25,11 +25,17 @@ class RayPairTest {
     explicit RayPairTest(const Ray<T, N>& ray) : slab_(ray) {}
     const RaySlabData<T, N>& slab() const { return slab_; }
 
-    /// Bit 0: the ray meets pair[0] within [tmin, tmax], entering at entry[0]; bit 1: pair[1].
+    /// The ray's [tmin, tmax] in the form test() takes; make it again when tmax changes.
+    struct Interval {
+        T tmin, tmax;
+    };
+    static Interval interval(T tmin, T tmax) { return {tmin, tmax}; }
+
+    /// Bit 0: the ray meets pair[0] within the interval, entering at entry[0]; bit 1: pair[1].
     template <unsigned Octant>
-    unsigned test(const BvhNode<Aabb<T, N>>* pair, T tmin, T tmax, T entry[2]) const {
-        T t1 = tmax, t3 = tmax;
-        entry[0] = entry[1] = tmin;
+    unsigned test(const BvhNode<Aabb<T, N>>* pair, const Interval& interval, T entry[2]) const {
+        T t1 = interval.tmax, t3 = interval.tmax;
+        entry[0] = entry[1] = interval.tmin;
         const bool l = slab_.template clip<Octant>(pair[0].bounds, entry[0], t1);
         const bool r = slab_.template clip<Octant>(pair[1].bounds, entry[1], t3);
         return unsigned(l) | unsigned(r) << 1;
@@ -56,12 +62,18 @@ class RayPairTest<float, 3> {
     }
     const RaySlabData<float, 3>& slab() const { return slab_; }
 
+    /// (tmin, tmin, -tmax, -tmax): the accumulator's start, never NaN; make it again when tmax
+    /// changes.
+    using Interval = __m128;
+    static Interval interval(float tmin, float tmax) {
+        return _mm_shuffle_ps(_mm_set1_ps(tmin), _mm_set1_ps(-tmax), 0);
+    }
+
     template <unsigned Octant>
-    unsigned test(const BvhNode<Aabb3f>* pair, float tmin, float tmax, float entry[2]) const {
+    unsigned test(const BvhNode<Aabb3f>* pair, Interval interval, float entry[2]) const {
         const PairPlanes planes = gather_pair_planes(pair);
         const __m128 x = planes.axis[0], y = planes.axis[1], z = planes.axis[2];
-        // Accumulator (tmin, tmin, -tmax, -tmax): never NaN.
-        __m128 acc = _mm_shuffle_ps(_mm_set1_ps(tmin), _mm_set1_ps(-tmax), 0);
+        __m128 acc = interval;
         acc = _mm_max_ps(
             near_far<(Octant >> 0) & 1u>(_mm_mul_ps(_mm_sub_ps(x, origin_[0]), scale_[0])), acc);
         acc = _mm_max_ps(
