@@ -79,7 +79,8 @@ BuildOptions parse_builder(std::string_view name) {
     }
     std::string valid;
     for (auto& [n, o] : all_builder_configurations()) valid += (valid.empty() ? "" : ", ") + n;
-    throw Error("unknown builder '" + std::string(name) + "'; valid: " + valid + ", top-down[+opt]");
+    throw Error("unknown builder '" + std::string(name) + "'; valid: " + valid +
+                ", top-down[+opt]");
 }
 
 }  // namespace bvhkit

@@ -1,4 +1,4 @@
-// `bvhkit bench-dynamic`: workloads D1, D2, D3 (the dynamic tree against Box2D's and Bullet's
+// `bvhkit bench dynamic`: workloads D1, D2, D3 (the dynamic tree against Box2D's and Bullet's
 // broadphases); see bench/workloads/dynamic_bench.hpp.
 #include <cstdio>
 #include <cstdlib>
@@ -24,7 +24,7 @@ int parse_positive(const char* option, const char* text) {
 void usage(std::FILE* out) {
     std::fprintf(
         out,
-        "usage: bvhkit bench-dynamic [--json] [--n N] [--steps S] [--reps R] [--only D1|D2|D3]\n"
+        "usage: bvhkit bench dynamic [--json] [--n N] [--steps S] [--reps R] [--only D1|D2|D3]\n"
         "  D1 2D crowd (vs Box2D b2BroadPhase), D2 3D crowd (vs Bullet btDbvtBroadphase),\n"
         "  D3 churn. Defaults: --n 100000 --steps 40 --reps 3 (bvhkit-greedy: 1 rep).\n"
         "  step_ms: ms per step (D3: per round of 1,000 ops); speedup: that row's step_ms over\n"
@@ -59,7 +59,7 @@ int bench_dynamic_command(int argc, char** argv) {
             if (!c.d1 && !c.d2 && !c.d3)
                 throw Error("--only: '" + std::string(w) + "' is not D1, D2 or D3");
         } else {
-            std::fprintf(stderr, "bvhkit bench-dynamic: unknown option '%s'\n", argv[i]);
+            std::fprintf(stderr, "bvhkit bench dynamic: unknown option '%s'\n", argv[i]);
             usage(stderr);
             return 2;
         }

@@ -17,10 +17,8 @@ struct Subcommand {
 };
 
 const Subcommand kSubcommands[] = {
-    {"bench", "same-run benchmarks against the peers (rays, dynamic, nearest)",
+    {"bench", "same-run benchmarks against the peers (rays, dynamic, nearest, collide)",
      bvhkit::tools::bench_command},
-    {"bench-dynamic", "dynamic tree workloads D1-D3 against Box2D and Bullet",
-     bvhkit::tools::bench_dynamic_command},
     {"closest", "closest points on a mesh for a points file", bvhkit::tools::closest_command},
     {"collide", "collision of two meshes at the poses of a file", bvhkit::tools::collide_command},
     {"distance", "distance between two meshes at the poses of a file",

@@ -9,8 +9,8 @@
 #include <limits>
 
 #include "bvhkit/dynamic/small_stack.hpp"
-#include "bvhkit/math/ray.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
+#include "bvhkit/math/ray.hpp"
 
 namespace bvhkit::dynamic_detail {
 
