@@ -9,6 +9,7 @@
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
+#include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
 #include "collision_support.hpp"
 #include "test_support.hpp"
@@ -160,6 +161,7 @@ TEST(Degenerate, IdenticalPosesTouchEverywhere) {
     check_identity<Aabb3f>(m);
     check_identity<Sphere<float>>(m);
     check_identity<Obb<float>>(m);
+    check_identity<Rss<float>>(m);
     check_identity<Kdop<float, 18>>(m);
 }
 
@@ -204,6 +206,7 @@ TEST(Degenerate, TouchingAtAVertexOrAnEdge) {
     check_touching<Aabb3f>();
     check_touching<Sphere<float>>();
     check_touching<Obb<float>>();
+    check_touching<Rss<float>>();
     check_touching<Kdop<float, 14>>();
     check_touching<Kdop<float, 26>>();
 }

@@ -9,6 +9,7 @@
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
+#include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
 #include "collision_support.hpp"
 #include "test_support.hpp"
@@ -78,6 +79,7 @@ void check_all(const TriangleMesh& fa, const TriangleMesh& fb, std::size_t count
     check_distance<Aabb3d>(ma, mb, poses, truth);
     check_distance<Sphere<double>>(ma, mb, poses, truth);
     check_distance<Obb<double>>(ma, mb, poses, truth);
+    check_distance<Rss<double>>(ma, mb, poses, truth);
     check_distance<Kdop<double, 18>>(ma, mb, poses, truth);
     std::printf("[ distance ] %zu separated poses\n", poses.size());
 }
@@ -160,6 +162,7 @@ TEST(Refit, EveryVolumeMatchesRebuild) {
     check_refit<Aabb3f>(m);
     check_refit<Sphere<float>>(m);
     check_refit<Obb<float>>(m);
+    check_refit<Rss<float>>(m);
     check_refit<Kdop<float, 14>>(m);
     check_refit<Kdop<float, 18>>(m);
     check_refit<Kdop<float, 26>>(m);
@@ -205,9 +208,66 @@ TEST(Volumes, PromisesHold) {
     check_volume_promises<Aabb3d>();
     check_volume_promises<Sphere<double>>();
     check_volume_promises<Obb<double>>();
+    check_volume_promises<Rss<double>>();
     check_volume_promises<Kdop<double, 14>>();
     check_volume_promises<Kdop<double, 18>>();
     check_volume_promises<Kdop<double, 26>>();
+}
+
+// Rss: every vertex lies within the radius of the rectangle, and the rectangle distance (the
+// bound's core) equals a dense sampling of both rectangles, never more.
+TEST(Volumes, RssContainsItsTrianglesAndMeasuresRectanglesExactly) {
+    SplitMix64 rng(91);
+    using Traits = VolumeTraits<Rss<double>>;
+    const auto rect_point = [](const Rss<double>& v, double s, double t) {
+        return v.center + v.axes[0] * (s * v.half[0]) + v.axes[1] * (t * v.half[1]);
+    };
+    for (int trial = 0; trial < int(scaled(200, 10)); ++trial) {
+        const auto soup = random_soup<double>(1 + rng.below(8), 0.3, rng.next());
+        const auto tris = triangles_of(soup);
+        const Rss<double> v = Traits::fit(tris);
+        ASSERT_GE(v.half[0], 0.0);
+        ASSERT_GE(v.half[1], 0.0);
+        for (const auto& t : tris)
+            for (const Vec3d& p : {t.p0, t.p1, t.p2}) {
+                const Vec3d q = p - v.center;
+                const double x = std::clamp(dot(q, v.axes[0]), -v.half[0], v.half[0]);
+                const double y = std::clamp(dot(q, v.axes[1]), -v.half[1], v.half[1]);
+                ASSERT_LE(length(p - rect_point(v, x / std::max(v.half[0], 1e-300),
+                                                y / std::max(v.half[1], 1e-300))),
+                          v.radius * (1 + 1e-12) + 1e-15)
+                    << "trial " << trial;
+            }
+        // Against a second volume under a pose: the bound against sampled points of each edge
+        // (a closest pair always has a point on an edge) and a grid over the other rectangle.
+        const auto other = random_soup<double>(1 + rng.below(8), 0.3, rng.next());
+        const Rss<double> w = Traits::fit(triangles_of(other));
+        const auto pose = random_rigid_poses(Aabb3d(Vec3d(0.0), Vec3d(1.0)), 1, rng.next())[0];
+        Rss<double> wp = w;  // w carried into v's frame
+        wp.center = pose.apply(w.center);
+        for (int i = 0; i < 3; ++i) wp.axes[i] = pose.rotation * w.axes[i];
+        const auto prepared = Traits::prepare(pose, 0.0);
+        const double bound = Traits::distance_lower_bound(v, w, prepared);
+        double sampled = std::numeric_limits<double>::infinity();
+        constexpr int n = 40;
+        for (int e = 0; e < 8; ++e)
+            for (int i = 0; i <= n; ++i) {
+                const double s = -1 + 2.0 * i / n;
+                const bool first = e < 4;
+                const Rss<double>& edge_of = first ? v : wp;
+                const Rss<double>& grid_of = first ? wp : v;
+                const double es = (e & 1) ? 1.0 : -1.0;
+                const Vec3d p = (e & 2) ? rect_point(edge_of, es, s) : rect_point(edge_of, s, es);
+                for (int j = 0; j <= n; ++j)
+                    for (int k = 0; k <= n; ++k)
+                        sampled = std::min(sampled, length(p - rect_point(grid_of, -1 + 2.0 * j / n,
+                                                                          -1 + 2.0 * k / n)));
+            }
+        sampled -= v.radius + wp.radius;
+        const double step = 2.0 * (v.half[0] + v.half[1] + w.half[0] + w.half[1]) / n;
+        ASSERT_LE(bound, std::max(0.0, sampled) + 1e-12) << "trial " << trial;
+        ASSERT_GE(bound, sampled - step) << "trial " << trial;
+    }
 }
 
 TEST(Volumes, ObbFollowsTheShape) {

@@ -9,6 +9,7 @@
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
+#include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
 #include "collision_support.hpp"
 #include "test_support.hpp"
@@ -68,6 +69,7 @@ void check_meshes(const TriangleMesh& ma, const TriangleMesh& mb, std::size_t co
     check_volume<Aabb3f>(ma, mb, poses, truth, colliding);
     check_volume<Sphere<float>>(ma, mb, poses, truth, colliding);
     check_volume<Obb<float>>(ma, mb, poses, truth, colliding);
+    check_volume<Rss<float>>(ma, mb, poses, truth, colliding);
     check_volume<Kdop<float, 14>>(ma, mb, poses, truth, colliding);
     check_volume<Kdop<float, 18>>(ma, mb, poses, truth, colliding);
     check_volume<Kdop<float, 26>>(ma, mb, poses, truth, colliding);
@@ -131,6 +133,7 @@ void check_self_all(const TriangleMesh& m, bool expect_some) {
     check_self<Aabb3f>(m, truth);
     check_self<Sphere<float>>(m, truth);
     check_self<Obb<float>>(m, truth);
+    check_self<Rss<float>>(m, truth);
     check_self<Kdop<float, 18>>(m, truth);
     std::printf("[ self ] %zu triangles, %zu intersecting pairs\n", m.triangles.size(),
                 truth.size());

@@ -1,0 +1,254 @@
+#pragma once
+// Rss<T>: a rectangle swept by a sphere (Larsen, Gottschalk, Lin, Manocha 1999, "Fast proximity
+// queries with swept sphere volumes"): the points within `radius` of the rectangle centred at
+// `center`, spanned by axes[0] and axes[1] with half lengths `half[0]`, `half[1]`; axes[2] is its
+// normal. Fitted in the covariance frame of the OBB (obb.hpp), the normal along the thinnest
+// extent. Its point: the distance lower bound is exact for the volume, the distance between the
+// two rectangles minus both radii, so whole subtrees are cut that a box's axis gaps keep.
+//
+// Overlap under a pose is conservative: the volumes' enclosing boxes (half extents
+// half + radius, half + radius, radius) meet by the 15-axis test. Exact would be "rectangle
+// distance <= ra + rb", several times the cost, and collision queries prefer Obb anyway.
+#include <algorithm>
+
+#include "bvhkit/volumes/obb.hpp"
+
+namespace bvhkit {
+
+template <class T>
+struct Rss {
+    using Scalar = T;
+    Vec<T, 3> center{};
+    Mat3<T> axes{};  // rows: two rectangle axes, then the normal (unit, orthogonal)
+    T half[2] = {0, 0};
+    T radius = -1;  // negative: empty
+};
+
+namespace detail {
+
+/// Squared distance from the segment p + s d (s in [0, 1]) to the rectangle [-h0, h0] x [-h1, h1]
+/// in the plane z = 0. The squared distance along the segment is convex, piecewise quadratic and
+/// continuously differentiable, its pieces split where x or y leaves the rectangle's range; the
+/// minimum lies on the first piece whose end has a non-negative slope, found by walking the (at
+/// most four) breakpoints in order.
+template <class T>
+T segment_rectangle_distance_squared(const Vec<T, 3>& p, const Vec<T, 3>& d, T h0, T h1) {
+    const auto excess = [](T x, T h) { return x > h ? x - h : (x < -h ? x + h : T(0)); };
+    const auto value = [&](T s) {
+        const T ex = excess(p[0] + s * d[0], h0), ey = excess(p[1] + s * d[1], h1);
+        const T z = p[2] + s * d[2];
+        return ex * ex + ey * ey + z * z;
+    };
+    const auto slope = [&](T s) {  // half the derivative
+        return excess(p[0] + s * d[0], h0) * d[0] + excess(p[1] + s * d[1], h1) * d[1] +
+               (p[2] + s * d[2]) * d[2];
+    };
+    // Breakpoints strictly inside (0, 1), then the segment's end.
+    T cut[5];
+    int n = 0;
+    for (int axis = 0; axis < 2; ++axis) {
+        const T h = axis == 0 ? h0 : h1;
+        if (d[axis] == T(0)) continue;
+        for (const T edge : {-h, h}) {
+            const T s = (edge - p[axis]) / d[axis];
+            if (!(s > T(0) && s < T(1))) continue;
+            int k = n++;  // insertion keeps them in order (at most four)
+            for (; k > 0 && cut[k - 1] > s; --k) cut[k] = cut[k - 1];
+            cut[k] = s;
+        }
+    }
+    cut[n++] = T(1);
+    T lo = 0;
+    if (slope(lo) >= T(0)) return value(lo);
+    for (int k = 0; k < n; ++k) {
+        const T hi = cut[k];
+        const T g_hi = slope(hi);
+        if (g_hi >= T(0)) {
+            // The slope is linear on [lo, hi]: its root.
+            const T g_lo = slope(lo);
+            const T s = g_hi > g_lo ? lo + (hi - lo) * (-g_lo / (g_hi - g_lo)) : lo;
+            return value(std::clamp(s, lo, hi));
+        }
+        lo = hi;
+    }
+    return value(T(1));
+}
+
+/// Distance between rectangle A (half lengths ha, axis-aligned at the origin in the plane z = 0)
+/// and rectangle B (centre t, axes u = columns of c, half lengths hb), B given in A's frame.
+/// Two convex polygons that do not meet are closest at a point of an edge of one of them, and if
+/// they meet an edge of one touches the other; so the distance is the least over the 8 edges of
+/// the edge's distance to the other rectangle, each in that rectangle's frame.
+template <class T>
+T rectangles_distance(const Mat3<T>& c, const Vec<T, 3>& t, const T ha[2], const T hb[2]) {
+    const Vec<T, 3> u0{c[0][0], c[1][0], c[2][0]}, u1{c[0][1], c[1][1], c[2][1]};
+    T best = std::numeric_limits<T>::infinity();
+    // B's edges against A, in A's frame.
+    for (int side = 0; side < 2; ++side) {
+        const Vec<T, 3>& along = side == 0 ? u0 : u1;   // the edge's direction
+        const Vec<T, 3>& across = side == 0 ? u1 : u0;  // offset to the edge
+        const T h_along = hb[side], h_across = hb[1 - side];
+        for (const T sign : {T(-1), T(1)}) {
+            const Vec<T, 3> mid = t + across * (sign * h_across);
+            const Vec<T, 3> start = mid - along * h_along;
+            const Vec<T, 3> dir = along * (T(2) * h_along);
+            // Both ends on one side of A's plane, farther than the best: nothing to gain.
+            const T z0 = start[2], z1 = start[2] + dir[2];
+            if ((z0 > T(0)) == (z1 > T(0)) && std::min(z0 * z0, z1 * z1) >= best) continue;
+            best = std::min(best, segment_rectangle_distance_squared(start, dir, ha[0], ha[1]));
+        }
+    }
+    // A's edges against B, in B's frame: x_B = Cᵀ (x_A - t).
+    const Vec<T, 3> tb = -c.transpose_times(t);
+    const Vec<T, 3> a0{c[0][0], c[0][1], c[0][2]}, a1{c[1][0], c[1][1], c[1][2]};  // A's axes
+    for (int side = 0; side < 2; ++side) {
+        const Vec<T, 3>& along = side == 0 ? a0 : a1;
+        const Vec<T, 3>& across = side == 0 ? a1 : a0;
+        const T h_along = ha[side], h_across = ha[1 - side];
+        for (const T sign : {T(-1), T(1)}) {
+            const Vec<T, 3> mid = tb + across * (sign * h_across);
+            const Vec<T, 3> start = mid - along * h_along;
+            const Vec<T, 3> dir = along * (T(2) * h_along);
+            const T z0 = start[2], z1 = start[2] + dir[2];
+            if ((z0 > T(0)) == (z1 > T(0)) && std::min(z0 * z0, z1 * z1) >= best) continue;
+            best = std::min(best, segment_rectangle_distance_squared(start, dir, hb[0], hb[1]));
+        }
+    }
+    return std::sqrt(best);
+}
+
+}  // namespace detail
+
+template <class T>
+struct VolumeTraits<Rss<T>> {
+    using V = Rss<T>;
+    using Prepared = PreparedPose<T>;
+    static constexpr bool merge_is_tight = false;
+
+    static V fit(std::span<const Triangle<T>> tris) {
+        if (tris.empty()) return {};
+        const Obb<T> box = VolumeTraits<Obb<T>>::fit(tris);
+        return around(Mat3<double>(box.axes), box.extents, [&](auto&& f) {
+            for (const auto& t : tris) {
+                f(Vec3d(t.p0));
+                f(Vec3d(t.p1));
+                f(Vec3d(t.p2));
+            }
+        });
+    }
+    /// Around the corners of both volumes' enclosing boxes (loose, but refit re-fits instead).
+    static V merge(const V& a, const V& b) {
+        if (a.radius < 0) return b;
+        if (b.radius < 0) return a;
+        const V& big = size(a) >= size(b) ? a : b;
+        const Vec<T, 3> e{big.half[0] + big.radius, big.half[1] + big.radius, big.radius};
+        return around(Mat3<double>(big.axes), e, [&](auto&& f) {
+            for (const V* v : {&a, &b})
+                for (int k = 0; k < 8; ++k) {
+                    Vec3d p(v->center);
+                    const double ext[3] = {double(v->half[0] + v->radius),
+                                           double(v->half[1] + v->radius), double(v->radius)};
+                    for (int i = 0; i < 3; ++i)
+                        p += Vec3d(v->axes[i]) * ((k >> i & 1) ? ext[i] : -ext[i]);
+                    f(p);
+                }
+        });
+    }
+    static bool overlaps(const V& a, const V& b) {
+        return overlaps(a, b, prepare(Transform<T>::identity(), T(0)));
+    }
+    static Prepared prepare(const Transform<T>& pose, T slack) { return {pose, slack}; }
+    static bool overlaps(const V& a, const V& b, const Prepared& p) {
+        Mat3<T> c, abs_c;
+        Vec<T, 3> t;
+        relative(a, b, p, c, abs_c, t);
+        return !detail::boxes_separated(c, abs_c, t, box_extents(a), box_extents(b), p.slack);
+    }
+    static T size(const V& v) { return length_squared(box_extents(v)); }
+    static T distance_lower_bound(const V& a, const V& b, const Prepared& p) {
+        Mat3<T> c, abs_c;
+        Vec<T, 3> t;
+        relative(a, b, p, c, abs_c, t);
+        const T d = detail::rectangles_distance(c, t, a.half, b.half) - a.radius - b.radius;
+        return std::max(T(0), d - p.slack);
+    }
+
+  private:
+    static Vec<T, 3> box_extents(const V& v) {
+        return {v.half[0] + v.radius, v.half[1] + v.radius, v.radius};
+    }
+    /// The volume with the given frame around some points. `extents` (the points' half extents
+    /// along the axes) picks the normal: the axis of the thinnest extent. The radius is half the
+    /// thickness along it; then each rectangle side is pulled in as far as every point stays
+    /// within the radius: first x with a point's whole remaining budget sqrt(r² - z²), then y
+    /// with what x left it, so no point ends farther than r from the rectangle.
+    template <class ForEachPoint>
+    static V around(const Mat3<double>& frame, const Vec<T, 3>& extents,
+                    ForEachPoint&& for_each_point) {
+        int normal = 0;
+        for (int i = 1; i < 3; ++i)
+            if (extents[i] < extents[normal]) normal = i;
+        const int i0 = (normal + 1) % 3, i1 = (normal + 2) % 3;
+        Mat3<double> axes;
+        axes[0] = frame[i0];
+        axes[1] = frame[i1];
+        axes[2] = cross(axes[0], axes[1]);
+        constexpr double inf = std::numeric_limits<double>::infinity();
+        double zlo = inf, zhi = -inf, scale = 0;
+        for_each_point([&](const Vec3d& p) {
+            const double z = dot(axes[2], p);
+            zlo = std::min(zlo, z);
+            zhi = std::max(zhi, z);
+            scale = std::max(scale, max_component(bvhkit::max(p, -p)));
+        });
+        V v;
+        if (!(zlo <= zhi)) return v;
+        const double zmid = (zlo + zhi) * 0.5, r = (zhi - zlo) * 0.5;
+        const double r2 = r * r;
+        // x side: lo = min(x + budget), hi = max(x - budget).
+        double xlo = inf, xhi = -inf;
+        for_each_point([&](const Vec3d& p) {
+            const double z = dot(axes[2], p) - zmid;
+            const double budget = std::sqrt(std::max(0.0, r2 - z * z));
+            const double x = dot(axes[0], p);
+            xlo = std::min(xlo, x + budget);
+            xhi = std::max(xhi, x - budget);
+        });
+        if (xlo > xhi) xlo = xhi = (xlo + xhi) * 0.5;  // every point reaches the middle
+        double ylo = inf, yhi = -inf;
+        for_each_point([&](const Vec3d& p) {
+            const double z = dot(axes[2], p) - zmid;
+            const double x = dot(axes[0], p);
+            const double ex = x > xhi ? x - xhi : (x < xlo ? xlo - x : 0.0);
+            const double budget = std::sqrt(std::max(0.0, r2 - z * z - ex * ex));
+            const double y = dot(axes[1], p);
+            ylo = std::min(ylo, y + budget);
+            yhi = std::max(yhi, y - budget);
+        });
+        if (ylo > yhi) ylo = yhi = (ylo + yhi) * 0.5;
+        const Vec3d mid{(xlo + xhi) * 0.5, (ylo + yhi) * 0.5, zmid};
+        const Vec3d c = axes.transpose_times(mid);
+        // Rounding of the sums above and of storing in T: widen the radius by a few ulps of the
+        // coordinates' scale.
+        const double pad = (scale + max_component(bvhkit::max(c, -c))) * double(detail::fit_pad<T>);
+        v.center = Vec<T, 3>(c);
+        v.axes = Mat3<T>(axes);
+        v.half[0] = T((xhi - xlo) * 0.5);
+        v.half[1] = T((yhi - ylo) * 0.5);
+        v.radius = T(r + pad);
+        return v;
+    }
+    static void relative(const V& a, const V& b, const Prepared& p, Mat3<T>& c, Mat3<T>& abs_c,
+                         Vec<T, 3>& t) {
+        constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
+        const Mat3<T> ar = a.axes * p.r;
+        for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t j = 0; j < 3; ++j) {
+                c[i][j] = dot(ar[i], b.axes[j]);
+                abs_c[i][j] = std::fabs(c[i][j]) + eps;
+            }
+        t = a.axes * (p.r * b.center + p.t - a.center);
+    }
+};
+
+}  // namespace bvhkit
