@@ -49,14 +49,23 @@ DistanceResult<typename V::Scalar> distance(
     const auto tb = b.slot_triangles();
     const auto pose =
         Traits::prepare(pose_of_b_in_a, pose_slack(a.scale(), b.scale(), pose_of_b_in_a));
-    const auto bound = [&](std::uint32_t x, std::uint32_t y) {
-        result.stats.node();
-        return Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose);
-    };
     T best = std::numeric_limits<T>::infinity();
     const auto hopeless = [&](T lb) {
         const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
         return lb >= best - tol;
+    };
+    const auto bound = [&](std::uint32_t x, std::uint32_t y) {
+        result.stats.node();
+        // A volume that can stop early once the pair is sure to be dropped (rss.hpp) is told
+        // where that is: the best so far less the tolerance.
+        if constexpr (requires {
+                          Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose, best);
+                      }) {
+            const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
+            return Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose, best - tol);
+        } else {
+            return Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose);
+        }
     };
     struct Entry {
         std::uint32_t a, b;

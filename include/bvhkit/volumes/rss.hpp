@@ -76,42 +76,60 @@ T segment_rectangle_distance_squared(const Vec<T, 3>& p, const Vec<T, 3>& d, T h
 
 /// Distance between rectangle A (half lengths ha, axis-aligned at the origin in the plane z = 0)
 /// and rectangle B (centre t, axes u = columns of c, half lengths hb), B given in A's frame.
-/// Two convex polygons that do not meet are closest at a point of an edge of one of them, and if
-/// they meet an edge of one touches the other; so the distance is the least over the 8 edges of
-/// the edge's distance to the other rectangle, each in that rectangle's frame.
+///
+/// Where two convex polygons are closest, one point can be taken on the boundary of one of them
+/// (both inside their faces means parallel planes, and sliding keeps the distance). A closest
+/// point on B's boundary: an edge of B against the whole of A (4 segment-rectangle distances).
+/// Else the point on A's boundary faces B's interior: an edge of A whose distance to B's plane
+/// could still fall along it (so a corner of A over B's face), or one that crosses B's face (the
+/// rectangles meet). So: B's 4 edges against A, A's 4 corners above B, A's 4 edges through B.
+///
+/// `limit`: the caller needs nothing beyond it; the result is min(distance, limit). A B edge is
+/// measured only when a cheap lower bound could beat the best so far (per axis of A's frame,
+/// the gap when both ends lie beyond one side of its range; the squares add up), and of each
+/// pair of opposite edges the one facing A's centre goes first.
 template <class T>
-T rectangles_distance(const Mat3<T>& c, const Vec<T, 3>& t, const T ha[2], const T hb[2]) {
-    const Vec<T, 3> u0{c[0][0], c[1][0], c[2][0]}, u1{c[0][1], c[1][1], c[2][1]};
-    T best = std::numeric_limits<T>::infinity();
-    // B's edges against A, in A's frame.
-    for (int side = 0; side < 2; ++side) {
-        const Vec<T, 3>& along = side == 0 ? u0 : u1;   // the edge's direction
-        const Vec<T, 3>& across = side == 0 ? u1 : u0;  // offset to the edge
-        const T h_along = hb[side], h_across = hb[1 - side];
-        for (const T sign : {T(-1), T(1)}) {
-            const Vec<T, 3> mid = t + across * (sign * h_across);
-            const Vec<T, 3> start = mid - along * h_along;
-            const Vec<T, 3> dir = along * (T(2) * h_along);
-            // Both ends on one side of A's plane, farther than the best: nothing to gain.
-            const T z0 = start[2], z1 = start[2] + dir[2];
-            if ((z0 > T(0)) == (z1 > T(0)) && std::min(z0 * z0, z1 * z1) >= best) continue;
-            best = std::min(best, segment_rectangle_distance_squared(start, dir, ha[0], ha[1]));
+T rectangles_distance(const Mat3<T>& c, const Vec<T, 3>& t, const T ha[2], const T hb[2],
+                      T limit = std::numeric_limits<T>::infinity()) {
+    T best = limit * limit;
+    const auto gap = [](T x0, T x1, T h) {
+        if (x0 > h && x1 > h) return std::min(x0, x1) - h;
+        if (x0 < -h && x1 < -h) return -h - std::max(x0, x1);
+        return T(0);
+    };
+    // A's corners in B's frame (x_B = Cᵀ (x_A - t); rows of c are A's axes there), first: they
+    // settle facing rectangles at once, and their edges' crossings tell whether the two meet.
+    const Vec<T, 3> tb = -c.transpose_times(t);
+    const Vec<T, 3> da = c[0] * ha[0], db = c[1] * ha[1];
+    const Vec<T, 3> corners[4] = {tb - da - db, tb + da - db, tb + da + db, tb - da + db};
+    for (int k = 0; k < 4; ++k) {
+        const Vec<T, 3>& p = corners[k];
+        const bool over = std::fabs(p[0]) <= hb[0] && std::fabs(p[1]) <= hb[1];
+        if (over) best = std::min(best, p[2] * p[2]);
+        const Vec<T, 3>& q = corners[(k + 1) % 4];
+        if ((p[2] > T(0)) != (q[2] > T(0)) && p[2] != q[2]) {
+            const T s = p[2] / (p[2] - q[2]);  // where the edge meets B's plane
+            const T x = p[0] + s * (q[0] - p[0]), y = p[1] + s * (q[1] - p[1]);
+            if (std::fabs(x) <= hb[0] && std::fabs(y) <= hb[1]) return T(0);
         }
     }
-    // A's edges against B, in B's frame: x_B = Cᵀ (x_A - t).
-    const Vec<T, 3> tb = -c.transpose_times(t);
-    const Vec<T, 3> a0{c[0][0], c[0][1], c[0][2]}, a1{c[1][0], c[1][1], c[1][2]};  // A's axes
+    // B's edges in A's frame (columns of c are B's axes).
+    const Vec<T, 3> u0{c[0][0], c[1][0], c[2][0]}, u1{c[0][1], c[1][1], c[2][1]};
     for (int side = 0; side < 2; ++side) {
-        const Vec<T, 3>& along = side == 0 ? a0 : a1;
-        const Vec<T, 3>& across = side == 0 ? a1 : a0;
-        const T h_along = ha[side], h_across = ha[1 - side];
-        for (const T sign : {T(-1), T(1)}) {
-            const Vec<T, 3> mid = tb + across * (sign * h_across);
-            const Vec<T, 3> start = mid - along * h_along;
-            const Vec<T, 3> dir = along * (T(2) * h_along);
-            const T z0 = start[2], z1 = start[2] + dir[2];
-            if ((z0 > T(0)) == (z1 > T(0)) && std::min(z0 * z0, z1 * z1) >= best) continue;
-            best = std::min(best, segment_rectangle_distance_squared(start, dir, hb[0], hb[1]));
+        const Vec<T, 3>& along = side == 0 ? u0 : u1;
+        const Vec<T, 3>& across = side == 0 ? u1 : u0;
+        const T h_along = hb[side], h_across = hb[1 - side];
+        const Vec<T, 3> dir = along * (T(2) * h_along);
+        const Vec<T, 3> base = t - along * h_along;
+        const Vec<T, 3> offset = across * h_across;
+        const bool facing_minus = dot(t, across) > T(0);
+        for (int pass = 0; pass < 2; ++pass) {
+            const Vec<T, 3> start = (pass == 0) == facing_minus ? base - offset : base + offset;
+            const Vec<T, 3> end = start + dir;
+            const T gx = gap(start[0], end[0], ha[0]), gy = gap(start[1], end[1], ha[1]);
+            const T gz = gap(start[2], end[2], T(0));
+            if (gx * gx + gy * gy + gz * gz >= best) continue;
+            best = std::min(best, segment_rectangle_distance_squared(start, dir, ha[0], ha[1]));
         }
     }
     return std::sqrt(best);
@@ -166,11 +184,46 @@ struct VolumeTraits<Rss<T>> {
     }
     static T size(const V& v) { return length_squared(box_extents(v)); }
     static T distance_lower_bound(const V& a, const V& b, const Prepared& p) {
+        return distance_lower_bound(a, b, p, std::numeric_limits<T>::infinity());
+    }
+    /// The bound, or any value >= cutoff when the bound is (the traversal drops the pair then):
+    /// three cheap gaps first (along either normal, between the circumscribed spheres), which
+    /// settle most pairs a query looks at, then the exact rectangle distance, its edges skipped
+    /// once they cannot come within the cutoff.
+    static T distance_lower_bound(const V& a, const V& b, const Prepared& p, T cutoff) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
         relative(a, b, p, c, abs_c, t);
-        const T d = detail::rectangles_distance(c, t, a.half, b.half) - a.radius - b.radius;
-        return std::max(T(0), d - p.slack);
+        const T reach = a.radius + b.radius + p.slack;
+        const T along_a = std::fabs(t[2]) - b.half[0] * abs_c[2][0] - b.half[1] * abs_c[2][1];
+        const T tb2 = c[0][2] * t[0] + c[1][2] * t[1] + c[2][2] * t[2];  // -(A's centre in B).z
+        const T along_b = std::fabs(tb2) - a.half[0] * abs_c[0][2] - a.half[1] * abs_c[1][2];
+        const T spheres = length(t) - std::sqrt(a.half[0] * a.half[0] + a.half[1] * a.half[1]) -
+                          std::sqrt(b.half[0] * b.half[0] + b.half[1] * b.half[1]);
+        const T cheap = std::max({along_a, along_b, spheres}) - reach;
+        if (cheap >= cutoff) return cheap;
+        // One rectangle wholly on one side of the other's plane, its corner nearest that plane
+        // above the other rectangle: the normal gap is the distance (facing patches of two
+        // surfaces, most of the pairs a query refines).
+        if (along_a > T(0)) {
+            const T s = t[2] > T(0) ? T(-1) : T(1);
+            const T s0 = c[2][0] > T(0) ? s : -s, s1 = c[2][1] > T(0) ? s : -s;
+            const T x = t[0] + s0 * b.half[0] * c[0][0] + s1 * b.half[1] * c[0][1];
+            const T y = t[1] + s0 * b.half[0] * c[1][0] + s1 * b.half[1] * c[1][1];
+            if (std::fabs(x) <= a.half[0] && std::fabs(y) <= a.half[1])
+                return std::max(T(0), along_a - reach);
+        }
+        if (along_b > T(0)) {
+            const Vec<T, 3> tb = -c.transpose_times(t);  // A's centre in B's frame
+            const T s = tb[2] > T(0) ? T(-1) : T(1);
+            const T s0 = c[0][2] > T(0) ? s : -s, s1 = c[1][2] > T(0) ? s : -s;
+            const T x = tb[0] + s0 * a.half[0] * c[0][0] + s1 * a.half[1] * c[1][0];
+            const T y = tb[1] + s0 * a.half[0] * c[0][1] + s1 * a.half[1] * c[1][1];
+            if (std::fabs(x) <= b.half[0] && std::fabs(y) <= b.half[1])
+                return std::max(T(0), along_b - reach);
+        }
+        const T d = detail::rectangles_distance(c, t, a.half, b.half, cutoff + reach) - reach;
+        return std::max({T(0), d, cheap});
     }
 
   private:
