@@ -34,6 +34,21 @@ struct DistanceResult {
     PairStats stats;  // volume bounds computed, triangle pairs measured
 };
 
+namespace detail {
+
+/// Whether triangle `u` lies wholly on one side of triangle t's plane, at least `gap` from it
+/// (then the triangles are at least `gap` apart).
+template <class T>
+bool beyond_plane(const Triangle<T>& t, const Triangle<T>& u, T gap) {
+    const Vec<T, 3> n = cross(t.p1 - t.p0, t.p2 - t.p0);
+    const T d0 = dot(n, u.p0 - t.p0), d1 = dot(n, u.p1 - t.p0), d2 = dot(n, u.p2 - t.p0);
+    const T reach = gap * gap * length_squared(n);
+    const T lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
+    return (lo > T(0) && lo * lo >= reach) || (hi < T(0) && hi * hi >= reach);
+}
+
+}  // namespace detail
+
 template <BoundingVolume V>
 DistanceResult<typename V::Scalar> distance(
     const CollisionModel<V>& a, const CollisionModel<V>& b,
@@ -47,8 +62,9 @@ DistanceResult<typename V::Scalar> distance(
     const auto& nb_ = b.bvh().nodes;
     const auto ta = a.slot_triangles();
     const auto tb = b.slot_triangles();
-    const auto pose =
-        Traits::prepare(pose_of_b_in_a, pose_slack(a.scale(), b.scale(), pose_of_b_in_a));
+    const T slack = pose_slack(a.scale(), b.scale(), pose_of_b_in_a);
+    const auto pose = Traits::prepare(pose_of_b_in_a, slack);
+    const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
     T best = std::numeric_limits<T>::infinity();
     const auto hopeless = [&](T lb) {
         const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
@@ -65,6 +81,16 @@ DistanceResult<typename V::Scalar> distance(
             return Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose, best - tol);
         } else {
             return Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose);
+        }
+    };
+    // A node against the other node placed in its frame (pairs.hpp, detail::Placeable).
+    const auto placed_bound = [&](const V& x, const V& w) {
+        result.stats.node();
+        if constexpr (requires { Traits::distance_lower_bound_placed(x, w, slack, best); }) {
+            const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
+            return Traits::distance_lower_bound_placed(x, w, slack, best - tol);
+        } else {
+            return Traits::distance_lower_bound_placed(x, w, slack);
         }
     };
     struct Entry {
@@ -92,6 +118,11 @@ DistanceResult<typename V::Scalar> distance(
                                                     length_squared(tri_b.p2 - tri_b.p0)));
                     const T reach = best + ra + rb;
                     if (length_squared(ta[sa].p0 - tri_b.p0) > reach * reach) continue;
+                    // Then by either triangle's plane: the other wholly at least `best` beyond
+                    // it (facing triangles of two surfaces, which the spheres keep).
+                    if (detail::beyond_plane(ta[sa], tri_b, best) ||
+                        detail::beyond_plane(tri_b, ta[sa], best))
+                        continue;
                     result.stats.primitive();
                     const auto d = triangle_distance(ta[sa], tri_b);
                     if (d.distance_squared < best * best) {
@@ -113,12 +144,24 @@ DistanceResult<typename V::Scalar> distance(
         int n = 0;
         switch (detail::choose(rule, na, nb)) {
             case detail::Open::A:
-                kids[n++] = {na.left(), e.b, bound(na.left(), e.b)};
-                kids[n++] = {na.right(), e.b, bound(na.right(), e.b)};
+                if constexpr (detail::Placeable<V>) {
+                    const V w = Traits::place(nb.bounds, pose);
+                    for (const std::uint32_t x : {na.left(), na.right()})
+                        kids[n++] = {x, e.b, placed_bound(na_[x].bounds, w)};
+                } else {
+                    kids[n++] = {na.left(), e.b, bound(na.left(), e.b)};
+                    kids[n++] = {na.right(), e.b, bound(na.right(), e.b)};
+                }
                 break;
             case detail::Open::B:
-                kids[n++] = {e.a, nb.left(), bound(e.a, nb.left())};
-                kids[n++] = {e.a, nb.right(), bound(e.a, nb.right())};
+                if constexpr (detail::Placeable<V>) {
+                    const V w = Traits::place(na.bounds, inverse);
+                    for (const std::uint32_t y : {nb.left(), nb.right()})
+                        kids[n++] = {e.a, y, placed_bound(nb_[y].bounds, w)};
+                } else {
+                    kids[n++] = {e.a, nb.left(), bound(e.a, nb.left())};
+                    kids[n++] = {e.a, nb.right(), bound(e.a, nb.right())};
+                }
                 break;
             case detail::Open::Both:
                 for (std::uint32_t x : {na.left(), na.right()})

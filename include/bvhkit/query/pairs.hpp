@@ -75,6 +75,17 @@ Open choose(DescentRule rule, const BvhNode<V>& na, const BvhNode<V>& nb) {
     }
 }
 
+/// Volumes that can be carried into the other tree's frame once per traversal step (obb.hpp,
+/// rss.hpp): opening one node tests both its children against the other node, so that node is
+/// placed once (B's into A's frame with the pose, A's into B's with its inverse) and each test
+/// saves a 3x3 product.
+template <class V>
+concept Placeable = requires(const V& v, const typename VolumeTraits<V>::Prepared& p,
+                             typename V::Scalar slack) {
+    { VolumeTraits<V>::place(v, p) } -> std::same_as<V>;
+    { VolumeTraits<V>::overlaps_placed(v, v, slack) } -> std::same_as<bool>;
+};
+
 }  // namespace detail
 
 /// Calls on_pair(slot_a, slot_b) -> bool for every pair of primitive slots in two leaves whose
@@ -89,6 +100,7 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
     using Traits = VolumeTraits<V>;
     if (a.empty() || b.empty()) return true;
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
+    const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
     const auto overlap = [&](std::uint32_t x, std::uint32_t y) {
         stats.node();
         return Traits::overlaps(a.nodes[x].bounds, b.nodes[y].bounds, pose);
@@ -127,12 +139,30 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
         }
         switch (detail::choose(rule, na, nb)) {
             case detail::Open::A:
-                if (overlap(na.right(), p.b)) stack[top++] = {na.right(), p.b};
-                if (overlap(na.left(), p.b)) stack[top++] = {na.left(), p.b};
+                if constexpr (detail::Placeable<V>) {
+                    const V w = Traits::place(nb.bounds, pose);
+                    for (const std::uint32_t x : {na.right(), na.left()}) {
+                        stats.node();
+                        if (Traits::overlaps_placed(a.nodes[x].bounds, w, slack))
+                            stack[top++] = {x, p.b};
+                    }
+                } else {
+                    if (overlap(na.right(), p.b)) stack[top++] = {na.right(), p.b};
+                    if (overlap(na.left(), p.b)) stack[top++] = {na.left(), p.b};
+                }
                 break;
             case detail::Open::B:
-                if (overlap(p.a, nb.right())) stack[top++] = {p.a, nb.right()};
-                if (overlap(p.a, nb.left())) stack[top++] = {p.a, nb.left()};
+                if constexpr (detail::Placeable<V>) {
+                    const V w = Traits::place(na.bounds, inverse);
+                    for (const std::uint32_t y : {nb.right(), nb.left()}) {
+                        stats.node();
+                        if (Traits::overlaps_placed(b.nodes[y].bounds, w, slack))
+                            stack[top++] = {p.a, y};
+                    }
+                } else {
+                    if (overlap(p.a, nb.right())) stack[top++] = {p.a, nb.right()};
+                    if (overlap(p.a, nb.left())) stack[top++] = {p.a, nb.left()};
+                }
                 break;
             case detail::Open::Both:
                 for (std::uint32_t x : {na.right(), na.left()})

@@ -168,7 +168,38 @@ struct VolumeTraits<Obb<T>> {
         return std::max(T(0), detail::boxes_gap(c, abs_c, t, a.extents, b.extents) - p.slack);
     }
 
+    /// b carried into A's frame once, for the several tests a traversal step makes against it
+    /// (each then skips the product of a's axes with the pose's rotation).
+    static V place(const V& b, const Prepared& p) {
+        V w = b;
+        w.center = p.r * b.center + p.t;
+        for (std::size_t j = 0; j < 3; ++j) w.axes[j] = p.r * b.axes[j];
+        return w;
+    }
+    /// overlaps(a, b, p) for w = place(b, p).
+    static bool overlaps_placed(const V& a, const V& w, T slack) {
+        Mat3<T> c, abs_c;
+        Vec<T, 3> t;
+        relative_placed(a, w, c, abs_c, t);
+        return !detail::boxes_separated(c, abs_c, t, a.extents, w.extents, slack);
+    }
+    static T distance_lower_bound_placed(const V& a, const V& w, T slack) {
+        Mat3<T> c, abs_c;
+        Vec<T, 3> t;
+        relative_placed(a, w, c, abs_c, t);
+        return std::max(T(0), detail::boxes_gap(c, abs_c, t, a.extents, w.extents) - slack);
+    }
+
   private:
+    static void relative_placed(const V& a, const V& w, Mat3<T>& c, Mat3<T>& abs_c, Vec<T, 3>& t) {
+        constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
+        for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t j = 0; j < 3; ++j) {
+                c[i][j] = dot(a.axes[i], w.axes[j]);
+                abs_c[i][j] = std::fabs(c[i][j]) + eps;
+            }
+        t = a.axes * (w.center - a.center);
+    }
     static void relative(const V& a, const V& b, const Prepared& p, Mat3<T>& c, Mat3<T>& abs_c,
                          Vec<T, 3>& t) {
         constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);

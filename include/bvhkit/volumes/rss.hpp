@@ -194,7 +194,34 @@ struct VolumeTraits<Rss<T>> {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
         relative(a, b, p, c, abs_c, t);
-        const T reach = a.radius + b.radius + p.slack;
+        return bound_from(a, b, c, abs_c, t, p.slack, cutoff);
+    }
+    /// b carried into A's frame once, for the several tests a traversal step makes against it
+    /// (each then skips the product of a's axes with the pose's rotation).
+    static V place(const V& b, const Prepared& p) {
+        V w = b;
+        w.center = p.r * b.center + p.t;
+        for (std::size_t j = 0; j < 3; ++j) w.axes[j] = p.r * b.axes[j];
+        return w;
+    }
+    static bool overlaps_placed(const V& a, const V& w, T slack) {
+        Mat3<T> c, abs_c;
+        Vec<T, 3> t;
+        relative_placed(a, w, c, abs_c, t);
+        return !detail::boxes_separated(c, abs_c, t, box_extents(a), box_extents(w), slack);
+    }
+    static T distance_lower_bound_placed(const V& a, const V& w, T slack, T cutoff) {
+        Mat3<T> c, abs_c;
+        Vec<T, 3> t;
+        relative_placed(a, w, c, abs_c, t);
+        return bound_from(a, w, c, abs_c, t, slack, cutoff);
+    }
+
+  private:
+    /// b's axes as the columns of c and its centre t, both in a's frame.
+    static T bound_from(const V& a, const V& b, const Mat3<T>& c, const Mat3<T>& abs_c,
+                        const Vec<T, 3>& t, T slack, T cutoff) {
+        const T reach = a.radius + b.radius + slack;
         const T along_a = std::fabs(t[2]) - b.half[0] * abs_c[2][0] - b.half[1] * abs_c[2][1];
         const T tb2 = c[0][2] * t[0] + c[1][2] * t[1] + c[2][2] * t[2];  // -(A's centre in B).z
         const T along_b = std::fabs(tb2) - a.half[0] * abs_c[0][2] - a.half[1] * abs_c[1][2];
@@ -226,7 +253,6 @@ struct VolumeTraits<Rss<T>> {
         return std::max({T(0), d, cheap});
     }
 
-  private:
     static Vec<T, 3> box_extents(const V& v) {
         return {v.half[0] + v.radius, v.half[1] + v.radius, v.radius};
     }
@@ -290,6 +316,15 @@ struct VolumeTraits<Rss<T>> {
         v.half[1] = T((yhi - ylo) * 0.5);
         v.radius = T(r + pad);
         return v;
+    }
+    static void relative_placed(const V& a, const V& w, Mat3<T>& c, Mat3<T>& abs_c, Vec<T, 3>& t) {
+        constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
+        for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t j = 0; j < 3; ++j) {
+                c[i][j] = dot(a.axes[i], w.axes[j]);
+                abs_c[i][j] = std::fabs(c[i][j]) + eps;
+            }
+        t = a.axes * (w.center - a.center);
     }
     static void relative(const V& a, const V& b, const Prepared& p, Mat3<T>& c, Mat3<T>& abs_c,
                          Vec<T, 3>& t) {
