@@ -89,8 +89,10 @@ DistanceResult<typename V::Scalar> distance(
         if constexpr (requires { Traits::distance_lower_bound_placed(x, w, slack, best); }) {
             const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
             return Traits::distance_lower_bound_placed(x, w, slack, best - tol);
-        } else {
+        } else if constexpr (detail::Placeable<V>) {
             return Traits::distance_lower_bound_placed(x, w, slack);
+        } else {
+            return T(0);  // not called: only placeable volumes are placed
         }
     };
     struct Entry {
