@@ -7,7 +7,11 @@
 #include "args.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/distance.hpp"
+#include "bvhkit/volumes/aabb_volume.hpp"
+#include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
+#include "bvhkit/volumes/rss.hpp"
+#include "bvhkit/volumes/sphere.hpp"
 #include "commands.hpp"
 #include "pose_file.hpp"
 
@@ -15,17 +19,31 @@ namespace bvhkit::tools {
 namespace {
 
 constexpr const char* kHelp =
-    R"(usage: bvhkit distance MESH_A MESH_B --poses FILE --out FILE
+    R"(usage: bvhkit distance MESH_A MESH_B --poses FILE --out FILE [--bv rss|obb|aabb|sphere|kdop18]
 
 For each pose (12 float32: row-major rotation R, translation t; B placed at x' = R x + t in A's
 frame) writes the float32 minimum distance between the two meshes, or -1 where they touch or
-intersect. Exact (no tolerance); OBB trees.
+intersect. Exact (no tolerance). --bv picks the trees' bounding volume (default rss, the
+fastest for distance: its bound is the exact distance between the volumes).
 )";
+
+template <class V>
+void distance_all(const TriangleMesh& ma, const TriangleMesh& mb,
+                  const std::vector<Transform<float>>& poses, std::vector<unsigned char>& out) {
+    const CollisionModel<V> a(ma), b(mb);
+    for (const auto& p : poses) {
+        const float d = distance(a, b, p).distance;
+        const float v = d > 0.0f ? d : -1.0f;
+        unsigned char bytes[4];
+        std::memcpy(bytes, &v, 4);
+        out.insert(out.end(), bytes, bytes + 4);
+    }
+}
 
 }  // namespace
 
 int distance_command(int argc, char** argv) {
-    const Args args(argc, argv, {"--poses", "--out"}, {});
+    const Args args(argc, argv, {"--poses", "--out", "--bv"}, {});
     if (args.help()) {
         std::fputs(kHelp, stdout);
         return 0;
@@ -34,16 +52,23 @@ int distance_command(int argc, char** argv) {
         std::fputs(kHelp, stderr);
         return 2;
     }
-    const CollisionModel<Obb<float>> a(load_mesh(args.positional()[0]));
-    const CollisionModel<Obb<float>> b(load_mesh(args.positional()[1]));
+    const TriangleMesh ma = load_mesh(args.positional()[0]);
+    const TriangleMesh mb = load_mesh(args.positional()[1]);
+    const auto poses = read_pose_file(args.value("--poses"));
+    const std::string bv = args.value("--bv", "rss");
     std::vector<unsigned char> out;
-    for (const auto& p : read_pose_file(args.value("--poses"))) {
-        const float d = distance(a, b, p).distance;
-        const float v = d > 0.0f ? d : -1.0f;
-        unsigned char bytes[4];
-        std::memcpy(bytes, &v, 4);
-        out.insert(out.end(), bytes, bytes + 4);
-    }
+    if (bv == "rss")
+        distance_all<Rss<float>>(ma, mb, poses, out);
+    else if (bv == "obb")
+        distance_all<Obb<float>>(ma, mb, poses, out);
+    else if (bv == "aabb")
+        distance_all<Aabb3f>(ma, mb, poses, out);
+    else if (bv == "sphere")
+        distance_all<Sphere<float>>(ma, mb, poses, out);
+    else if (bv == "kdop18")
+        distance_all<Kdop<float, 18>>(ma, mb, poses, out);
+    else
+        throw Error("--bv: unknown bounding volume '" + bv + "' (rss, obb, aabb, sphere, kdop18)");
     write_bytes(args.value("--out"), out);
     return 0;
 }
