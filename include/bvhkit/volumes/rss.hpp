@@ -187,8 +187,8 @@ struct VolumeTraits<Rss<T>> {
         return distance_lower_bound(a, b, p, std::numeric_limits<T>::infinity());
     }
     /// The bound, or any value >= cutoff when the bound is (the traversal drops the pair then):
-    /// three cheap gaps first (along either normal, between the circumscribed spheres), which
-    /// settle most pairs a query looks at, then the exact rectangle distance, its edges skipped
+    /// three cheap gaps first (along either normal, between the circumscribed spheres), enough
+    /// for pairs plainly beyond the cutoff, then the exact rectangle distance, its edges skipped
     /// once they cannot come within the cutoff.
     static T distance_lower_bound(const V& a, const V& b, const Prepared& p, T cutoff) {
         Mat3<T> c, abs_c;
@@ -231,7 +231,7 @@ struct VolumeTraits<Rss<T>> {
         if (cheap >= cutoff) return cheap;
         // One rectangle wholly on one side of the other's plane, its corner nearest that plane
         // above the other rectangle: the normal gap is the distance (facing patches of two
-        // surfaces, most of the pairs a query refines).
+        // surfaces), no edge to measure.
         if (along_a > T(0)) {
             const T s = t[2] > T(0) ? T(-1) : T(1);
             const T s0 = c[2][0] > T(0) ? s : -s, s1 = c[2][1] > T(0) ? s : -s;
