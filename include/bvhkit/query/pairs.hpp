@@ -107,17 +107,6 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
     };
     std::array<detail::NodePair, detail::pair_stack_size> stack;
     std::size_t top = 0;
-    // Node pairs wait on the stack while their siblings' subtrees are searched; start fetching
-    // the children they will test when popped (large trees miss the cache on most node loads,
-    // and a wide volume's sibling pair spans several cache lines).
-    const auto fetch_children = [&](std::uint32_t x, std::uint32_t y) {
-        const auto prefetch = [](const auto* node) {
-            const char* p = reinterpret_cast<const char*>(node);
-            for (std::size_t k = 0; k < 2 * sizeof(*node); k += 64) __builtin_prefetch(p + k);
-        };
-        if (!a.nodes[x].is_leaf()) prefetch(&a.nodes[a.nodes[x].left()]);
-        if (!b.nodes[y].is_leaf()) prefetch(&b.nodes[b.nodes[y].left()]);
-    };
     if (!overlap(0, 0)) return true;
     stack[top++] = {0, 0};
     while (top > 0) {
@@ -152,13 +141,11 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
             case detail::Open::A:
                 if constexpr (detail::Placeable<V>) {
                     const V w = Traits::place(nb.bounds, pose);
-                    const std::size_t before = top;
                     for (const std::uint32_t x : {na.right(), na.left()}) {
                         stats.node();
                         if (Traits::overlaps_placed(a.nodes[x].bounds, w, slack))
                             stack[top++] = {x, p.b};
                     }
-                    if (top >= before + 2) fetch_children(stack[top - 2].a, stack[top - 2].b);
                 } else {
                     if (overlap(na.right(), p.b)) stack[top++] = {na.right(), p.b};
                     if (overlap(na.left(), p.b)) stack[top++] = {na.left(), p.b};
@@ -167,13 +154,11 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
             case detail::Open::B:
                 if constexpr (detail::Placeable<V>) {
                     const V w = Traits::place(na.bounds, inverse);
-                    const std::size_t before = top;
                     for (const std::uint32_t y : {nb.right(), nb.left()}) {
                         stats.node();
                         if (Traits::overlaps_placed(b.nodes[y].bounds, w, slack))
                             stack[top++] = {p.a, y};
                     }
-                    if (top >= before + 2) fetch_children(stack[top - 2].a, stack[top - 2].b);
                 } else {
                     if (overlap(p.a, nb.right())) stack[top++] = {p.a, nb.right()};
                     if (overlap(p.a, nb.left())) stack[top++] = {p.a, nb.left()};
