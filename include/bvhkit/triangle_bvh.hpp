@@ -27,8 +27,9 @@ class TriangleBvh {
     explicit TriangleBvh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {},
                          TriangleTest test = TriangleTest::Fast)
         : triangle_test_(test) {
-        check_indices(mesh);
-        build([&](std::size_t i) { return triangle_of(mesh, i); }, mesh.triangles.size(), options);
+        check_triangle_indices(mesh);
+        build([&](std::size_t i) { return triangle_at<T>(mesh, i); }, mesh.triangles.size(),
+              options);
     }
 
     explicit TriangleBvh(const std::vector<Triangle<T>>& triangles,
@@ -69,8 +70,8 @@ class TriangleBvh {
             throw Error("TriangleBvh::refit: the mesh has " +
                         std::to_string(mesh.triangles.size()) +
                         " triangles, the tree was built over " + std::to_string(triangle_count_));
-        check_indices(mesh);
-        const auto triangle = [&](std::size_t i) { return triangle_of(mesh, i); };
+        check_triangle_indices(mesh);
+        const auto triangle = [&](std::size_t i) { return triangle_at<T>(mesh, i); };
         bvhkit::refit(bvh_, [&](std::uint32_t i) { return triangle(i).bounds(); });
         lay_out(triangle);
     }
@@ -80,24 +81,7 @@ class TriangleBvh {
     const std::vector<std::uint32_t>& skipped() const { return report_.skipped; }
     std::size_t triangle_count() const { return triangle_count_; }
 
-    /// Throws bvhkit::Error naming the first triangle that names a vertex the mesh does not have.
-    template <class U>
-    static void check_indices(const BasicTriangleMesh<U>& mesh) {
-        for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
-            for (std::uint32_t k : mesh.triangles[i])
-                if (k >= mesh.vertices.size())
-                    throw Error("triangle " + std::to_string(i) + " names vertex " +
-                                std::to_string(k) + " of " + std::to_string(mesh.vertices.size()));
-    }
-
   private:
-    template <class U>
-    static Triangle<T> triangle_of(const BasicTriangleMesh<U>& mesh, std::size_t i) {
-        const auto& t = mesh.triangles[i];
-        return {Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
-                Vec<T, 3>(mesh.vertices[t[2]])};
-    }
-
     template <class TriangleAt>
     void build(TriangleAt&& triangle, std::size_t count, const BuildOptions& options) {
         std::vector<Aabb<T, 3>> boxes;

@@ -6,7 +6,11 @@
 #include <cstdint>
 #include <vector>
 
+#include <string>
+
+#include "bvhkit/error.hpp"
 #include "bvhkit/math/aabb.hpp"
+#include "bvhkit/primitives/triangle.hpp"
 
 namespace bvhkit {
 
@@ -24,5 +28,23 @@ struct BasicTriangleMesh {
 };
 
 using TriangleMesh = BasicTriangleMesh<float>;
+
+/// Throws bvhkit::Error naming the first triangle that names a vertex the mesh does not have.
+template <class U>
+void check_triangle_indices(const BasicTriangleMesh<U>& mesh) {
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+        for (std::uint32_t k : mesh.triangles[i])
+            if (k >= mesh.vertices.size())
+                throw Error("triangle " + std::to_string(i) + " names vertex " + std::to_string(k) +
+                            " of " + std::to_string(mesh.vertices.size()));
+}
+
+/// Triangle i of the mesh in scalar type T (indices unchecked: see check_triangle_indices).
+template <class T, class U>
+Triangle<T> triangle_at(const BasicTriangleMesh<U>& mesh, std::size_t i) {
+    const auto& t = mesh.triangles[i];
+    return {Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
+            Vec<T, 3>(mesh.vertices[t[2]])};
+}
 
 }  // namespace bvhkit

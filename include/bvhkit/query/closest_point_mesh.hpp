@@ -36,18 +36,11 @@ class ClosestPointMesh {
 
     template <class U>
     explicit ClosestPointMesh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {}) {
+        check_triangle_indices(mesh);
         std::vector<Triangle<T>> tris;
         tris.reserve(mesh.triangles.size());
-        for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-            const auto& t = mesh.triangles[i];
-            for (std::uint32_t k : t)
-                if (k >= mesh.vertices.size())
-                    throw Error("ClosestPointMesh: triangle " + std::to_string(i) +
-                                " names vertex " + std::to_string(k) + " of " +
-                                std::to_string(mesh.vertices.size()));
-            tris.push_back({Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
-                            Vec<T, 3>(mesh.vertices[t[2]])});
-        }
+        for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+            tris.push_back(triangle_at<T>(mesh, i));
         build(tris, options);
     }
     explicit ClosestPointMesh(const std::vector<Triangle<T>>& triangles,

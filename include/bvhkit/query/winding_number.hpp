@@ -41,15 +41,9 @@ class WindingNumberMesh {
         std::vector<Aabb<T, 3>> boxes(mesh.triangles.size());
         std::vector<Vec<T, 3>> centroids(mesh.triangles.size());
         std::vector<Triangle<T>> tris(mesh.triangles.size());
+        check_triangle_indices(mesh);
         for (std::size_t i = 0; i < tris.size(); ++i) {
-            const auto& t = mesh.triangles[i];
-            for (std::uint32_t k : t)
-                if (k >= mesh.vertices.size())
-                    throw Error("WindingNumberMesh: triangle " + std::to_string(i) +
-                                " names vertex " + std::to_string(k) + " of " +
-                                std::to_string(mesh.vertices.size()));
-            tris[i] = {Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
-                       Vec<T, 3>(mesh.vertices[t[2]])};
+            tris[i] = triangle_at<T>(mesh, i);
             boxes[i] = tris[i].bounds();
             centroids[i] = boxes[i].centroid();
         }
