@@ -109,11 +109,18 @@ DistanceResult<typename V::Scalar> distance(
     thread_local std::vector<Entry> heap;
     heap.clear();
     const auto later = [](const Entry& x, const Entry& y) { return x.bound > y.bound; };
-    heap.push_back({0, 0, bound(0, 0)});
-    while (!heap.empty()) {
-        std::pop_heap(heap.begin(), heap.end(), later);
-        const Entry e = heap.back();
-        heap.pop_back();
+    // `next`: a child that is already the least pending pair goes on without a trip through
+    // the heap (the usual case while refining toward a leaf).
+    Entry next{0, 0, bound(0, 0)};
+    bool have_next = true;
+    while (have_next || !heap.empty()) {
+        Entry e = next;
+        if (!have_next) {
+            std::pop_heap(heap.begin(), heap.end(), later);
+            e = heap.back();
+            heap.pop_back();
+        }
+        have_next = false;
         if (hopeless(e.bound)) break;  // and so is every pair still waiting
         const auto& na = na_[e.a];
         const auto& nb = nb_[e.b];
@@ -180,11 +187,20 @@ DistanceResult<typename V::Scalar> distance(
                     for (std::uint32_t y : {nb.left(), nb.right()}) kids[n++] = {x, y, bound(x, y)};
                 break;
         }
+        int least = -1;
         for (int k = 0; k < n; ++k)
-            if (!hopeless(kids[k].bound)) {
+            if (!hopeless(kids[k].bound) && (least < 0 || kids[k].bound < kids[least].bound))
+                least = k;
+        for (int k = 0; k < n; ++k) {
+            if (hopeless(kids[k].bound)) continue;
+            if (k == least && (heap.empty() || kids[k].bound <= heap.front().bound)) {
+                next = kids[k];
+                have_next = true;
+            } else {
                 heap.push_back(kids[k]);
                 std::push_heap(heap.begin(), heap.end(), later);
             }
+        }
     }
     return result;
 }
