@@ -6,6 +6,7 @@
 #include "args.hpp"
 #include "commands.hpp"
 #include "nearest_bench.hpp"
+#include "output.hpp"
 #include "ray_bench.hpp"
 
 namespace bvhkit::tools {
@@ -36,13 +37,7 @@ int bench_rays(int argc, char** argv) {
     }
     bench::RayBenchOptions o;
     o.meshes = args.positional();
-    if (o.meshes.empty()) {
-        for (const char* m : {"stanford-bunny.obj", "igea.ply"}) {
-            const auto p = std::filesystem::path(BVHKIT_SHARED_DATA) / m;
-            if (std::filesystem::exists(p)) o.meshes.push_back(p.string());
-        }
-        if (o.meshes.empty()) o.meshes.push_back("sphere:subdiv=7");
-    }
+    if (o.meshes.empty()) o.meshes = default_bench_meshes();
     o.repetitions = int(args.integer("--reps", 5, 1, 1000));
     o.random_rays = std::size_t(args.integer("--rays", 1000000, 1, 100000000));
     o.camera_size = std::uint32_t(args.integer("--size", 1024, 1, 16384));
@@ -52,10 +47,7 @@ int bench_rays(int argc, char** argv) {
                      "Embree 3 was not found at build time (apt-get install libembree-dev): "
                      "only bvhkit is measured\n");
     const auto rows = bench::run_ray_bench(o, args.flag("--json") ? nullptr : stderr);
-    if (args.flag("--json"))
-        bench::print_json(stdout, rows);
-    else
-        bench::print_table(stdout, rows);
+    print_rows(rows, args.flag("--json"));
     return 0;
 }
 
@@ -84,13 +76,7 @@ int bench_nearest(int argc, char** argv) {
     }
     bench::NearestBenchOptions o;
     o.meshes = args.positional();
-    if (o.meshes.empty()) {
-        for (const char* m : {"stanford-bunny.obj", "igea.ply"}) {
-            const auto p = std::filesystem::path(BVHKIT_SHARED_DATA) / m;
-            if (std::filesystem::exists(p)) o.meshes.push_back(p.string());
-        }
-        if (o.meshes.empty()) o.meshes.push_back("sphere:subdiv=7");
-    }
+    if (o.meshes.empty()) o.meshes = default_bench_meshes();
     o.repetitions = int(args.integer("--reps", 5, 1, 1000));
     o.points = std::size_t(args.integer("--points", 100000, 1, 100000000));
     o.builder = args.value("--builder", "binned-sah");
@@ -100,10 +86,7 @@ int bench_nearest(int argc, char** argv) {
                      "CGAL was not found at build time (apt-get install libcgal-dev): only "
                      "bvhkit is measured\n");
     const auto rows = bench::run_nearest_bench(o, args.flag("--json") ? nullptr : stderr);
-    if (args.flag("--json"))
-        bench::print_json(stdout, rows);
-    else
-        bench::print_table(stdout, rows);
+    print_rows(rows, args.flag("--json"));
     return 0;
 }
 

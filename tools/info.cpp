@@ -6,6 +6,7 @@
 #include "bvhkit/query/ray_sets.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "commands.hpp"
+#include "output.hpp"
 #include "report.hpp"
 
 namespace bvhkit::tools {
@@ -67,10 +68,7 @@ int info_command(int argc, char** argv) {
         if (!bvh.skipped().empty()) row.set("skipped", (long long)bvh.skipped().size());
         rows.push_back(row);
     }
-    if (args.flag("--json"))
-        bench::print_json(stdout, rows);
-    else
-        bench::print_table(stdout, rows);
+    print_rows(rows, args.flag("--json"));
     return 0;
 }
 
