@@ -125,16 +125,17 @@ DistanceResult<typename V::Scalar> distance(
         const auto& na = na_[e.a];
         const auto& nb = nb_[e.b];
         if (na.is_leaf() && nb.is_leaf()) {
-            for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
-                if (is_degenerate(ta[sa])) continue;
-                for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
-                    if (is_degenerate(tb[sb])) continue;
-                    const Triangle<T> tri_b = transformed(tb[sb], pose_of_b_in_a);
+            // B's triangle outside: carried into A's frame once for all of A's.
+            for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
+                if (is_degenerate(tb[sb])) continue;
+                const Triangle<T> tri_b = transformed(tb[sb], pose_of_b_in_a);
+                const T rb = std::sqrt(std::max(length_squared(tri_b.p1 - tri_b.p0),
+                                                length_squared(tri_b.p2 - tri_b.p0)));
+                for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
+                    if (is_degenerate(ta[sa])) continue;
                     // Cheap rejection by the triangles' spheres about their first corners.
                     const T ra = std::sqrt(std::max(length_squared(ta[sa].p1 - ta[sa].p0),
                                                     length_squared(ta[sa].p2 - ta[sa].p0)));
-                    const T rb = std::sqrt(std::max(length_squared(tri_b.p1 - tri_b.p0),
-                                                    length_squared(tri_b.p2 - tri_b.p0)));
                     const T reach = best + ra + rb;
                     if (length_squared(ta[sa].p0 - tri_b.p0) > reach * reach) continue;
                     // Then by either triangle's plane: the other wholly at least `best` beyond
