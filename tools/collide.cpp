@@ -19,6 +19,7 @@
 #include "bvhkit/volumes/sphere.hpp"
 #include "collide_bench.hpp"
 #include "commands.hpp"
+#include "output.hpp"
 #include "pose_file.hpp"
 
 namespace bvhkit::tools {
@@ -119,13 +120,7 @@ int bench_collide_command(int argc, char** argv) {
     }
     bench::CollideBenchOptions o;
     o.meshes = args.positional();
-    if (o.meshes.empty()) {
-        for (const char* m : {"stanford-bunny.obj", "igea.ply"}) {
-            const auto p = std::filesystem::path(BVHKIT_SHARED_DATA) / m;
-            if (std::filesystem::exists(p)) o.meshes.push_back(p.string());
-        }
-        if (o.meshes.empty()) o.meshes.push_back("sphere:subdiv=6");
-    }
+    if (o.meshes.empty()) o.meshes = default_bench_meshes("sphere:subdiv=6");
     o.repetitions = int(args.integer("--reps", 3, 1, 1000));
     o.poses = std::size_t(args.integer("--poses", 1000, 1, 10000000));
     o.distance_poses = std::size_t(args.integer("--distance-poses", 0, 0, 10000000));
@@ -135,10 +130,7 @@ int bench_collide_command(int argc, char** argv) {
                      "FCL was not found at build time (apt-get install libfcl-dev): only bvhkit "
                      "is measured\n");
     const auto rows = bench::run_collide_bench(o, stderr);
-    if (args.flag("--json"))
-        bench::print_json(stdout, rows);
-    else
-        bench::print_table(stdout, rows);
+    print_rows(rows, args.flag("--json"));
     return 0;
 }
 

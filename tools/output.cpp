@@ -5,13 +5,13 @@
 
 namespace bvhkit::tools {
 
-std::vector<std::string> default_bench_meshes() {
+std::vector<std::string> default_bench_meshes(const char* fallback) {
     std::vector<std::string> meshes;
     for (const char* m : {"stanford-bunny.obj", "igea.ply"}) {
         const auto p = std::filesystem::path(BVHKIT_SHARED_DATA) / m;
         if (std::filesystem::exists(p)) meshes.push_back(p.string());
     }
-    if (meshes.empty()) meshes.push_back("sphere:subdiv=7");
+    if (meshes.empty()) meshes.push_back(fallback);
     return meshes;
 }
 

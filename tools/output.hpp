@@ -8,8 +8,8 @@
 
 namespace bvhkit::tools {
 
-/// The shared bunny and igea when ../shared/data is present, else a procedural sphere.
-std::vector<std::string> default_bench_meshes();
+/// The shared bunny and igea when ../shared/data is present, else `fallback` (a generator spec).
+std::vector<std::string> default_bench_meshes(const char* fallback = "sphere:subdiv=7");
 
 void print_rows(const std::vector<bench::Row>& rows, bool json);
 

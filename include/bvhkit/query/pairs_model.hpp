@@ -37,11 +37,11 @@ class CollisionModel {
     template <class U>
     explicit CollisionModel(const BasicTriangleMesh<U>& mesh,
                             const BuildOptions& options = collision_build_options()) {
-        check(mesh);
+        check_triangle_indices(mesh);
         std::vector<Aabb<T, 3>> boxes(mesh.triangles.size());
         std::vector<Vec<T, 3>> centroids(mesh.triangles.size());
         for (std::size_t i = 0; i < boxes.size(); ++i) {
-            boxes[i] = triangle_of(mesh, i).bounds();
+            boxes[i] = triangle_at<T>(mesh, i).bounds();
             centroids[i] = boxes[i].centroid();
         }
         const AabbBvh<T, 3> topology = build_bvh<T, 3>(boxes, centroids, options, &report_);
@@ -58,7 +58,7 @@ class CollisionModel {
             throw Error("CollisionModel::refit: the mesh has " +
                         std::to_string(mesh.triangles.size()) +
                         " triangles, the model was built over " + std::to_string(triangle_count_));
-        check(mesh);
+        check_triangle_indices(mesh);
         lay_out(mesh, bvh_.primitive_indices);
         refit_volumes(bvh_, std::span<const Triangle<T>>(slot_triangles_));
     }
@@ -78,26 +78,12 @@ class CollisionModel {
 
   private:
     template <class U>
-    static Triangle<T> triangle_of(const BasicTriangleMesh<U>& mesh, std::size_t i) {
-        const auto& t = mesh.triangles[i];
-        return {Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
-                Vec<T, 3>(mesh.vertices[t[2]])};
-    }
-    template <class U>
-    static void check(const BasicTriangleMesh<U>& mesh) {
-        for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
-            for (std::uint32_t k : mesh.triangles[i])
-                if (k >= mesh.vertices.size())
-                    throw Error("triangle " + std::to_string(i) + " names vertex " +
-                                std::to_string(k) + " of " + std::to_string(mesh.vertices.size()));
-    }
-    template <class U>
     void lay_out(const BasicTriangleMesh<U>& mesh, const std::vector<std::uint32_t>& order) {
         slot_triangles_.resize(order.size());
         slot_vertex_ids_.resize(order.size());
         Aabb<T, 3> box;
         for (std::size_t s = 0; s < order.size(); ++s) {
-            slot_triangles_[s] = triangle_of(mesh, order[s]);
+            slot_triangles_[s] = triangle_at<T>(mesh, order[s]);
             slot_vertex_ids_[s] = mesh.triangles[order[s]];
             box.grow(slot_triangles_[s].p0).grow(slot_triangles_[s].p1).grow(slot_triangles_[s].p2);
         }
