@@ -5,21 +5,15 @@
 #include <string>
 #include <string_view>
 
+#include "args.hpp"
 #include "bvhkit/error.hpp"
 #include "commands.hpp"
 #include "dynamic_bench.hpp"
+#include "output.hpp"
 
 namespace bvhkit::tools {
 
 namespace {
-
-int parse_positive(const char* option, const char* text) {
-    char* end = nullptr;
-    const long v = std::strtol(text, &end, 10);
-    if (!text[0] || *end || v <= 0 || v > 100000000)
-        throw Error(std::string(option) + ": '" + text + "' is not a positive integer");
-    return int(v);
-}
 
 void usage(std::FILE* out) {
     std::fprintf(
@@ -34,42 +28,23 @@ void usage(std::FILE* out) {
 }  // namespace
 
 int bench_dynamic_command(int argc, char** argv) {
+    const Args args(argc, argv, {"--n", "--steps", "--reps", "--only"}, {"--json"});
+    if (args.help()) {
+        usage(stdout);
+        return 0;
+    }
+    if (!args.positional().empty())
+        throw Error("unexpected argument '" + args.positional()[0] + "'");
     bench::DynamicBenchConfig c;
-    bool json = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view a = argv[i];
-        const auto value = [&]() -> const char* {
-            if (i + 1 >= argc) throw Error(std::string(a) + " needs a value");
-            return argv[++i];
-        };
-        if (a == "--help" || a == "-h") {
-            usage(stdout);
-            return 0;
-        } else if (a == "--json") {
-            json = true;
-        } else if (a == "--n") {
-            c.n = parse_positive("--n", value());
-        } else if (a == "--steps") {
-            c.steps = parse_positive("--steps", value());
-        } else if (a == "--reps") {
-            c.reps = parse_positive("--reps", value());
-        } else if (a == "--only") {
-            const std::string_view w = value();
-            c.d1 = w == "D1", c.d2 = w == "D2", c.d3 = w == "D3";
-            if (!c.d1 && !c.d2 && !c.d3)
-                throw Error("--only: '" + std::string(w) + "' is not D1, D2 or D3");
-        } else {
-            std::fprintf(stderr, "bvhkit bench dynamic: unknown option '%s'\n", argv[i]);
-            usage(stderr);
-            return 2;
-        }
+    c.n = int(args.integer("--n", c.n, 1, 100000000));
+    c.steps = int(args.integer("--steps", c.steps, 1, 100000000));
+    c.reps = int(args.integer("--reps", c.reps, 1, 100000000));
+    if (args.has("--only")) {
+        const std::string w = args.value("--only");
+        c.d1 = w == "D1", c.d2 = w == "D2", c.d3 = w == "D3";
+        if (!c.d1 && !c.d2 && !c.d3) throw Error("--only: '" + w + "' is not D1, D2 or D3");
     }
-    const auto rows = bench::run_dynamic_bench(c, stderr);
-    if (json) {
-        bench::print_json(stdout, rows);
-    } else {
-        bench::print_table(stdout, rows);
-    }
+    print_rows(bench::run_dynamic_bench(c, stderr), args.flag("--json"));
     return 0;
 }
 

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "args.hpp"
 #include "bvhkit/dynamic/dynamic_tree.hpp"
 #include "bvhkit/error.hpp"
 #include "commands.hpp"
@@ -26,14 +27,6 @@ void usage(std::FILE* out) {
         "  Builds a 2D dynamic tree and writes it as SVG (default tree.svg): internal nodes\n"
         "  coloured by depth, fat boxes dashed, proxy boxes filled. --moves moves every box\n"
         "  M times by a small random step first, so the fat boxes show.\n");
-}
-
-long parse_count(const char* option, const char* text) {
-    char* end = nullptr;
-    const long v = std::strtol(text, &end, 10);
-    if (!text[0] || *end || v < 0 || v > 10000000)
-        throw Error(std::string(option) + ": '" + text + "' is not a non-negative integer");
-    return v;
 }
 
 /// Battle City-like map on a 26 x 26 grid: brick walls in blocks, the player's base, tanks, shells.
@@ -58,45 +51,27 @@ std::vector<Aabb2f> battle_scene(std::mt19937& rng) {
 }  // namespace
 
 int draw_tree_command(int argc, char** argv) {
-    std::string out = "tree.svg", scene = "random";
-    long n = 200, moves = 0;
-    unsigned seed = 1;
-    DynamicTreeOptions<float> options;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view a = argv[i];
-        const auto value = [&]() -> const char* {
-            if (i + 1 >= argc) throw Error(std::string(a) + " needs a value");
-            return argv[++i];
-        };
-        if (a == "--help" || a == "-h") {
-            usage(stdout);
-            return 0;
-        } else if (a == "-o") {
-            out = value();
-        } else if (a == "--n") {
-            n = parse_count("--n", value());
-        } else if (a == "--seed") {
-            seed = unsigned(parse_count("--seed", value()));
-        } else if (a == "--moves") {
-            moves = parse_count("--moves", value());
-        } else if (a == "--scene") {
-            scene = value();
-            if (scene != "random" && scene != "battle")
-                throw Error("--scene: '" + scene + "' is not random or battle");
-        } else if (a == "--strategy") {
-            const std::string_view s = value();
-            if (s == "bnb")
-                options.insertion = InsertionStrategy::BranchAndBound;
-            else if (s == "greedy")
-                options.insertion = InsertionStrategy::Greedy;
-            else
-                throw Error("--strategy: '" + std::string(s) + "' is not bnb or greedy");
-        } else {
-            std::fprintf(stderr, "bvhkit draw-tree: unknown option '%s'\n", argv[i]);
-            usage(stderr);
-            return 2;
-        }
+    const Args args(argc, argv, {"-o", "--n", "--seed", "--moves", "--scene", "--strategy"}, {});
+    if (args.help()) {
+        usage(stdout);
+        return 0;
     }
+    if (!args.positional().empty())
+        throw Error("unexpected argument '" + args.positional()[0] + "'");
+    const std::string out = args.value("-o", "tree.svg"), scene = args.value("--scene", "random");
+    const long n = long(args.integer("--n", 200, 0, 10000000));
+    const long moves = long(args.integer("--moves", 0, 0, 10000000));
+    const auto seed = unsigned(args.integer("--seed", 1, 0, 4294967295LL));
+    if (scene != "random" && scene != "battle")
+        throw Error("--scene: '" + scene + "' is not random or battle");
+    DynamicTreeOptions<float> options;
+    const std::string strategy = args.value("--strategy", "bnb");
+    if (strategy == "bnb")
+        options.insertion = InsertionStrategy::BranchAndBound;
+    else if (strategy == "greedy")
+        options.insertion = InsertionStrategy::Greedy;
+    else
+        throw Error("--strategy: '" + strategy + "' is not bnb or greedy");
 
     std::mt19937 rng(seed);
     std::vector<Aabb2f> boxes;
