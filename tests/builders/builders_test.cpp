@@ -25,15 +25,6 @@ std::vector<std::pair<std::string, BuildOptions>> new_configurations() {
 }
 
 template <class T>
-std::vector<Triangle<T>> triangles_of(const TriangleMesh& mesh) {
-    std::vector<Triangle<T>> tris;
-    for (const auto& t : mesh.triangles)
-        tris.push_back({Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
-                        Vec<T, 3>(mesh.vertices[t[2]])});
-    return tris;
-}
-
-template <class T>
 void check_builders(const std::vector<Triangle<T>>& tris, std::size_t ray_count) {
     std::vector<Aabb<T, 3>> boxes;
     for (const auto& t : tris) boxes.push_back(t.bounds());
@@ -56,13 +47,13 @@ TEST(Builders, EveryNewBuilderMatchesBruteForceOnASoup) {
 }
 
 TEST(Builders, EveryNewBuilderMatchesBruteForceOnASphere) {
-    check_builders(triangles_of<float>(make_sphere(test::small_scale() ? 3 : 5)),
+    check_builders(mesh_triangles<float>(make_sphere(test::small_scale() ? 3 : 5)),
                    test::scaled(2000, 5));
 }
 
 TEST(Builders, SharedTeapot) {
     BVHKIT_REQUIRE_MESH(path, "teapot.obj");
-    check_builders(triangles_of<float>(read_mesh(path)), test::scaled(2000, 5));
+    check_builders(mesh_triangles<float>(read_mesh(path)), test::scaled(2000, 5));
 }
 
 TEST(Builders, EdgeCases) {

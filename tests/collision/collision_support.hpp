@@ -14,14 +14,6 @@
 namespace bvhkit::test {
 
 template <class T>
-std::vector<Triangle<T>> triangles_of(const BasicTriangleMesh<T>& m) {
-    std::vector<Triangle<T>> out;
-    for (const auto& t : m.triangles)
-        out.push_back({m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]});
-    return out;
-}
-
-template <class T>
 Aabb<T, 3> widened_box(const Triangle<T>& t, T pad) {
     Aabb<T, 3> b = t.bounds();
     b.min = b.min - Vec<T, 3>(pad);
@@ -73,7 +65,7 @@ PairSet brute_force_pairs(const std::vector<Triangle<T>>& a, const std::vector<T
 /// Every intersecting pair i < j of one mesh's triangles that share no vertex index.
 template <class T>
 PairSet brute_force_self(const BasicTriangleMesh<T>& m, T pad) {
-    const auto tris = triangles_of(m);
+    const auto tris = mesh_triangles(m);
     std::vector<Aabb<T, 3>> boxes(tris.size());
     for (std::size_t i = 0; i < tris.size(); ++i) boxes[i] = widened_box(tris[i], pad);
     PairSet out;

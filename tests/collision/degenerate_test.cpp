@@ -119,7 +119,7 @@ TEST(TriangleDistance, MatchesDenseSampling) {
     for (int trial = 0; trial < int(scaled(200, 10)); ++trial) {
         const auto ma = random_soup<double>(1, 0.5, rng.next());
         const auto mb = random_soup<double>(1, 0.5, rng.next());
-        const Tri a = triangles_of(ma)[0], b = triangles_of(mb)[0];
+        const Tri a = mesh_triangles(ma)[0], b = mesh_triangles(mb)[0];
         const auto d = triangle_distance(a, b);
         // Reported points are on the triangles and that far apart.
         EXPECT_LT(length(closest_point(a, d.p).point - d.p), 1e-12);
@@ -149,7 +149,7 @@ void check_identity(const TriangleMesh& m) {
     PairSet got;
     for (const auto& c : r.contacts) got.insert({c.triangle_a, c.triangle_b});
     for (std::uint32_t i = 0; i < m.triangles.size(); ++i) ASSERT_TRUE(got.count({i, i})) << i;
-    const auto tris = triangles_of(m);
+    const auto tris = mesh_triangles(m);
     EXPECT_EQ(got, brute_force_pairs(tris, tris, Transform<float>::identity(), 1e-5f));
     EXPECT_TRUE(collides(model, model, Transform<float>::identity()));
     EXPECT_EQ(distance(model, model, Transform<float>::identity()).distance, 0.0f);

@@ -43,7 +43,7 @@ template <class V>
 void check_distance(const BasicTriangleMesh<double>& ma, const BasicTriangleMesh<double>& mb,
                     const std::vector<Transform<double>>& poses, const std::vector<double>& truth) {
     const CollisionModel<V> a(ma), b(mb);
-    const auto ta = triangles_of(ma), tb = triangles_of(mb);
+    const auto ta = mesh_triangles(ma), tb = mesh_triangles(mb);
     for (std::size_t k = 0; k < poses.size(); ++k) {
         for (DescentRule rule : {DescentRule::Larger, DescentRule::A, DescentRule::Simultaneous}) {
             DistanceOptions<double> o;
@@ -69,7 +69,7 @@ void check_distance(const BasicTriangleMesh<double>& ma, const BasicTriangleMesh
 void check_all(const TriangleMesh& fa, const TriangleMesh& fb, std::size_t count,
                std::uint64_t seed) {
     const auto ma = converted<double>(fa), mb = converted<double>(fb);
-    const auto ta = triangles_of(ma), tb = triangles_of(mb);
+    const auto ta = mesh_triangles(ma), tb = mesh_triangles(mb);
     const auto poses = separated_poses(ta, tb, mb.bounds(), count, seed);
     std::vector<double> truth;
     for (const auto& p : poses) {
@@ -102,7 +102,7 @@ TEST(Distance, FloatModelsAgreeWithDoubleBruteForce) {
     BVHKIT_REQUIRE_MESH(path, "suzanne.obj");
     const auto m = read_mesh(path);
     const auto md = converted<double>(m);
-    const auto td = triangles_of(md);
+    const auto td = mesh_triangles(md);
     const CollisionModel<Obb<float>> model(m);
     const auto poses = separated_poses(td, td, md.bounds(), separated_count(5), 31);
     for (const auto& p : poses) {
@@ -136,7 +136,7 @@ void check_refit(const TriangleMesh& m) {
                         (0.05f * size);
         refitted.refit(moved);
         const CollisionModel<V> rebuilt(moved);
-        const auto tris = triangles_of(moved);
+        const auto tris = mesh_triangles(moved);
         const auto poses = random_rigid_poses(moved.bounds(), scaled(20, 4), 40 + step);
         CollideResult<float> r1, r2;
         for (const auto& p : poses) {
@@ -184,7 +184,7 @@ void check_volume_promises() {
     for (int trial = 0; trial < int(scaled(300, 10)); ++trial) {
         const auto a = random_soup<double>(1 + rng.below(6), 0.2, rng.next());
         const auto b = random_soup<double>(1 + rng.below(6), 0.2, rng.next());
-        const auto ta = triangles_of(a), tb = triangles_of(b);
+        const auto ta = mesh_triangles(a), tb = mesh_triangles(b);
         const V va = Traits::fit(ta), vb = Traits::fit(tb);
         const V one = Traits::fit(std::span<const Triangle<double>>(ta).first(1));
         ASSERT_TRUE(Traits::overlaps(va, one));
@@ -224,7 +224,7 @@ TEST(Volumes, RssContainsItsTrianglesAndMeasuresRectanglesExactly) {
     };
     for (int trial = 0; trial < int(scaled(200, 10)); ++trial) {
         const auto soup = random_soup<double>(1 + rng.below(8), 0.3, rng.next());
-        const auto tris = triangles_of(soup);
+        const auto tris = mesh_triangles(soup);
         const Rss<double> v = Traits::fit(tris);
         ASSERT_GE(v.half[0], 0.0);
         ASSERT_GE(v.half[1], 0.0);
@@ -241,7 +241,7 @@ TEST(Volumes, RssContainsItsTrianglesAndMeasuresRectanglesExactly) {
         // Against a second volume under a pose: the bound against sampled points of each edge
         // (a closest pair always has a point on an edge) and a grid over the other rectangle.
         const auto other = random_soup<double>(1 + rng.below(8), 0.3, rng.next());
-        const Rss<double> w = Traits::fit(triangles_of(other));
+        const Rss<double> w = Traits::fit(mesh_triangles(other));
         const auto pose = random_rigid_poses(Aabb3d(Vec3d(0.0), Vec3d(1.0)), 1, rng.next())[0];
         Rss<double> wp = w;  // w carried into v's frame
         wp.center = pose.apply(w.center);
@@ -282,7 +282,7 @@ TEST(Volumes, ObbFollowsTheShape) {
         m.vertices.push_back({s, s + 0.1, 0.05});
         m.triangles.push_back({n, n + 1, n + 2});
     }
-    const auto tris = triangles_of(m);
+    const auto tris = mesh_triangles(m);
     const Obb<double> o = VolumeTraits<Obb<double>>::fit(tris);
     const Aabb3d b = VolumeTraits<Aabb3d>::fit(tris);
     const Vec3d e = b.extent() * 0.5;

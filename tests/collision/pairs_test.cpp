@@ -60,7 +60,7 @@ void check_volume(const TriangleMesh& ma, const TriangleMesh& mb,
 void check_meshes(const TriangleMesh& ma, const TriangleMesh& mb, std::size_t count,
                   std::uint64_t seed) {
     const auto poses = random_rigid_poses(mb.bounds(), count, seed);
-    const auto ta = triangles_of(ma), tb = triangles_of(mb);
+    const auto ta = mesh_triangles(ma), tb = mesh_triangles(mb);
     const Aabb3f box = unite(ma.bounds(), mb.bounds());
     const float pad = 1e-5f * length(box.max - box.min);
     std::vector<PairSet> truth;

@@ -25,19 +25,10 @@ std::size_t rays_for(std::size_t triangles) {
 }
 
 template <class T>
-std::vector<Triangle<T>> triangles_of(const TriangleMesh& mesh) {
-    std::vector<Triangle<T>> out;
-    for (const auto& t : mesh.triangles)
-        out.push_back({Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
-                       Vec<T, 3>(mesh.vertices[t[2]])});
-    return out;
-}
-
-template <class T>
 void check_mesh(const std::string& name) {
     BVHKIT_REQUIRE_MESH(path, name);
     const TriangleMesh mesh = read_mesh(path);
-    const auto tris = triangles_of<T>(mesh);
+    const auto tris = mesh_triangles<T>(mesh);
     // R2-style rays (origins in the box, directions on the sphere) plus a few camera rays.
     std::vector<Ray<T, 3>> rays;
     for (const auto& r : random_rays(mesh.bounds(), rays_for(tris.size()), 42))
@@ -104,7 +95,7 @@ TEST(SharedMeshesRefit, RefitAfterDeformationMatchesBruteForce) {
         v = {x, v[1], z};
     }
     bvh.refit(mesh);
-    const auto tris = triangles_of<float>(mesh);
+    const auto tris = mesh_triangles<float>(mesh);
     std::vector<Aabb3f> boxes;
     for (const auto& t : tris) boxes.push_back(t.bounds());
     validate(bvh.bvh(), boxes);

@@ -15,15 +15,6 @@ namespace bvhkit {
 namespace {
 
 template <class T>
-std::vector<Triangle<T>> triangles_of(const TriangleMesh& mesh) {
-    std::vector<Triangle<T>> tris;
-    for (const auto& t : mesh.triangles)
-        tris.push_back({Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
-                        Vec<T, 3>(mesh.vertices[t[2]])});
-    return tris;
-}
-
-template <class T>
 T distance2(const Triangle<T>& t, const Vec<T, 3>& p) {
     return length_squared(closest_point(t, p).point - p);
 }
@@ -114,8 +105,8 @@ TEST_P(SharedMeshNearest, EqualsBruteForceFloatAndDouble) {
     const TriangleMesh mesh = read_mesh(path);
     const std::size_t large = mesh.triangles.size() > 100000;
     const std::size_t points = test::scaled(large ? 60 : 200, 10);
-    check_against_brute_force(triangles_of<float>(mesh), points, 1);
-    check_against_brute_force(triangles_of<double>(mesh), points, 2);
+    check_against_brute_force(mesh_triangles<float>(mesh), points, 1);
+    check_against_brute_force(mesh_triangles<double>(mesh), points, 2);
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, SharedMeshNearest,

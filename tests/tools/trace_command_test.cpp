@@ -40,9 +40,7 @@ class TraceCommand : public ::testing::TestWithParam<const char*> {};
 TEST_P(TraceCommand, HitsEqualBruteForceForR1AndR2Rays) {
     BVHKIT_REQUIRE_MESH(path, GetParam());
     const TriangleMesh mesh = read_mesh(path);
-    std::vector<Triangle<float>> tris;
-    for (const auto& t : mesh.triangles)
-        tris.push_back({mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]});
+    const std::vector<Triangle<float>> tris = mesh_triangles(mesh);
     // The brute force costs rays x triangles; a camera of 48 x 48 and as many random rays.
     const std::uint32_t side = test::full_scale() ? 256 : 48;
     std::vector<Ray3f> rays = camera_rays(mesh.bounds(), side, side);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <string>
+#include <type_traits>
 
 #include "bvhkit/error.hpp"
 #include "bvhkit/math/aabb.hpp"
@@ -45,6 +46,18 @@ Triangle<T> triangle_at(const BasicTriangleMesh<U>& mesh, std::size_t i) {
     const auto& t = mesh.triangles[i];
     return {Vec<T, 3>(mesh.vertices[t[0]]), Vec<T, 3>(mesh.vertices[t[1]]),
             Vec<T, 3>(mesh.vertices[t[2]])};
+}
+
+/// Every triangle of the mesh, in order, in scalar type T (the mesh's own by default); throws
+/// bvhkit::Error for an index out of range.
+template <class T = void, class U>
+auto mesh_triangles(const BasicTriangleMesh<U>& mesh) {
+    using R = std::conditional_t<std::is_void_v<T>, U, T>;
+    check_triangle_indices(mesh);
+    std::vector<Triangle<R>> out;
+    out.reserve(mesh.triangles.size());
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) out.push_back(triangle_at<R>(mesh, i));
+    return out;
 }
 
 }  // namespace bvhkit

@@ -36,11 +36,7 @@ class ClosestPointMesh {
 
     template <class U>
     explicit ClosestPointMesh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {}) {
-        check_triangle_indices(mesh);
-        std::vector<Triangle<T>> tris;
-        tris.reserve(mesh.triangles.size());
-        for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
-            tris.push_back(triangle_at<T>(mesh, i));
+        const std::vector<Triangle<T>> tris = mesh_triangles<T>(mesh);
         build(tris, options);
     }
     explicit ClosestPointMesh(const std::vector<Triangle<T>>& triangles,
