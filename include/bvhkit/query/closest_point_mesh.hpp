@@ -106,8 +106,10 @@ class ClosestPointMesh {
         for (std::uint32_t i : bvh_.primitive_indices) tris_.push_back(tris[i]);
         triangle_count_ = tris.size();
     }
-    auto distance() const {
-        return [tris = tris_.data()](std::uint32_t slot, const Vec<T, 3>& p, T bound) {
+    /// The squared distance to the triangle in a leaf slot, for nearest().
+    struct SlotDistance {
+        const Triangle<T>* tris;
+        T operator()(std::uint32_t slot, const Vec<T, 3>& p, T bound) const {
             const Triangle<T>& t = tris[slot];
             // The triangle's box is a cheap lower bound: most triangles of a leaf fail it.
             T box_d2 = 0;
@@ -119,8 +121,12 @@ class ClosestPointMesh {
             }
             if (box_d2 > bound) return box_d2;
             return length_squared(bvhkit::closest_point(t, p).point - p);
-        };
-    }
+        }
+        /// Asks for a leaf's first triangle ahead of time (nearest() calls it for leaves it will
+        /// open later).
+        void prefetch(std::uint32_t slot) const { __builtin_prefetch(tris + slot); }
+    };
+    SlotDistance distance() const { return {tris_.data()}; }
     MeshPoint<T> point_of(std::uint32_t slot, const Vec<T, 3>& p) const {
         const ClosestPoint<T> c = bvhkit::closest_point(tris_[slot], p);
         return {c.point, length_squared(c.point - p), bvh_.primitive_indices[slot], c.u, c.v};

@@ -8,6 +8,7 @@
 // walk ends when the nearest node left is. Popping a node descends straight into its nearer child
 // and only queues the farther one, which halves the heap traffic. The heap lives in a
 // NearestScratch the caller keeps (one per thread), so queries allocate nothing once it has grown.
+// A distance functor may also offer prefetch(slot), called for each leaf the walk will open.
 //
 // The primitive's distance is the caller's: `distance(slot, point, bound)` returns the squared
 // distance from `point` to the primitive in leaf slot `slot` (bvh.primitive_indices[slot] is the
@@ -91,6 +92,18 @@ void best_first(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, NearestScratch<T
             const std::uint32_t near = l + right_nearer, far = l + !right_nearer;
             const T dl = d[right_nearer], dr = d[!right_nearer];
             const T r2 = radius2();
+            // A child within the radius is likely to be opened (now or from the heap): ask for its
+            // children's line, or its leaf's first primitive, before it is needed. Queries jump
+            // around a tree far larger than the caches, so this hides a miss per node (~15%).
+            for (int c = 0; c < 2; ++c) {
+                if (d[c] > r2) continue;
+                const auto& child = nodes[l + c];
+                if (child.is_leaf()) {
+                    if constexpr (requires { on_slot.prefetch(0u); }) on_slot.prefetch(child.first);
+                } else {
+                    __builtin_prefetch(nodes + child.first);
+                }
+            }
             if (dr <= r2) {
                 heap.push_back({dr, far});
                 std::push_heap(heap.begin(), heap.end(), heap_after<T>);
@@ -112,16 +125,24 @@ NearestSlot<T> nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, Distance&
                        Stats&& stats = {}) {
     NearestSlot<T> best;
     T radius2 = max_distance_squared;
-    nearest_detail::best_first(
-        bvh, p, scratch, [&] { return radius2; },
-        [&](std::uint32_t s) {
+    struct OnSlot {
+        Distance& distance;
+        const Vec<T, N>& p;
+        NearestSlot<T>& best;
+        T& radius2;
+        void operator()(std::uint32_t s) {
             const T d2 = distance(s, p, radius2);
             if (d2 < best.distance_squared && d2 <= radius2) {
                 best = {s, d2};
                 radius2 = d2;
             }
-        },
-        stats);
+        }
+        void prefetch(std::uint32_t s) {
+            if constexpr (requires { distance.prefetch(s); }) distance.prefetch(s);
+        }
+    };
+    nearest_detail::best_first(
+        bvh, p, scratch, [&] { return radius2; }, OnSlot{distance, p, best, radius2}, stats);
     return best;
 }
 
