@@ -270,6 +270,39 @@ TEST(Volumes, RssContainsItsTrianglesAndMeasuresRectanglesExactly) {
     }
 }
 
+// The segment-rectangle distance inside the Rss bound: against a ternary search of the exact
+// point-rectangle distance along the segment (convex in s), including segments parallel to an
+// axis of the rectangle or to its plane, points, and segments through the rectangle.
+TEST(Volumes, SegmentRectangleDistanceMatchesSearch) {
+    SplitMix64 rng(17);
+    const auto point_d2 = [](const Vec3d& q, double h0, double h1) {
+        const double ex = q[0] - std::clamp(q[0], -h0, h0), ey = q[1] - std::clamp(q[1], -h1, h1);
+        return ex * ex + ey * ey + q[2] * q[2];
+    };
+    for (int trial = 0; trial < int(scaled(20000, 2000)); ++trial) {
+        const double h0 = rng.uniform(0, 2), h1 = rng.uniform(0, 2);
+        Vec3d p, d;
+        for (int a = 0; a < 3; ++a) {
+            p[a] = rng.uniform(-4, 4);
+            d[a] = rng.uniform(-6, 6);
+            if (rng.below(5) == 0) d[a] = 0;  // parallel to an axis or to the plane
+        }
+        if (rng.below(7) == 0) p[2] = 0;  // in the plane
+        const double got = detail::segment_rectangle_distance_squared(p, d, h0, h1);
+        double lo = 0, hi = 1;
+        for (int i = 0; i < 200; ++i) {
+            const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+            if (point_d2(p + d * m1, h0, h1) <= point_d2(p + d * m2, h0, h1))
+                hi = m2;
+            else
+                lo = m1;
+        }
+        const double want =
+            std::min({point_d2(p + d * lo, h0, h1), point_d2(p, h0, h1), point_d2(p + d, h0, h1)});
+        ASSERT_NEAR(got, want, 1e-9 * (1 + want)) << "trial " << trial;
+    }
+}
+
 TEST(Volumes, ObbFollowsTheShape) {
     // A long thin slab along (1, 1, 0): the covariance fit finds that axis, so the box is far
     // smaller than the AABB.

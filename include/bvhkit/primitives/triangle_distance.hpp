@@ -5,6 +5,7 @@
 // Collision Detection, 2005, 5.1.9) and 6 point-triangle distances (5.1.5, closest_point.hpp).
 // Triangles that meet (triangle_triangle.hpp's rules) are at distance 0, the points at the start
 // of their intersection segment.
+#include "bvhkit/math/select.hpp"
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/primitives/triangle_triangle.hpp"
 
@@ -22,7 +23,7 @@ SegmentClosest<T> closest_points_segments(const Vec<T, 3>& p1, const Vec<T, 3>& 
                                           const Vec<T, 3>& p2, const Vec<T, 3>& q2) {
     const Vec<T, 3> d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
     const T a = dot(d1, d1), e = dot(d2, d2), f = dot(d2, r);
-    const auto clamp01 = [](T x) { return x < T(0) ? T(0) : (x > T(1) ? T(1) : x); };
+    const auto clamp01 = [](T x) { return clamp_of(x, T(0), T(1)); };
     T s = 0, t = 0;
     if (a <= T(0) && e <= T(0)) {
         s = t = 0;

@@ -11,6 +11,7 @@
 // distance <= ra + rb", several times the cost, and collision queries prefer Obb anyway.
 #include <algorithm>
 
+#include "bvhkit/math/select.hpp"
 #include "bvhkit/volumes/obb.hpp"
 
 namespace bvhkit {
@@ -33,7 +34,8 @@ namespace detail {
 /// most four) breakpoints in order.
 template <class T>
 T segment_rectangle_distance_squared(const Vec<T, 3>& p, const Vec<T, 3>& d, T h0, T h1) {
-    const auto excess = [](T x, T h) { return x > h ? x - h : (x < -h ? x + h : T(0)); };
+    // How far x lies outside [-h, h] (signed); branch free, as the side is unpredictable.
+    const auto excess = [](T x, T h) { return x - min_of(max_of(x, -h), h); };
     const auto value = [&](T s) {
         const T ex = excess(p[0] + s * d[0], h0), ey = excess(p[1] + s * d[1], h1);
         const T z = p[2] + s * d[2];
@@ -43,21 +45,21 @@ T segment_rectangle_distance_squared(const Vec<T, 3>& p, const Vec<T, 3>& d, T h
         return excess(p[0] + s * d[0], h0) * d[0] + excess(p[1] + s * d[1], h1) * d[1] +
                (p[2] + s * d[2]) * d[2];
     };
-    // Breakpoints strictly inside (0, 1), then the segment's end.
-    T cut[5];
-    int n = 0;
-    for (int axis = 0; axis < 2; ++axis) {
-        const T h = axis == 0 ? h0 : h1;
-        if (d[axis] == T(0)) continue;
-        for (const T edge : {-h, h}) {
-            const T s = (edge - p[axis]) / d[axis];
-            if (!(s > T(0) && s < T(1))) continue;
-            int k = n++;  // insertion keeps them in order (at most four)
-            for (; k > 0 && cut[k - 1] > s; --k) cut[k] = cut[k - 1];
-            cut[k] = s;
-        }
-    }
-    cut[n++] = T(1);
+    // The breakpoints, where x crosses -h0, h0 and y crosses -h1, h1, clamped to [0, 1] (both at 0
+    // when the segment runs parallel; pieces of zero length do no harm), sorted without
+    // branches, then the segment's end.
+    const auto crossings = [](T pa, T da, T h, T& lo, T& hi) {
+        const T inv = da != T(0) ? T(1) / da : T(0);
+        const T a = (-h - pa) * inv, b = (h - pa) * inv;
+        lo = min_of(max_of(min_of(a, b), T(0)), T(1));
+        hi = min_of(max_of(max_of(a, b), T(0)), T(1));
+    };
+    T xl, xh, yl, yh;
+    crossings(p[0], d[0], h0, xl, xh);
+    crossings(p[1], d[1], h1, yl, yh);
+    const T m0 = max_of(xl, yl), m1 = min_of(xh, yh);
+    const T cut[5] = {min_of(xl, yl), min_of(m0, m1), max_of(m0, m1), max_of(xh, yh), T(1)};
+    const int n = 5;
     T lo = 0;
     if (slope(lo) >= T(0)) return value(lo);
     for (int k = 0; k < n; ++k) {
@@ -67,7 +69,7 @@ T segment_rectangle_distance_squared(const Vec<T, 3>& p, const Vec<T, 3>& d, T h
             // The slope is linear on [lo, hi]: its root.
             const T g_lo = slope(lo);
             const T s = g_hi > g_lo ? lo + (hi - lo) * (-g_lo / (g_hi - g_lo)) : lo;
-            return value(std::clamp(s, lo, hi));
+            return value(clamp_of(s, lo, hi));
         }
         lo = hi;
     }
@@ -92,10 +94,9 @@ template <class T>
 T rectangles_distance(const Mat3<T>& c, const Vec<T, 3>& t, const T ha[2], const T hb[2],
                       T limit = std::numeric_limits<T>::infinity()) {
     T best = limit * limit;
+    // The gap between [x0, x1] (either order) and [-h, h], branch free.
     const auto gap = [](T x0, T x1, T h) {
-        if (x0 > h && x1 > h) return std::min(x0, x1) - h;
-        if (x0 < -h && x1 < -h) return -h - std::max(x0, x1);
-        return T(0);
+        return max_of(max_of(min_of(x0, x1) - h, -h - max_of(x0, x1)), T(0));
     };
     // A's corners in B's frame (x_B = Cᵀ (x_A - t); rows of c are A's axes there), first: they
     // settle facing rectangles at once, and their edges' crossings tell whether the two meet.
@@ -104,8 +105,12 @@ T rectangles_distance(const Mat3<T>& c, const Vec<T, 3>& t, const T ha[2], const
     const Vec<T, 3> corners[4] = {tb - da - db, tb + da - db, tb + da + db, tb - da + db};
     for (int k = 0; k < 4; ++k) {
         const Vec<T, 3>& p = corners[k];
-        const bool over = std::fabs(p[0]) <= hb[0] && std::fabs(p[1]) <= hb[1];
-        if (over) best = std::min(best, p[2] * p[2]);
+        // The corner's distance to B (its height when it lies over B's face): a distance
+        // between points of the two rectangles, so an upper bound of theirs, exact when the
+        // rectangles face each other.
+        const T ex = p[0] - clamp_of(p[0], -hb[0], hb[0]),
+                ey = p[1] - clamp_of(p[1], -hb[1], hb[1]);
+        best = min_of(best, ex * ex + ey * ey + p[2] * p[2]);
         const Vec<T, 3>& q = corners[(k + 1) % 4];
         if ((p[2] > T(0)) != (q[2] > T(0)) && p[2] != q[2]) {
             const T s = p[2] / (p[2] - q[2]);  // where the edge meets B's plane
@@ -122,14 +127,15 @@ T rectangles_distance(const Mat3<T>& c, const Vec<T, 3>& t, const T ha[2], const
         const Vec<T, 3> dir = along * (T(2) * h_along);
         const Vec<T, 3> base = t - along * h_along;
         const Vec<T, 3> offset = across * h_across;
-        const bool facing_minus = dot(t, across) > T(0);
+        // The edge on the side facing A's centre first (a sign, not a branch).
+        const Vec<T, 3> facing = offset * std::copysign(T(1), -dot(t, across));
         for (int pass = 0; pass < 2; ++pass) {
-            const Vec<T, 3> start = (pass == 0) == facing_minus ? base - offset : base + offset;
+            const Vec<T, 3> start = pass == 0 ? base + facing : base - facing;
             const Vec<T, 3> end = start + dir;
             const T gx = gap(start[0], end[0], ha[0]), gy = gap(start[1], end[1], ha[1]);
             const T gz = gap(start[2], end[2], T(0));
             if (gx * gx + gy * gy + gz * gz >= best) continue;
-            best = std::min(best, segment_rectangle_distance_squared(start, dir, ha[0], ha[1]));
+            best = min_of(best, segment_rectangle_distance_squared(start, dir, ha[0], ha[1]));
         }
     }
     return std::sqrt(best);
