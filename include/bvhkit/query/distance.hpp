@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bvhkit/primitives/triangle_distance.hpp"
+#include "bvhkit/query/min_heap.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 
 namespace bvhkit {
@@ -106,20 +107,15 @@ DistanceResult<typename V::Scalar> distance(
     // below the answer; depth first with near-first children opened about twice as many on the
     // C2 workload, refining near pairs before a good best was known. The heap lives on for the
     // thread's next query, so a query allocates only when it needs more room than any before.
-    thread_local std::vector<Entry> heap;
-    heap.clear();
-    const auto later = [](const Entry& x, const Entry& y) { return x.bound > y.bound; };
+    thread_local std::vector<Entry> heap_storage;
+    MinHeap4 heap(heap_storage, [](const Entry& x) { return x.bound; });
     // `next`: a child that is already the least pending pair goes on without a trip through
     // the heap (the usual case while refining toward a leaf).
     Entry next{0, 0, bound(0, 0)};
     bool have_next = true;
     while (have_next || !heap.empty()) {
         Entry e = next;
-        if (!have_next) {
-            std::pop_heap(heap.begin(), heap.end(), later);
-            e = heap.back();
-            heap.pop_back();
-        }
+        if (!have_next) e = heap.pop();
         have_next = false;
         if (hopeless(e.bound)) break;  // and so is every pair still waiting
         const auto& na = na_[e.a];
@@ -194,12 +190,11 @@ DistanceResult<typename V::Scalar> distance(
                 least = k;
         for (int k = 0; k < n; ++k) {
             if (hopeless(kids[k].bound)) continue;
-            if (k == least && (heap.empty() || kids[k].bound <= heap.front().bound)) {
+            if (k == least && (heap.empty() || kids[k].bound <= heap.top().bound)) {
                 next = kids[k];
                 have_next = true;
             } else {
-                heap.push_back(kids[k]);
-                std::push_heap(heap.begin(), heap.end(), later);
+                heap.push(kids[k]);
             }
         }
     }

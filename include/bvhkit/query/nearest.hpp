@@ -21,6 +21,7 @@
 
 #include "bvhkit/bvh/sibling_pair.hpp"
 #include "bvhkit/primitives/hit.hpp"
+#include "bvhkit/query/min_heap.hpp"
 #include "bvhkit/query/stats.hpp"
 
 namespace bvhkit {
@@ -50,11 +51,6 @@ struct NearestSlot {
 
 namespace nearest_detail {
 
-template <class T>
-inline bool heap_after(const NearestEntry<T>& a, const NearestEntry<T>& b) {
-    return a.distance_squared > b.distance_squared;  // std heaps are max-heaps: invert
-}
-
 /// The best-first walk. `radius2()` is the current squared search radius (it shrinks as
 /// on_slot(slot, d2) finds closer primitives).
 template <class T, std::size_t N, class Radius, class OnSlot, class Stats>
@@ -62,16 +58,13 @@ void best_first(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, NearestScratch<T
                 Radius&& radius2, OnSlot&& on_slot, Stats&& stats) {
     if (bvh.empty()) return;
     const auto* nodes = bvh.nodes.data();
-    auto& heap = scratch.heap;
-    heap.clear();
+    MinHeap4 heap(scratch.heap, [](const NearestEntry<T>& e) { return e.distance_squared; });
     stats.node();
     const T root_d2 = nodes[0].bounds.distance_squared(p);
     if (root_d2 > radius2()) return;
-    heap.push_back({root_d2, 0});
+    heap.push({root_d2, 0});
     while (!heap.empty()) {
-        std::pop_heap(heap.begin(), heap.end(), heap_after<T>);
-        const NearestEntry<T> e = heap.back();
-        heap.pop_back();
+        const NearestEntry<T> e = heap.pop();
         if (e.distance_squared > radius2()) break;  // every node left is farther still
         std::uint32_t current = e.node;
         while (true) {
@@ -105,8 +98,7 @@ void best_first(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, NearestScratch<T
                 }
             }
             if (dr <= r2) {
-                heap.push_back({dr, far});
-                std::push_heap(heap.begin(), heap.end(), heap_after<T>);
+                heap.push({dr, far});
             }
             if (dl > r2) break;
             current = near;
