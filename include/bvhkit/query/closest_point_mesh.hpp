@@ -12,6 +12,7 @@
 
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/parallel.hpp"
+#include "bvhkit/math/select.hpp"
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/nearest.hpp"
@@ -114,10 +115,10 @@ class ClosestPointMesh {
             // The triangle's box is a cheap lower bound: most triangles of a leaf fail it.
             T box_d2 = 0;
             for (std::size_t a = 0; a < 3; ++a) {
-                const T lo = std::min(t.p0[a], std::min(t.p1[a], t.p2[a]));
-                const T hi = std::max(t.p0[a], std::max(t.p1[a], t.p2[a]));
-                const T g = std::max(lo - p[a], p[a] - hi);
-                if (g > T(0)) box_d2 += g * g;
+                const T lo = min_of(t.p0[a], min_of(t.p1[a], t.p2[a]));
+                const T hi = max_of(t.p0[a], max_of(t.p1[a], t.p2[a]));
+                const T g = max_of(max_of(lo - p[a], p[a] - hi), T(0));
+                box_d2 += g * g;
             }
             if (box_d2 > bound) return box_d2;
             return length_squared(bvhkit::closest_point(t, p).point - p);
