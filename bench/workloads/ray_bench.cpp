@@ -29,7 +29,8 @@ struct Workload {
 
 std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progress) {
     std::vector<Row> rows;
-    const BuildOptions build_options = parse_builder(options.builder);
+    BuildOptions build_options = parse_builder(options.builder);
+    build_options.threads = 1;  // single thread, as Embree is run here (issue 2's comparison)
     for (const std::string& arg : options.meshes) {
         const TriangleMesh mesh = load_mesh(arg);
         const std::string name = mesh_name(arg);
