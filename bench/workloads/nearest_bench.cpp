@@ -148,7 +148,7 @@ std::vector<Row> run_nearest_bench(const NearestBenchOptions& o, std::FILE* prog
                 Aabb3f::of_points(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]));
             centroids.push_back(boxes.back().centroid());
         }
-        for (const char* b : {"bottom-up", "lbvh"}) {
+        for (const char* b : {"binned-sah", "bottom-up", "lbvh"}) {
             BuildOptions b1 = parse_builder(b), ball = b1;
             b1.threads = 1;
             ball.threads = 0;

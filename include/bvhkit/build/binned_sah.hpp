@@ -5,6 +5,10 @@
 // smaller nodes get fewer bins (4 + n / 20, up to bin_count): the sweep over bins is a per-node
 // cost that would otherwise dominate the many small nodes. A node no larger than 8 primitives goes
 // to the full sweep instead, which is exact and, that small, cheaper.
+//
+// A large node (parallel_binning_from primitives) bins in chunks on several threads when the rule's
+// options allow (threads != 1), each chunk into its own bins, merged afterwards (Wald 2007, section
+// 4); box unions and counts are exact in any order, so the split is the same as binned serially.
 #include "bvhkit/build/sweep_sah.hpp"
 
 namespace bvhkit {
@@ -13,11 +17,14 @@ template <class T, std::size_t N>
 class BinnedSahRule {
   public:
     static constexpr std::uint32_t sweep_below = 8;
+    static constexpr std::size_t parallel_binning_from = 1u << 15;
+    static constexpr std::size_t binning_chunk = 8192;
 
     BinnedSahRule(const BuildInput<T, N>& in, const BuildOptions& options)
         : in_(in),
           costs_(options.costs),
           max_bins_(std::clamp<std::uint32_t>(options.bin_count, 2, 256)),
+          threads_(options.threads),
           bins_(N * max_bins_),
           right_area_(max_bins_),
           small_nodes_(in, options) {}
@@ -32,16 +39,23 @@ class BinnedSahRule {
             const T extent = cb.max[a] - cb.min[a];
             scale[a] = extent > T(0) ? T(bin_count) / extent : T(0);
         }
-        for (std::size_t i = 0; i < N * bin_count; ++i) bins_[i] = Bin{};
         const BinMapping mapping(cb.min, scale, bin_count);
-        for (std::uint32_t i : task.indices) {
-            std::uint32_t bin[N];
-            mapping.bins(in_.centroids[i], bin);
-            for (std::size_t a = 0; a < N; ++a) {
-                Bin& b = bins_[a * bin_count + bin[a]];
-                b.bounds.grow(in_.boxes[i]);
-                ++b.count;
-            }
+        const std::size_t row = N * bin_count;
+        if (threads_ != 1 && have_parallel() && count >= parallel_binning_from) {
+            const std::size_t chunks = (count + binning_chunk - 1) / binning_chunk;
+            if (chunk_bins_.size() < chunks * row) chunk_bins_.resize(chunks * row);
+            parallel_for(count, binning_chunk, threads_, [&](std::size_t b, std::size_t e) {
+                bin_range(task.indices.subspan(b, e - b), mapping,
+                          &chunk_bins_[b / binning_chunk * row]);
+            });
+            std::fill_n(bins_.begin(), row, Bin{});
+            for (std::size_t c = 0; c < chunks; ++c)
+                for (std::size_t k = 0; k < row; ++k) {
+                    bins_[k].bounds.grow(chunk_bins_[c * row + k].bounds);
+                    bins_[k].count += chunk_bins_[c * row + k].count;
+                }
+        } else {
+            bin_range(task.indices, mapping, bins_.data());
         }
 
         T best_cost = std::numeric_limits<T>::infinity();
@@ -119,10 +133,29 @@ class BinnedSahRule {
         BoxAccumulator<T, N> bounds;
         std::uint32_t count = 0;
     };
+
+    /// Resets the N rows of `mapping.count` bins at `out` and bins the primitives of `indices`.
+    void bin_range(std::span<const std::uint32_t> indices, const BinMapping& mapping,
+                   Bin* out) const {
+        const std::uint32_t bin_count = mapping.count;
+        std::fill_n(out, N * bin_count, Bin{});
+        for (std::uint32_t i : indices) {
+            std::uint32_t bin[N];
+            mapping.bins(in_.centroids[i], bin);
+            for (std::size_t a = 0; a < N; ++a) {
+                Bin& b = out[a * bin_count + bin[a]];
+                b.bounds.grow(in_.boxes[i]);
+                ++b.count;
+            }
+        }
+    }
+
     BuildInput<T, N> in_;
     SahCosts costs_;
     std::uint32_t max_bins_;
-    std::vector<Bin> bins_;  // N rows of bins, reused for every node
+    unsigned threads_;
+    std::vector<Bin> bins_;        // N rows of bins, reused for every node
+    std::vector<Bin> chunk_bins_;  // N rows per chunk of a node binned in parallel
     std::vector<T> right_area_;
     SweepSahRule<T, N> small_nodes_;
 };

@@ -50,8 +50,10 @@ struct BuildOptions {
     /// Run the reinsertion optimizer (Bittner et al. 2013, build/reinsertion.hpp) after the build;
     /// it keeps the built tree when it finds no cheaper one.
     bool optimize = false;
-    /// Threads for the builders that run in parallel (bottom-up, LBVH) when bvhkit was built with
-    /// oneTBB: 0 = all, 1 = serial. The tree is the same for every value.
+    /// Threads for the builders when bvhkit was built with oneTBB: the top-down ones (binned and
+    /// sweep SAH, the classic rules) split large nodes and whole subtrees in parallel, bottom-up
+    /// and LBVH run their passes in parallel; insertion and the optimizer are serial. 0 = all,
+    /// 1 = serial, k = at most k. The tree is the same, bit for bit, for every value.
     unsigned threads = 0;
     std::uint32_t ploc_radius = 16;  // bottom-up: neighbours searched on each side
 };

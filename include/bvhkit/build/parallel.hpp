@@ -1,18 +1,21 @@
 #pragma once
-// The one place bvhkit touches threads: parallel_for over fixed chunks, on oneTBB when the library
-// was built with it (BVHKIT_HAVE_TBB), else a plain loop. Chunks have a fixed size and each index
-// is handled by exactly one call, so code that writes only its own indices gives the same result
-// with any number of threads: that is the rule every parallel path here follows (and the tests
-// check it against threads = 1).
+// The one place bvhkit touches threads: parallel_for over fixed chunks, parallel_invoke of two
+// calls, and with_threads (a task arena), on oneTBB when the library was built with it
+// (BVHKIT_HAVE_TBB), else plain serial code. Chunks have a fixed size and each index is handled by
+// exactly one call, so code that writes only its own indices gives the same result with any number
+// of threads: that is the rule every parallel path here follows (and the tests check it against
+// threads = 1).
 //
-// `threads`: 0 uses every core TBB offers, 1 runs serially on the calling thread, k limits TBB to
-// k threads (a task arena).
+// `threads`: 0 uses every core TBB offers (or, inside with_threads, the arena's), 1 runs serially
+// on the calling thread, k limits TBB to k threads (a task arena). Code already inside with_threads
+// passes 0, so nested calls stay in that arena instead of making one each.
 #include <algorithm>
 #include <cstddef>
 
 #if defined(BVHKIT_HAVE_TBB)
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 #endif
@@ -58,6 +61,38 @@ void parallel_for(std::size_t count, std::size_t grain, unsigned threads, Body&&
     (void)threads;
 #endif
     for (std::size_t b = 0; b < count; b += grain) body(b, std::min(count, b + grain));
+}
+
+/// Calls f() in a task arena of `threads` threads when threads > 1, else directly. Inside, pass
+/// threads = 0 to parallel_for and parallel_invoke: they then run in this arena, at most `threads`
+/// wide, without making an arena per call.
+template <class F>
+void with_threads(unsigned threads, F&& f) {
+#if defined(BVHKIT_HAVE_TBB)
+    if (threads > 1) {
+        tbb::task_arena arena(static_cast<int>(threads));
+        arena.execute(f);
+        return;
+    }
+#else
+    (void)threads;
+#endif
+    f();
+}
+
+/// Calls f() and g(), possibly at the same time (threads != 1, with oneTBB), else f() then g().
+template <class F, class G>
+void parallel_invoke(unsigned threads, F&& f, G&& g) {
+#if defined(BVHKIT_HAVE_TBB)
+    if (threads != 1) {
+        with_threads(threads, [&] { tbb::parallel_invoke(f, g); });
+        return;
+    }
+#else
+    (void)threads;
+#endif
+    f();
+    g();
 }
 
 }  // namespace bvhkit

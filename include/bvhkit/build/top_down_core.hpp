@@ -1,18 +1,28 @@
 #pragma once
 // The partition core every top-down builder shares. A builder only says how to split one node (a
 // SplitRule); this driver does the rest: it drops non-finite primitives, keeps the work stack,
-// computes node bounds, partitions the primitive indices in place, enforces the halting rules, and
-// falls back to a median split when a rule's split would leave one side empty, so no input makes it
+// computes node bounds, partitions the primitive indices, enforces the halting rules, and falls
+// back to a median split when a rule's split would leave one side empty, so no input makes it
 // recurse forever.
 //
 // Halting: a node becomes a leaf when it holds one primitive, when it reaches max_depth, or when
 // the rule asks for a leaf and it holds no more than max_leaf_size primitives.
+//
+// Threads (BuildOptions::threads != 1, with oneTBB): the nodes above a size cutoff are split one
+// task each, both children of a node at the same time, and the largest of them bin and partition in
+// parallel chunks too (Wald 2007, section 4, splits the top levels the same way); every node below
+// the cutoff becomes a subtree built by the serial driver into its own node array, and a last pass
+// lays those out exactly where the serial driver puts them. Every decision depends on a node's
+// primitives and size only, never on the thread count, so the tree is the same bit for bit.
 #include <algorithm>
+#include <memory>
+#include <numeric>
 #include <span>
 #include <string>
 
 #include "bvhkit/build/box_accumulator.hpp"
 #include "bvhkit/build/options.hpp"
+#include "bvhkit/build/parallel.hpp"
 #include "bvhkit/error.hpp"
 
 namespace bvhkit {
@@ -65,20 +75,49 @@ inline std::uint32_t bin_of(T c, T origin, T scale, std::uint32_t bin_count) {
     return b <= T(0) ? 0u : std::min(bin_count - 1, static_cast<std::uint32_t>(b));
 }
 
+namespace top_down_detail {
+/// Primitives per chunk of the parallel passes over a range. Fixed, so what a chunk computes never
+/// depends on the thread count.
+inline constexpr std::size_t chunk = 8192;
+/// Ranges at least this long are partitioned stably through a scratch buffer (in parallel chunks
+/// when threads allow), shorter ones in place. The choice depends on the size alone, so the order
+/// of primitive_indices is the same with any number of threads.
+inline constexpr std::size_t stable_partition_from = 4 * chunk;
+}  // namespace top_down_detail
+
 /// The builders' rule for bad input: a primitive whose box is non-finite or empty is left out (or
 /// rejected, per options); validate() checks the same rule. A centroid that is not finite (or lies
 /// outside its box) is replaced by the box's centre, so the centroid never decides.
 template <class T, std::size_t N>
 std::vector<std::uint32_t> usable_primitives(BuildInput<T, N>& in, std::vector<Vec<T, N>>& fixed,
                                              const BuildOptions& options, BuildReport* report) {
+    using top_down_detail::chunk;
     if (in.boxes.size() != in.centroids.size())
         throw Error("build: " + std::to_string(in.boxes.size()) + " boxes but " +
                     std::to_string(in.centroids.size()) + " centroids");
     if (in.boxes.size() >= std::size_t(0xFFFFFFFFu))
         throw Error("build: " + std::to_string(in.boxes.size()) + " primitives; at most 2^32 - 2");
     std::vector<std::uint32_t> indices;
-    indices.reserve(in.boxes.size());
-    for (std::uint32_t i = 0; i < in.boxes.size(); ++i) {
+    const std::size_t n = in.boxes.size();
+    if (options.threads != 1 && have_parallel() && n >= 4 * chunk) {
+        // The usual case, every primitive usable as it is, checked in parallel: then the indices
+        // are 0..n-1. Anything else takes the serial loop below, which says what to skip or fix.
+        indices.resize(n);
+        std::vector<char> clean((n + chunk - 1) / chunk);
+        parallel_for(n, chunk, options.threads, [&](std::size_t b, std::size_t e) {
+            bool ok = true;
+            for (std::size_t i = b; i < e; ++i) {
+                const Aabb<T, N>& box = in.boxes[i];
+                ok &= box.is_finite() && !box.is_empty() && box.contains(in.centroids[i]);
+                indices[i] = static_cast<std::uint32_t>(i);
+            }
+            clean[b / chunk] = ok;
+        });
+        if (std::find(clean.begin(), clean.end(), char(0)) == clean.end()) return indices;
+        indices.clear();
+    }
+    indices.reserve(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
         if (in.boxes[i].is_finite() && !in.boxes[i].is_empty()) {
             indices.push_back(i);
             if (!in.boxes[i].contains(in.centroids[i])) {
@@ -101,36 +140,117 @@ std::vector<std::uint32_t> usable_primitives(BuildInput<T, N>& in, std::vector<V
 template <class T, std::size_t N>
 struct RangeBounds {
     BoxAccumulator<T, N> boxes, centroids;
-    void add(const BuildInput<T, N>& in, std::uint32_t i) {
+    // Forced inline: GCC otherwise calls it out of line from the partition loops (+10% build).
+    [[gnu::always_inline]] void add(const BuildInput<T, N>& in, std::uint32_t i) {
         boxes.grow(in.boxes[i]);
         centroids.grow_point(in.centroids[i]);
     }
+    void add(const RangeBounds& o) {
+        boxes.grow(o.boxes);
+        centroids.grow(o.centroids);
+    }
 };
 
-/// Reorders `range` so the primitives going left come first, gathering both sides' bounds on the
-/// way (each primitive is classified and grown exactly once); returns how many go left.
+/// Bounds of the primitives of `range`, in parallel chunks for long ranges (min and max are exact
+/// in any order, so the result does not depend on the chunks).
 template <class T, std::size_t N>
-std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
-                                   const Split<T>& s, RangeBounds<T, N>& left,
-                                   RangeBounds<T, N>& right) {
-    using Kind = typename Split<T>::Kind;
-    const auto& c = in.centroids;
-    const std::uint32_t a = s.axis;
-    if (s.kind == Kind::Leaf) return 0;
-    if (s.kind == Kind::AtCount) {
-        const auto k =
-            static_cast<std::uint32_t>(std::min<std::size_t>(s.left_count, range.size()));
-        std::nth_element(range.begin(), range.begin() + k, range.end(),
-                         [&](std::uint32_t i, std::uint32_t j) {
-                             return c[i][a] < c[j][a] || (c[i][a] == c[j][a] && i < j);
-                         });
-        for (std::uint32_t i = 0; i < range.size(); ++i) (i < k ? left : right).add(in, range[i]);
-        return k;
+RangeBounds<T, N> range_bounds(const BuildInput<T, N>& in, std::span<const std::uint32_t> range,
+                               unsigned threads) {
+    using top_down_detail::chunk;
+    RangeBounds<T, N> all;
+    if (threads == 1 || !have_parallel() || range.size() < 4 * chunk) {
+        for (std::uint32_t i : range) all.add(in, i);
+        return all;
     }
-    const auto goes_left = [&](std::uint32_t i) {
-        if (s.kind == Kind::AtPosition) return c[i][a] < s.position;
-        return bin_of(c[i][a], s.bin_origin, s.bin_scale, s.bin_count) <= s.bin;
+    std::vector<RangeBounds<T, N>> part((range.size() + chunk - 1) / chunk);
+    parallel_for(range.size(), chunk, threads, [&](std::size_t b, std::size_t e) {
+        RangeBounds<T, N>& p = part[b / chunk];
+        for (std::size_t k = b; k < e; ++k) p.add(in, range[k]);
+    });
+    for (const RangeBounds<T, N>& p : part) all.add(p);
+    return all;
+}
+
+namespace top_down_detail {
+
+/// Stable partition of `range` through `scratch` (as long): the primitives going left keep their
+/// order and come first, then the others in their order. The result is unique, so the serial pass
+/// and the parallel chunks (each classifies its part into scratch, then copies it to its place)
+/// give the same order.
+template <class T, std::size_t N, class GoesLeft>
+std::uint32_t stable_partition(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
+                               std::span<std::uint32_t> scratch, const GoesLeft& goes_left,
+                               unsigned threads, RangeBounds<T, N>& left,
+                               RangeBounds<T, N>& right) {
+    const std::size_t n = range.size();
+    std::uint32_t* const out = range.data();
+    std::uint32_t* const tmp = scratch.data();
+    if (threads == 1 || !have_parallel()) {
+        // Left ones move down in place (the write never passes the read), right ones to scratch.
+        std::size_t l = 0, r = 0;
+        for (std::size_t k = 0; k < n; ++k) {
+            const std::uint32_t i = out[k];
+            if (goes_left(i)) {
+                out[l++] = i;
+                left.add(in, i);
+            } else {
+                tmp[r++] = i;
+                right.add(in, i);
+            }
+        }
+        std::copy_n(tmp, r, out + l);
+        return static_cast<std::uint32_t>(l);
+    }
+    struct Part {
+        RangeBounds<T, N> left, right;
+        std::size_t left_count = 0, left_at = 0, right_at = 0;
     };
+    std::vector<Part> parts((n + chunk - 1) / chunk);  // one allocation per large node only
+    // A chunk's left primitives go to its part of scratch from the front, the right ones from
+    // the back (so reversed).
+    parallel_for(n, chunk, threads, [&](std::size_t b, std::size_t e) {
+        Part& p = parts[b / chunk];
+        std::size_t l = b, r = e;
+        for (std::size_t k = b; k < e; ++k) {
+            const std::uint32_t i = out[k];
+            if (goes_left(i)) {
+                tmp[l++] = i;
+                p.left.add(in, i);
+            } else {
+                tmp[--r] = i;
+                p.right.add(in, i);
+            }
+        }
+        p.left_count = l - b;
+    });
+    std::size_t left_total = 0;
+    for (Part& p : parts) p.left_at = left_total, left_total += p.left_count;
+    std::size_t right_total = left_total;
+    for (std::size_t c = 0; c < parts.size(); ++c) {
+        parts[c].right_at = right_total;
+        right_total += std::min(n, (c + 1) * chunk) - c * chunk - parts[c].left_count;
+    }
+    parallel_for(n, chunk, threads, [&](std::size_t b, std::size_t e) {
+        const Part& p = parts[b / chunk];
+        std::copy_n(tmp + b, p.left_count, out + p.left_at);
+        std::reverse_copy(tmp + b + p.left_count, tmp + e, out + p.right_at);
+    });
+    for (const Part& p : parts) {
+        left.add(p.left);
+        right.add(p.right);
+    }
+    return static_cast<std::uint32_t>(left_total);
+}
+
+}  // namespace top_down_detail
+
+namespace top_down_detail {
+
+/// Hoare's partition of `range` by `goes_left`, in place.
+template <class T, std::size_t N, class GoesLeft>
+std::uint32_t partition_in_place(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
+                                 const GoesLeft& goes_left, RangeBounds<T, N>& left,
+                                 RangeBounds<T, N>& right) {
     std::uint32_t* first = range.data();
     std::uint32_t* last = range.data() + range.size();
     while (first < last) {
@@ -144,69 +264,273 @@ std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::ui
     return static_cast<std::uint32_t>(first - range.data());
 }
 
-/// Builds over `indices` (from usable_primitives) with `rule` deciding each split.
-template <class T, std::size_t N, class SplitRule>
-Bvh<Aabb<T, N>> build_top_down(const BuildInput<T, N>& in, std::vector<std::uint32_t> indices,
-                               const BuildOptions& options, SplitRule& rule) {
-    Bvh<Aabb<T, N>> bvh;
-    bvh.primitive_indices = std::move(indices);
-    std::vector<std::uint32_t>& idx = bvh.primitive_indices;
-    if (idx.empty()) return bvh;
+/// Partitions `range` by `goes_left`: stably through scratch when it is long, else in place.
+template <class T, std::size_t N, class GoesLeft>
+std::uint32_t partition_by(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
+                           std::span<std::uint32_t> scratch, unsigned threads,
+                           const GoesLeft& goes_left, RangeBounds<T, N>& left,
+                           RangeBounds<T, N>& right) {
+    if (range.size() >= stable_partition_from && scratch.size() >= range.size())
+        return stable_partition(in, range, scratch, goes_left, threads, left, right);
+    return partition_in_place(in, range, goes_left, left, right);
+}
 
-    const std::uint32_t max_depth = std::min(options.max_depth, max_bvh_depth);
-    const std::uint32_t max_leaf = std::max<std::uint32_t>(1, options.max_leaf_size);
-    bvh.nodes.reserve(2 * idx.size() - 1);
-    bvh.nodes.emplace_back();
+}  // namespace top_down_detail
 
-    struct Work {
-        std::uint32_t node, begin, end, depth;
-        RangeBounds<T, N> bounds;  // of the range's boxes and centroids, gathered by the parent
-    };
-    Work root{0, 0, static_cast<std::uint32_t>(idx.size()), 0, {}};
-    for (std::uint32_t i : idx) root.bounds.add(in, i);
-    std::vector<Work> stack{root};
-    while (!stack.empty()) {
-        const Work w = stack.back();
-        stack.pop_back();
-        const Aabb<T, N> bounds = w.bounds.boxes.box();
-        const Aabb<T, N> centroid_bounds = w.bounds.centroids.box();
-        bvh.nodes[w.node].bounds = bounds;
-        const std::uint32_t count = w.end - w.begin;
-        auto make_leaf = [&] {
-            bvh.nodes[w.node].first = w.begin;
-            bvh.nodes[w.node].count = count;
-        };
-        if (count == 1 || w.depth >= max_depth) {
-            make_leaf();
-            continue;
+/// Reorders `range` so the primitives going left come first, gathering both sides' bounds on the
+/// way (each primitive is classified and grown exactly once); returns how many go left. A range of
+/// at least stable_partition_from primitives is partitioned stably through `scratch` (as long as
+/// the range; the drivers always pass it), on `threads`; a shorter one in place.
+template <class T, std::size_t N>
+std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
+                                   const Split<T>& s, RangeBounds<T, N>& left,
+                                   RangeBounds<T, N>& right, std::span<std::uint32_t> scratch = {},
+                                   unsigned threads = 1) {
+    using Kind = typename Split<T>::Kind;
+    const auto& c = in.centroids;
+    const std::uint32_t a = s.axis;
+    switch (s.kind) {
+        case Kind::Leaf:
+            return 0;
+        case Kind::AtCount: {
+            const auto k =
+                static_cast<std::uint32_t>(std::min<std::size_t>(s.left_count, range.size()));
+            std::nth_element(range.begin(), range.begin() + k, range.end(),
+                             [&](std::uint32_t i, std::uint32_t j) {
+                                 return c[i][a] < c[j][a] || (c[i][a] == c[j][a] && i < j);
+                             });
+            if (range.size() >= top_down_detail::stable_partition_from) {
+                left = range_bounds(in, std::span<const std::uint32_t>(range.first(k)), threads);
+                right = range_bounds(in, std::span<const std::uint32_t>(range.subspan(k)), threads);
+            } else {
+                for (std::uint32_t i = 0; i < range.size(); ++i)
+                    (i < k ? left : right).add(in, range[i]);
+            }
+            return k;
         }
-        std::span<std::uint32_t> range(idx.data() + w.begin, count);
-        const Split<T> split = rule(SplitTask<T, N>{range, bounds, centroid_bounds, w.depth});
-        if (split.kind == Split<T>::Kind::Leaf && count <= max_leaf) {
-            make_leaf();
-            continue;
-        }
-        RangeBounds<T, N> left, right;
-        std::uint32_t left_count = partition_primitives(in, range, split, left, right);
-        if (left_count == 0 || left_count == count) {
-            // The rule gave no split (or could not split). Fall back to the object median on the
-            // centroids' longest axis; if all centroids coincide the order is arbitrary, so halve.
-            left = right = RangeBounds<T, N>{};
-            left_count = partition_primitives(
-                in, range,
-                Split<T>::at_count(static_cast<std::uint32_t>(centroid_bounds.largest_axis()),
-                                   count / 2),
+        case Kind::AtPosition:  // one loop per kind, the kind not tested per primitive
+            return top_down_detail::partition_by(
+                in, range, scratch, threads, [&](std::uint32_t i) { return c[i][a] < s.position; },
                 left, right);
+        case Kind::AtBin:
+            return top_down_detail::partition_by(
+                in, range, scratch, threads,
+                [&](std::uint32_t i) {
+                    return bin_of(c[i][a], s.bin_origin, s.bin_scale, s.bin_count) <= s.bin;
+                },
+                left, right);
+    }
+    return 0;
+}
+
+namespace top_down_detail {
+
+/// A node waiting to be split: its slot in the node array, its range of the index array, its
+/// depth, and the bounds of that range (gathered by the parent's partition).
+template <class T, std::size_t N>
+struct Work {
+    std::uint32_t node, begin, end, depth;
+    RangeBounds<T, N> bounds;
+};
+
+/// What every step of one build shares.
+template <class T, std::size_t N>
+struct Context {
+    const BuildInput<T, N>& in;
+    std::uint32_t* indices;  // the whole index array
+    std::uint32_t* scratch;  // as long; a large node partitions through its own part of it
+    std::uint32_t max_depth, max_leaf;
+};
+
+/// One step of every driver: 0 when the node of `w` is a leaf, else partitions its range and
+/// returns how many of it go left, with both sides' bounds.
+template <class T, std::size_t N, class SplitRule>
+std::uint32_t split_node(const Context<T, N>& cx, const Work<T, N>& w, SplitRule& rule,
+                         unsigned threads, RangeBounds<T, N>& left, RangeBounds<T, N>& right) {
+    const std::uint32_t count = w.end - w.begin;
+    if (count == 1 || w.depth >= cx.max_depth) return 0;
+    const Aabb<T, N> centroid_bounds = w.bounds.centroids.box();
+    const std::span<std::uint32_t> range(cx.indices + w.begin, count);
+    const std::span<std::uint32_t> scratch(cx.scratch ? cx.scratch + w.begin : nullptr,
+                                           cx.scratch ? count : 0);
+    const Split<T> split =
+        rule(SplitTask<T, N>{range, w.bounds.boxes.box(), centroid_bounds, w.depth});
+    if (split.kind == Split<T>::Kind::Leaf && count <= cx.max_leaf) return 0;
+    std::uint32_t left_count =
+        partition_primitives(cx.in, range, split, left, right, scratch, threads);
+    if (left_count == 0 || left_count == count) {
+        // The rule gave no split (or could not split). Fall back to the object median on the
+        // centroids' longest axis; if all centroids coincide the order is arbitrary, so halve.
+        left = right = RangeBounds<T, N>{};
+        left_count = partition_primitives(
+            cx.in, range,
+            Split<T>::at_count(static_cast<std::uint32_t>(centroid_bounds.largest_axis()),
+                               count / 2),
+            left, right, scratch, threads);
+    }
+    return left_count;
+}
+
+/// The serial driver: builds the subtree of `root` into `nodes` (where root.node already is),
+/// appending each sibling pair when its parent is split, depth first, left before right.
+template <class T, std::size_t N, class SplitRule, class Nodes>
+void build_serial(const Context<T, N>& cx, const Work<T, N>& root, SplitRule& rule, Nodes& nodes) {
+    std::vector<Work<T, N>> stack{root};
+    while (!stack.empty()) {
+        const Work<T, N> w = stack.back();
+        stack.pop_back();
+        nodes[w.node].bounds = w.bounds.boxes.box();
+        RangeBounds<T, N> left, right;
+        const std::uint32_t left_count = split_node(cx, w, rule, 1, left, right);
+        if (left_count == 0) {
+            nodes[w.node].first = w.begin;
+            nodes[w.node].count = w.end - w.begin;
+            continue;
         }
-        const auto first_child = static_cast<std::uint32_t>(bvh.nodes.size());
-        bvh.nodes[w.node].first = first_child;
-        bvh.nodes[w.node].count = 0;
-        bvh.nodes.emplace_back();
-        bvh.nodes.emplace_back();
+        const auto first_child = static_cast<std::uint32_t>(nodes.size());
+        nodes[w.node].first = first_child;
+        nodes[w.node].count = 0;
+        nodes.emplace_back();
+        nodes.emplace_back();
         // Right pushed first so the left subtree is laid out first (depth-first order).
         stack.push_back({first_child + 1, w.begin + left_count, w.end, w.depth + 1, right});
         stack.push_back({first_child, w.begin, w.begin + left_count, w.depth + 1, left});
     }
+}
+
+/// Nodes of more primitives than this are split one task each by the parallel driver; a smaller
+/// node becomes one task building its whole subtree serially (to balance many such tasks over the
+/// threads, it is small against the large meshes; to pay for a task's few allocations, not tiny).
+inline constexpr std::uint32_t parallel_subtree_cutoff = 4096;
+
+/// A node of the parallel driver's top tree: split there (children), or the root of a subtree the
+/// serial driver built into `subtree` (node 0 its root, child indices local to it).
+template <class T, std::size_t N>
+struct TopNode {
+    Aabb<T, N> bounds;
+    std::unique_ptr<TopNode[]> children;
+    std::vector<BvhNode<Aabb<T, N>>> subtree;
+    std::uint32_t self = 0, at = 0;  // final index; of its children pair or its subtree's pairs
+};
+
+template <class T, std::size_t N, class SplitRule>
+void build_top_node(const Context<T, N>& cx, const Work<T, N>& w, const BuildOptions& options,
+                    TopNode<T, N>& t) {
+    t.bounds = w.bounds.boxes.box();
+    const std::uint32_t count = w.end - w.begin;
+    if (count > parallel_subtree_cutoff) {
+        // A rule per node: rules keep scratch, and the two children run at the same time. It
+        // bins in parallel (threads = 0: this build's arena) when the node is large.
+        BuildOptions inner = options;
+        inner.threads = 0;
+        SplitRule rule(cx.in, inner);
+        RangeBounds<T, N> lb, rb;
+        if (const std::uint32_t k = split_node(cx, w, rule, 0, lb, rb)) {
+            const Work<T, N> left{0, w.begin, w.begin + k, w.depth + 1, lb};
+            const Work<T, N> right{0, w.begin + k, w.end, w.depth + 1, rb};
+            t.children = std::make_unique<TopNode<T, N>[]>(2);
+            parallel_invoke(
+                0, [&] { build_top_node<T, N, SplitRule>(cx, left, options, t.children[0]); },
+                [&] { build_top_node<T, N, SplitRule>(cx, right, options, t.children[1]); });
+            return;
+        }
+        t.subtree.resize(1);
+        t.subtree[0] = {t.bounds, w.begin, count};
+        return;
+    }
+    BuildOptions serial = options;
+    serial.threads = 1;
+    SplitRule rule(cx.in, serial);
+    t.subtree.reserve(2 * count - 1);
+    t.subtree.emplace_back();
+    Work<T, N> root = w;
+    root.node = 0;
+    build_serial(cx, root, rule, t.subtree);
+}
+
+/// Gives the top tree its final indices as the serial driver allocates them: a node's children
+/// pair when it is split, then all of its left subtree's pairs, then its right one's.
+template <class T, std::size_t N>
+void place_top_node(TopNode<T, N>& t, std::uint32_t self, std::uint32_t& next,
+                    std::vector<TopNode<T, N>*>& all) {
+    t.self = self;
+    t.at = next;
+    all.push_back(&t);
+    if (t.children) {
+        next += 2;
+        place_top_node(t.children[0], t.at, next, all);
+        place_top_node(t.children[1], t.at + 1, next, all);
+    } else {
+        next += static_cast<std::uint32_t>(t.subtree.size() - 1);
+    }
+}
+
+/// The parallel driver (run inside with_threads): the top tree in parallel, then one parallel copy
+/// of every subtree to its place, local child indices shifted.
+template <class T, std::size_t N, class SplitRule, class Nodes>
+void build_parallel(const Context<T, N>& cx, const Work<T, N>& root, const BuildOptions& options,
+                    Nodes& nodes) {
+    TopNode<T, N> top;
+    build_top_node<T, N, SplitRule>(cx, root, options, top);
+    std::vector<TopNode<T, N>*> all;
+    std::uint32_t next = 1;
+    place_top_node(top, 0, next, all);
+    nodes.resize(next);
+    parallel_for(all.size(), 1, 0, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+            TopNode<T, N>& t = *all[k];
+            if (t.children) {
+                nodes[t.self] = {t.bounds, t.at, 0};
+                continue;
+            }
+            const auto place = [&](std::uint32_t local) {
+                return local ? t.at + local - 1 : t.self;
+            };
+            for (std::uint32_t local = 0; local < t.subtree.size(); ++local) {
+                auto node = t.subtree[local];
+                if (!node.is_leaf()) node.first = place(node.first);
+                nodes[place(local)] = node;
+            }
+            std::vector<BvhNode<Aabb<T, N>>>().swap(t.subtree);  // freed by the thread that copied
+        }
+    });
+}
+
+}  // namespace top_down_detail
+
+/// Builds over `indices` (from usable_primitives) with `rule` deciding each split. In parallel
+/// when options.threads != 1 and oneTBB is there, for rules made from (BuildInput, BuildOptions):
+/// each task makes its own.
+template <class T, std::size_t N, class SplitRule>
+Bvh<Aabb<T, N>> build_top_down(const BuildInput<T, N>& in, std::vector<std::uint32_t> indices,
+                               const BuildOptions& options, SplitRule& rule) {
+    using namespace top_down_detail;
+    Bvh<Aabb<T, N>> bvh;
+    bvh.primitive_indices = std::move(indices);
+    std::vector<std::uint32_t>& idx = bvh.primitive_indices;
+    if (idx.empty()) return bvh;
+    const auto n = static_cast<std::uint32_t>(idx.size());
+    // Scratch only where a node is large enough to partition through it; left uninitialized.
+    std::unique_ptr<std::uint32_t[]> scratch;
+    if (n >= stable_partition_from) scratch.reset(new std::uint32_t[n]);
+    const Context<T, N> cx{in, idx.data(), scratch.get(),
+                           std::min(options.max_depth, max_bvh_depth),
+                           std::max<std::uint32_t>(1, options.max_leaf_size)};
+
+    constexpr bool remakeable =
+        std::is_constructible_v<SplitRule, const BuildInput<T, N>&, const BuildOptions&>;
+    if constexpr (remakeable) {
+        if (options.threads != 1 && have_parallel() && n > parallel_subtree_cutoff) {
+            with_threads(options.threads, [&] {
+                const Work<T, N> root{0, 0, n, 0, range_bounds<T, N>(in, idx, 0)};
+                build_parallel<T, N, SplitRule>(cx, root, options, bvh.nodes);
+            });
+            return bvh;
+        }
+    }
+    bvh.nodes.reserve(2 * idx.size() - 1);
+    bvh.nodes.emplace_back();
+    build_serial(cx, Work<T, N>{0, 0, n, 0, range_bounds<T, N>(in, idx, 1)}, rule, bvh.nodes);
     return bvh;
 }
 
