@@ -1,11 +1,11 @@
 // The parallel top-down builders (binned SAH, sweep SAH, the classic rules): with threads = 1, 2
 // and 0 they build the same tree bit for bit (nodes and primitive indices), it passes validate(),
 // and its SAH cost is the serial one. Sizes run from one primitive to 200k, past every threshold
-// of the parallel driver (subtree cutoff, parallel binning, stable partition).
+// of the parallel driver (subtree cutoff, parallel binning, stable partition). Without oneTBB the
+// same tests check that threads != 1 falls back to the serial build.
 #include <gtest/gtest.h>
 
 #include "bvhkit/build/build.hpp"
-#include "bvhkit/build/parallel.hpp"
 #include "bvhkit/bvh/validate.hpp"
 #include "bvhkit/io/read_mesh.hpp"
 #include "random_geometry.hpp"
@@ -67,7 +67,6 @@ void check_triangles(const std::vector<Triangle<T>>& tris, const BuildOptions& o
 }
 
 TEST(ParallelBuild, RandomSoupsOfEverySize) {
-    if (!have_parallel()) GTEST_SKIP() << "bvhkit built without oneTBB: threads are ignored";
     std::uint64_t seed = 100;
     for (std::size_t n : {1, 2, 3, 9, 100, 4097, 20000, 70000, 200000}) {
         // A quarter under the sanitizers: the largest soup still passes every threshold.
@@ -83,7 +82,6 @@ TEST(ParallelBuild, RandomSoupsOfEverySize) {
 }
 
 TEST(ParallelBuild, DoublePrecisionAndTwoDimensions) {
-    if (!have_parallel()) GTEST_SKIP() << "bvhkit built without oneTBB: threads are ignored";
     check_triangles(test::random_soup<double>(test::scaled(60000, 10), 7), BuildOptions{});
     test::Random rng(8);
     std::vector<Aabb2f> boxes(test::scaled(60000, 10));
@@ -101,7 +99,6 @@ TEST(ParallelBuild, DoublePrecisionAndTwoDimensions) {
 }
 
 TEST(ParallelBuild, LimitsAndDegenerateInput) {
-    if (!have_parallel()) GTEST_SKIP() << "bvhkit built without oneTBB: threads are ignored";
     const std::size_t n = test::scaled(100000, 10);
     const auto tris = test::random_soup<float>(n, 21);
     for (const auto& [name, base] : top_down_configurations()) {
@@ -138,7 +135,6 @@ TEST(ParallelBuild, LimitsAndDegenerateInput) {
 }
 
 TEST(ParallelBuild, SharedBunny) {
-    if (!have_parallel()) GTEST_SKIP() << "bvhkit built without oneTBB: threads are ignored";
     BVHKIT_REQUIRE_MESH(path, "stanford-bunny.obj");
     const auto tris = mesh_triangles<float>(read_mesh(path));
     for (const auto& [name, options] : top_down_configurations()) {
@@ -149,7 +145,6 @@ TEST(ParallelBuild, SharedBunny) {
 }
 
 TEST(ParallelBuild, SharedIgea) {
-    if (!have_parallel()) GTEST_SKIP() << "bvhkit built without oneTBB: threads are ignored";
     if (test::small_scale()) GTEST_SKIP() << "269k triangles: Release only";
     BVHKIT_REQUIRE_MESH(path, "igea.ply");
     check_triangles(mesh_triangles<float>(read_mesh(path)), BuildOptions{});
