@@ -7,8 +7,8 @@
 // to the full sweep instead, which is exact and, that small, cheaper.
 //
 // A large node (parallel_binning_from primitives) bins in chunks on several threads when the rule's
-// options allow (threads != 1), each chunk into its own bins, merged afterwards (Wald 2007, section
-// 4); box unions and counts are exact in any order, so the split is the same as binned serially.
+// options allow (threads != 1), each chunk into its own bins, merged afterwards; box unions and
+// counts are exact in any order, so the split is the same as binned serially.
 #include "bvhkit/build/sweep_sah.hpp"
 
 namespace bvhkit {
