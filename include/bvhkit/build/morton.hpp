@@ -83,12 +83,7 @@ std::vector<MortonItem> morton_order(std::span<const Vec<T, N>> centroids,
 #if defined(BVHKIT_HAVE_TBB)
     if (threads != 1 && items.size() > 16384) {
         // The order is total (no equal items), so a parallel sort gives the serial result.
-        if (threads == 0) {
-            tbb::parallel_sort(items.begin(), items.end());
-        } else {
-            tbb::task_arena arena(static_cast<int>(threads));
-            arena.execute([&] { tbb::parallel_sort(items.begin(), items.end()); });
-        }
+        with_threads(threads, [&] { tbb::parallel_sort(items.begin(), items.end()); });
         return items;
     }
 #endif

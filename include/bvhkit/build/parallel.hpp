@@ -31,6 +31,23 @@ constexpr bool have_parallel() {
 #endif
 }
 
+/// Calls f() in a task arena of `threads` threads when threads > 1, else directly. Inside, pass
+/// threads = 0 to parallel_for and parallel_invoke: they then run in this arena, at most `threads`
+/// wide, without making an arena per call.
+template <class F>
+void with_threads(unsigned threads, F&& f) {
+#if defined(BVHKIT_HAVE_TBB)
+    if (threads > 1) {
+        tbb::task_arena arena(static_cast<int>(threads));
+        arena.execute(f);
+        return;
+    }
+#else
+    (void)threads;
+#endif
+    f();
+}
+
 /// Calls body(begin, end) on consecutive chunks of [0, count), each of `grain` indices (the last
 /// may be shorter), possibly at the same time on several threads.
 template <class Body>
@@ -49,35 +66,13 @@ void parallel_for(std::size_t count, std::size_t grain, unsigned threads, Body&&
                 },
                 tbb::simple_partitioner());
         };
-        if (threads == 0) {
-            run();
-        } else {
-            tbb::task_arena arena(static_cast<int>(threads));
-            arena.execute(run);
-        }
+        with_threads(threads, run);
         return;
     }
 #else
     (void)threads;
 #endif
     for (std::size_t b = 0; b < count; b += grain) body(b, std::min(count, b + grain));
-}
-
-/// Calls f() in a task arena of `threads` threads when threads > 1, else directly. Inside, pass
-/// threads = 0 to parallel_for and parallel_invoke: they then run in this arena, at most `threads`
-/// wide, without making an arena per call.
-template <class F>
-void with_threads(unsigned threads, F&& f) {
-#if defined(BVHKIT_HAVE_TBB)
-    if (threads > 1) {
-        tbb::task_arena arena(static_cast<int>(threads));
-        arena.execute(f);
-        return;
-    }
-#else
-    (void)threads;
-#endif
-    f();
 }
 
 /// Calls f() and g(), possibly at the same time (threads != 1, with oneTBB), else f() then g().
