@@ -103,8 +103,11 @@ class ClosestPointMesh {
         }
         bvh_ = build_bvh<T, 3>(boxes, centroids, options);
         tris_.clear();
-        tris_.reserve(bvh_.primitive_indices.size());
+        tris_.reserve(bvh_.primitive_indices.size() + 1);
         for (std::uint32_t i : bvh_.primitive_indices) tris_.push_back(tris[i]);
+        // One triangle of padding: the SSE box test loads 4 floats from each corner, the last
+        // slot's third corner reaching one float past its triangle.
+        tris_.push_back(Triangle<T>{});
         triangle_count_ = tris.size();
     }
     /// The squared distance to the triangle in a leaf slot, for nearest().
@@ -113,13 +116,7 @@ class ClosestPointMesh {
         T operator()(std::uint32_t slot, const Vec<T, 3>& p, T bound) const {
             const Triangle<T>& t = tris[slot];
             // The triangle's box is a cheap lower bound: most triangles of a leaf fail it.
-            T box_d2 = 0;
-            for (std::size_t a = 0; a < 3; ++a) {
-                const T lo = min_of(t.p0[a], min_of(t.p1[a], t.p2[a]));
-                const T hi = max_of(t.p0[a], max_of(t.p1[a], t.p2[a]));
-                const T g = max_of(max_of(lo - p[a], p[a] - hi), T(0));
-                box_d2 += g * g;
-            }
+            const T box_d2 = box_distance_squared(t, p);
             if (box_d2 > bound) return box_d2;
             return length_squared(bvhkit::closest_point(t, p).point - p);
         }
@@ -128,13 +125,42 @@ class ClosestPointMesh {
         void prefetch(std::uint32_t slot) const { __builtin_prefetch(tris + slot); }
     };
     SlotDistance distance() const { return {tris_.data()}; }
+    /// Squared distance from p to the triangle's box. For float on x86 in SSE: each corner is one
+    /// 4-float load (the fourth lane, the next coordinate, masked off), ~15 instructions where the
+    /// scalar form takes ~100 (measured: a fifth of an N1 query).
+    static T box_distance_squared(const Triangle<T>& t, const Vec<T, 3>& p) {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>) {
+            static_assert(sizeof(Triangle<float>) == 9 * sizeof(float), "corners are contiguous");
+            const float* f = &t.p0[0];
+            const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 3), c = _mm_loadu_ps(f + 6);
+            const __m128 q = _mm_setr_ps(p[0], p[1], p[2], 0.0f);
+            const __m128 lo = _mm_min_ps(a, _mm_min_ps(b, c)), hi = _mm_max_ps(a, _mm_max_ps(b, c));
+            const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+            __m128 g =
+                _mm_max_ps(_mm_max_ps(_mm_sub_ps(lo, q), _mm_sub_ps(q, hi)), _mm_setzero_ps());
+            g = _mm_and_ps(g, xyz);
+            g = _mm_mul_ps(g, g);
+            const __m128 s = _mm_add_ps(g, _mm_movehl_ps(g, g));
+            return _mm_cvtss_f32(_mm_add_ss(s, _mm_shuffle_ps(s, s, _MM_SHUFFLE(1, 1, 1, 1))));
+        }
+#endif
+        T d2 = 0;
+        for (std::size_t a = 0; a < 3; ++a) {
+            const T lo = min_of(t.p0[a], min_of(t.p1[a], t.p2[a]));
+            const T hi = max_of(t.p0[a], max_of(t.p1[a], t.p2[a]));
+            const T g = max_of(max_of(lo - p[a], p[a] - hi), T(0));
+            d2 += g * g;
+        }
+        return d2;
+    }
     MeshPoint<T> point_of(std::uint32_t slot, const Vec<T, 3>& p) const {
         const ClosestPoint<T> c = bvhkit::closest_point(tris_[slot], p);
         return {c.point, length_squared(c.point - p), bvh_.primitive_indices[slot], c.u, c.v};
     }
 
     AabbBvh<T, 3> bvh_;
-    std::vector<Triangle<T>> tris_;  // leaf-slot order
+    std::vector<Triangle<T>> tris_;  // leaf-slot order, then one of padding
     std::size_t triangle_count_ = 0;
 };
 
