@@ -17,7 +17,7 @@ struct PairPlanes {
     __m128 axis[3];  // per axis: (L.min, L.max, R.min, R.max)
 };
 
-inline PairPlanes gather_pair_planes(const BvhNode<Aabb3f>* pair) {
+[[gnu::always_inline]] inline PairPlanes gather_pair_planes(const BvhNode<Aabb3f>* pair) {
     // Node layout in floats: min xyz (0-2), max xyz (3-5), first, count; the right node at 8-15.
     const float* p = reinterpret_cast<const float*>(pair);
     const __m128 a = _mm_loadu_ps(p), b = _mm_loadu_ps(p + 4);
@@ -36,7 +36,8 @@ inline PairPlanes gather_pair_planes(const BvhNode<Aabb3f>* pair) {
 
 /// Squared distances from p to both boxes of a sibling pair (0 inside), as Aabb::distance_squared.
 template <class T, std::size_t N>
-inline void pair_distances_squared(const BvhNode<Aabb<T, N>>* pair, const Vec<T, N>& p, T out[2]) {
+[[gnu::always_inline]] inline void pair_distances_squared(const BvhNode<Aabb<T, N>>* pair,
+                                                          const Vec<T, N>& p, T out[2]) {
 #if defined(__SSE2__)
     if constexpr (std::is_same_v<T, float> && N == 3) {
         // Per axis: (min - p, p - max) for each box, the larger of the two clamped at 0, squared.

@@ -68,6 +68,13 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
                     stack[size] = Entry{left + !right_first, entry[right_first ? 0 : 1]};
                     size += both;
                     current = left + right_first;
+                    // Ask now for the lines read next: the near child's children, and when both
+                    // children are hit, the far child's children, read when it is popped (its
+                    // node is in the line just tested, so the address costs nothing). For a leaf
+                    // `first` is a primitive slot and the address meaningless, which a prefetch
+                    // tolerates (it never faults). R1 -3 to -7%, R2 on igea -10%.
+                    __builtin_prefetch(nodes + nodes[current].first);
+                    if (both) __builtin_prefetch(nodes + nodes[left + !right_first].first);
                     continue;
                 }
             }
@@ -90,7 +97,7 @@ Hit<T> closest_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats
     TriangleHit<T> h;
     traverse_ray(
         bvh, ray,
-        [&](const auto& leaf) {
+        [&](const auto& leaf) __attribute__((always_inline)) {  // see ray_pair_test.hpp
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
                 if (test(s, ray, h)) {
@@ -115,7 +122,7 @@ bool any_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats&& sta
     TriangleHit<T> h;
     traverse_ray(
         bvh, ray,
-        [&](const auto& leaf) {
+        [&](const auto& leaf) __attribute__((always_inline)) {  // see ray_pair_test.hpp
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
                 if (test(s, ray, h)) return found = true;
@@ -134,7 +141,7 @@ void all_hits(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, OnHit&& on
     TriangleHit<T> h;
     traverse_ray(
         bvh, ray,
-        [&](const auto& leaf) {
+        [&](const auto& leaf) __attribute__((always_inline)) {  // see ray_pair_test.hpp
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
                 if (test(s, ray, h) && !on_hit(Hit<T>{h.t, bvh.primitive_indices[s], h.u, h.v}))
