@@ -138,9 +138,10 @@ TEST(RayPairTest, MatchesTheScalarSlabTestIncludingZeroDirectionsOnPlanes) {
                         for (float dz : dirs) {
                             if (dx == 0 && dy == 0 && dz == 0) continue;
                             const Ray3f ray({ox, oy, oz}, {dx, dy, dz}, 0.5f, 50.0f);
-                            const RayPairTest<float, 3> test(ray);
+                            const RaySlabData<float, 3> slab(ray);
                             float entry[2];
-                            const unsigned got = test.slab().with_octant([&](auto o) {
+                            const unsigned got = slab.with_octant([&](auto o) {
+                                const RayPairTest<float, 3> test(slab, o);
                                 return test.template test<decltype(o)::value>(
                                     pair, test.interval(ray.tmin, ray.tmax), entry);
                             });

@@ -29,10 +29,10 @@ template <class T, std::size_t N, class OnLeaf, class Stats = NoStats>
 void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
                   Stats&& stats = {}) {
     if (bvh.empty()) return;
-    const RayPairTest<T, N> pair_test(ray);
-    const RaySlabData<T, N>& slab = pair_test.slab();
+    const RaySlabData<T, N> slab(ray);
     slab.with_octant([&](auto octant) {
         constexpr unsigned O = decltype(octant)::value;
+        const RayPairTest<T, N> pair_test(slab, octant);
         const auto* nodes = bvh.nodes.data();
         // The root's own box needs a test only when it is a leaf: an internal root's children lie
         // inside it, so testing them decides as much.

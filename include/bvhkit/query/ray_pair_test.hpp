@@ -27,8 +27,10 @@ namespace bvhkit {
 template <class T, std::size_t N>
 class RayPairTest {
   public:
-    explicit RayPairTest(const Ray<T, N>& ray) : slab_(ray) {}
-    const RaySlabData<T, N>& slab() const { return slab_; }
+    /// For the ray `slab` was made from, whose octant is `Octant`.
+    template <unsigned Octant>
+    RayPairTest(const RaySlabData<T, N>& slab, std::integral_constant<unsigned, Octant>)
+        : slab_(slab) {}
 
     /// The ray's [tmin, tmax] in the form test() takes; make it again when tmax changes.
     struct Interval {
@@ -55,18 +57,20 @@ class RayPairTest {
 template <>
 class RayPairTest<float, 3> {
   public:
-    explicit RayPairTest(const Ray<float, 3>& ray) : slab_(ray) {
+    /// For the ray `slab` was made from, whose octant is `Octant` (known at compile time, so
+    /// the choice of near and far planes costs nothing per ray either).
+    template <unsigned Octant>
+    RayPairTest(const RaySlabData<float, 3>& slab, std::integral_constant<unsigned, Octant>) {
         constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
         for (int i = 0; i < 3; ++i) {
-            origin_[i] = _mm_set1_ps(ray.origin[i]);
-            const float inv = slab_.inv_direction[i];
+            origin_[i] = _mm_set1_ps(slab.origin[i]);
+            const float inv = slab.inv_direction[i];
             // Lanes hold (L.min, L.max, R.min, R.max) planes; far planes get -s * inv.
-            const bool negative = (slab_.octant >> i) & 1u;
+            const bool negative = (Octant >> i) & 1u;
             const float on_min = negative ? -s * inv : inv, on_max = negative ? inv : -s * inv;
             scale_[i] = _mm_setr_ps(on_min, on_max, on_min, on_max);
         }
     }
-    const RaySlabData<float, 3>& slab() const { return slab_; }
 
     /// (tmin, tmin, -tmax, -tmax): the accumulator's start, never NaN; make it again when tmax
     /// changes.
@@ -104,7 +108,6 @@ class RayPairTest<float, 3> {
             return _mm_shuffle_ps(t, t, _MM_SHUFFLE(3, 1, 2, 0));
     }
 
-    RaySlabData<float, 3> slab_;
     __m128 origin_[3];
     __m128 scale_[3];
 };
