@@ -110,8 +110,7 @@ class TriangleBvh {
         }
     }
     auto fast_test() const {
-        return [tris = fast_.data()](std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h)
-            __attribute__((always_inline)) {
+        return [tris = fast_.data()](std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) {
             return tris[slot].intersect(ray, ray.tmax, h);
         };
     }

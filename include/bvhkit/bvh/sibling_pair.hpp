@@ -36,8 +36,7 @@ struct PairPlanes {
 
 /// Squared distances from p to both boxes of a sibling pair (0 inside), as Aabb::distance_squared.
 template <class T, std::size_t N>
-[[gnu::always_inline]] inline void pair_distances_squared(const BvhNode<Aabb<T, N>>* pair,
-                                                          const Vec<T, N>& p, T out[2]) {
+inline void pair_distances_squared(const BvhNode<Aabb<T, N>>* pair, const Vec<T, N>& p, T out[2]) {
 #if defined(__SSE2__)
     if constexpr (std::is_same_v<T, float> && N == 3) {
         // Per axis: (min - p, p - max) for each box, the larger of the two clamped at 0, squared.

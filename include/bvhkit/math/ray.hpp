@@ -62,7 +62,7 @@ struct RaySlabData {
     /// Clips [tmin, tmax] to the box; true on a hit, and then tmin is the entry distance. `Octant`
     /// is this ray's octant, known at compile time so the near/far planes cost nothing to choose.
     template <unsigned Octant>
-    [[gnu::always_inline]] bool clip(const Aabb<T, N>& box, T& tmin, T& tmax) const {
+    bool clip(const Aabb<T, N>& box, T& tmin, T& tmax) const {
         constexpr T far_scale = T(1) + T(2) * rounding_gamma<T>(3);
         for (std::size_t i = 0; i < N; ++i) {
             constexpr unsigned one = 1;

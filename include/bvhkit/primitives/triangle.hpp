@@ -102,7 +102,7 @@ struct PrecomputedTriangle {
 
     /// Hits with t in [ray.tmin, tmax]. A degenerate triangle or a parallel ray makes det 0, and
     /// the resulting inf/NaN fails the comparisons, so it misses without a branch of its own.
-    [[gnu::always_inline]] bool intersect(const Ray<T, 3>& ray, T tmax, TriangleHit<T>& hit) const {
+    bool intersect(const Ray<T, 3>& ray, T tmax, TriangleHit<T>& hit) const {
         const Vec<T, 3> c = p0 - ray.origin;
         const Vec<T, 3> r = cross(ray.direction, c);
         const T inv_det = T(1) / dot(n, ray.direction);

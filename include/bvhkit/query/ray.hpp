@@ -97,7 +97,7 @@ Hit<T> closest_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats
     TriangleHit<T> h;
     traverse_ray(
         bvh, ray,
-        [&](const auto& leaf) __attribute__((always_inline)) {  // see ray_pair_test.hpp
+        [&](const auto& leaf) {
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
                 if (test(s, ray, h)) {
@@ -122,7 +122,7 @@ bool any_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats&& sta
     TriangleHit<T> h;
     traverse_ray(
         bvh, ray,
-        [&](const auto& leaf) __attribute__((always_inline)) {  // see ray_pair_test.hpp
+        [&](const auto& leaf) {
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
                 if (test(s, ray, h)) return found = true;
@@ -141,7 +141,7 @@ void all_hits(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, OnHit&& on
     TriangleHit<T> h;
     traverse_ray(
         bvh, ray,
-        [&](const auto& leaf) __attribute__((always_inline)) {  // see ray_pair_test.hpp
+        [&](const auto& leaf) {
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
                 if (test(s, ray, h) && !on_hit(Hit<T>{h.t, bvh.primitive_indices[s], h.u, h.v}))
