@@ -70,11 +70,8 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
              {Workload{"R1", &r1, false}, Workload{"R2", &r2, false}, Workload{"R3", &r2, true}}) {
             if (progress) std::fprintf(progress, "  %s ...\n", w.name);
             std::size_t our_hits = 0;
-            const auto trace_ours = [&] {
-                our_hits = 0;
-                for (const auto& r : *w.rays)
-                    our_hits += w.occlusion ? ours.any_hit(r) : bool(ours.closest_hit(r));
-            };
+            // In its own file: see ray_timed_calls.cpp.
+            const auto trace_ours = [&] { our_hits = trace_rays(ours, *w.rays, w.occlusion); };
 #if BVHKIT_HAVE_EMBREE
             std::size_t peer_hits = 0;
             const auto trace_peer = [&] {

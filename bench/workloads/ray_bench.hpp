@@ -2,10 +2,17 @@
 // Workload R of ../shared/BENCHMARKS.md: build, R1 primary rays, R2 incoherent rays, R3 occlusion,
 // for bvhkit and (when installed) Embree 3 in the same process, one thread each, medians of
 // repetitions.
+#include <span>
 #include <string>
 #include <vector>
 
+#include "bvhkit/math/ray.hpp"
 #include "report.hpp"
+
+namespace bvhkit {
+template <class T>
+class TriangleBvh;
+}
 
 namespace bvhkit::bench {
 
@@ -21,5 +28,9 @@ struct RayBenchOptions {
 std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progress);
 
 bool have_embree();
+
+/// bvhkit's timed ray loop (ray_timed_calls.cpp, a file of its own): the closest hits (or, with
+/// `occlusion`, any hits) of every ray; returns how many rays hit.
+std::size_t trace_rays(const TriangleBvh<float>& tree, std::span<const Ray3f> rays, bool occlusion);
 
 }  // namespace bvhkit::bench
