@@ -4,10 +4,19 @@
 // AABB_tree (closest_point_and_primitive after accelerate_distance_queries()) in the same process,
 // one thread each, medians of interleaved repetitions. With `scaling`, also bvhkit alone on one
 // thread against all threads (oneTBB): batched closest points and the parallel builders.
+#include <span>
 #include <string>
 #include <vector>
 
+#include "bvhkit/math/vec.hpp"
 #include "report.hpp"
+
+namespace bvhkit {
+template <class T>
+class ClosestPointMesh;
+template <class T>
+struct MeshPoint;
+}  // namespace bvhkit
 
 namespace bvhkit::bench {
 
@@ -24,5 +33,10 @@ struct NearestBenchOptions {
 std::vector<Row> run_nearest_bench(const NearestBenchOptions& options, std::FILE* progress);
 
 bool have_cgal();
+
+/// bvhkit's timed loop (nearest_timed_calls.cpp, a file of its own): the closest point of every
+/// point, on the calling thread.
+void closest_points_one_thread(const ClosestPointMesh<float>& mesh, std::span<const Vec3f> points,
+                               std::span<MeshPoint<float>> out);
 
 }  // namespace bvhkit::bench
