@@ -78,6 +78,44 @@ Obb<T> obb_around(const Mat3<double>& axes, ForEachPoint&& for_each_point) {
     return o;
 }
 
+/// Oriented volumes (Obb, Rss: a centre and three axes as rows) under a pose. frame_placed carries
+/// b into A's frame once, for the several tests a traversal step makes against it (each then skips
+/// the product of a's axes with the pose's rotation).
+template <class V, class T>
+V frame_placed(const V& b, const PreparedPose<T>& p) {
+    V w = b;
+    w.center = p.r * b.center + p.t;
+    for (std::size_t j = 0; j < 3; ++j) w.axes[j] = p.r * b.axes[j];
+    return w;
+}
+
+/// b's axes as the columns of c (abs_c: their magnitudes, padded for rounding) and its centre t,
+/// both in a's frame; w already placed (frame_placed).
+template <class V, class T>
+void frames_relative_placed(const V& a, const V& w, Mat3<T>& c, Mat3<T>& abs_c, Vec<T, 3>& t) {
+    constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
+    for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) {
+            c[i][j] = dot(a.axes[i], w.axes[j]);
+            abs_c[i][j] = std::fabs(c[i][j]) + eps;
+        }
+    t = a.axes * (w.center - a.center);
+}
+
+/// The same for b given in its own model frame and the pose of B in A.
+template <class V, class T>
+void frames_relative(const V& a, const V& b, const PreparedPose<T>& p, Mat3<T>& c, Mat3<T>& abs_c,
+                     Vec<T, 3>& t) {
+    constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
+    const Mat3<T> ar = a.axes * p.r;  // a's axes expressed in B's model frame, as rows
+    for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) {
+            c[i][j] = dot(ar[i], b.axes[j]);
+            abs_c[i][j] = std::fabs(c[i][j]) + eps;
+        }
+    t = a.axes * (p.r * b.center + p.t - a.center);
+}
+
 }  // namespace detail
 
 template <class T>
@@ -157,59 +195,32 @@ struct VolumeTraits<Obb<T>> {
     static bool overlaps(const V& a, const V& b, const Prepared& p) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
-        relative(a, b, p, c, abs_c, t);
+        detail::frames_relative(a, b, p, c, abs_c, t);
         return !detail::boxes_separated(c, abs_c, t, a.extents, b.extents, p.slack);
     }
     static T size(const V& v) { return length_squared(v.extents); }
     static T distance_lower_bound(const V& a, const V& b, const Prepared& p) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
-        relative(a, b, p, c, abs_c, t);
+        detail::frames_relative(a, b, p, c, abs_c, t);
         return std::max(T(0), detail::boxes_gap(c, abs_c, t, a.extents, b.extents) - p.slack);
     }
 
     /// b carried into A's frame once, for the several tests a traversal step makes against it
     /// (each then skips the product of a's axes with the pose's rotation).
-    static V place(const V& b, const Prepared& p) {
-        V w = b;
-        w.center = p.r * b.center + p.t;
-        for (std::size_t j = 0; j < 3; ++j) w.axes[j] = p.r * b.axes[j];
-        return w;
-    }
+    static V place(const V& b, const Prepared& p) { return detail::frame_placed(b, p); }
     /// overlaps(a, b, p) for w = place(b, p).
     static bool overlaps_placed(const V& a, const V& w, T slack) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
-        relative_placed(a, w, c, abs_c, t);
+        detail::frames_relative_placed(a, w, c, abs_c, t);
         return !detail::boxes_separated(c, abs_c, t, a.extents, w.extents, slack);
     }
     static T distance_lower_bound_placed(const V& a, const V& w, T slack) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
-        relative_placed(a, w, c, abs_c, t);
+        detail::frames_relative_placed(a, w, c, abs_c, t);
         return std::max(T(0), detail::boxes_gap(c, abs_c, t, a.extents, w.extents) - slack);
-    }
-
-  private:
-    static void relative_placed(const V& a, const V& w, Mat3<T>& c, Mat3<T>& abs_c, Vec<T, 3>& t) {
-        constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
-        for (std::size_t i = 0; i < 3; ++i)
-            for (std::size_t j = 0; j < 3; ++j) {
-                c[i][j] = dot(a.axes[i], w.axes[j]);
-                abs_c[i][j] = std::fabs(c[i][j]) + eps;
-            }
-        t = a.axes * (w.center - a.center);
-    }
-    static void relative(const V& a, const V& b, const Prepared& p, Mat3<T>& c, Mat3<T>& abs_c,
-                         Vec<T, 3>& t) {
-        constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
-        const Mat3<T> ar = a.axes * p.r;  // a's axes expressed in B's model frame, as rows
-        for (std::size_t i = 0; i < 3; ++i)
-            for (std::size_t j = 0; j < 3; ++j) {
-                c[i][j] = dot(ar[i], b.axes[j]);
-                abs_c[i][j] = std::fabs(c[i][j]) + eps;
-            }
-        t = a.axes * (p.r * b.center + p.t - a.center);
     }
 };
 

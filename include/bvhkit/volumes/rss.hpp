@@ -185,7 +185,7 @@ struct VolumeTraits<Rss<T>> {
     static bool overlaps(const V& a, const V& b, const Prepared& p) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
-        relative(a, b, p, c, abs_c, t);
+        detail::frames_relative(a, b, p, c, abs_c, t);
         return !detail::boxes_separated(c, abs_c, t, box_extents(a), box_extents(b), p.slack);
     }
     static T size(const V& v) { return length_squared(box_extents(v)); }
@@ -199,27 +199,22 @@ struct VolumeTraits<Rss<T>> {
     static T distance_lower_bound(const V& a, const V& b, const Prepared& p, T cutoff) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
-        relative(a, b, p, c, abs_c, t);
+        detail::frames_relative(a, b, p, c, abs_c, t);
         return bound_from(a, b, c, abs_c, t, p.slack, cutoff);
     }
     /// b carried into A's frame once, for the several tests a traversal step makes against it
     /// (each then skips the product of a's axes with the pose's rotation).
-    static V place(const V& b, const Prepared& p) {
-        V w = b;
-        w.center = p.r * b.center + p.t;
-        for (std::size_t j = 0; j < 3; ++j) w.axes[j] = p.r * b.axes[j];
-        return w;
-    }
+    static V place(const V& b, const Prepared& p) { return detail::frame_placed(b, p); }
     static bool overlaps_placed(const V& a, const V& w, T slack) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
-        relative_placed(a, w, c, abs_c, t);
+        detail::frames_relative_placed(a, w, c, abs_c, t);
         return !detail::boxes_separated(c, abs_c, t, box_extents(a), box_extents(w), slack);
     }
     static T distance_lower_bound_placed(const V& a, const V& w, T slack, T cutoff) {
         Mat3<T> c, abs_c;
         Vec<T, 3> t;
-        relative_placed(a, w, c, abs_c, t);
+        detail::frames_relative_placed(a, w, c, abs_c, t);
         return bound_from(a, w, c, abs_c, t, slack, cutoff);
     }
 
@@ -322,26 +317,6 @@ struct VolumeTraits<Rss<T>> {
         v.half[1] = T((yhi - ylo) * 0.5);
         v.radius = T(r + pad);
         return v;
-    }
-    static void relative_placed(const V& a, const V& w, Mat3<T>& c, Mat3<T>& abs_c, Vec<T, 3>& t) {
-        constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
-        for (std::size_t i = 0; i < 3; ++i)
-            for (std::size_t j = 0; j < 3; ++j) {
-                c[i][j] = dot(a.axes[i], w.axes[j]);
-                abs_c[i][j] = std::fabs(c[i][j]) + eps;
-            }
-        t = a.axes * (w.center - a.center);
-    }
-    static void relative(const V& a, const V& b, const Prepared& p, Mat3<T>& c, Mat3<T>& abs_c,
-                         Vec<T, 3>& t) {
-        constexpr T eps = std::numeric_limits<T>::epsilon() * T(16);
-        const Mat3<T> ar = a.axes * p.r;
-        for (std::size_t i = 0; i < 3; ++i)
-            for (std::size_t j = 0; j < 3; ++j) {
-                c[i][j] = dot(ar[i], b.axes[j]);
-                abs_c[i][j] = std::fabs(c[i][j]) + eps;
-            }
-        t = a.axes * (p.r * b.center + p.t - a.center);
     }
 };
 
