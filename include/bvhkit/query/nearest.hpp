@@ -8,7 +8,8 @@
 // walk ends when the nearest node left is. Popping a node descends straight into its nearer child
 // and only queues the farther one, which halves the heap traffic. The heap lives in a
 // NearestScratch the caller keeps (one per thread), so queries allocate nothing once it has grown.
-// A distance functor may also offer prefetch(slot), called for each leaf the walk will open.
+// A distance functor may also offer prefetch(slot), called for each leaf within the radius when
+// it is first seen (the walk may open it later).
 //
 // The primitive's distance is the caller's: `distance(slot, point, bound)` returns the squared
 // distance from `point` to the primitive in leaf slot `slot` (bvh.primitive_indices[slot] is the

@@ -35,8 +35,8 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
         T t_entry;
     };
     // One stack for all eight octant instances, outside them: each with its own 512-byte array,
-    // GCC's stack-frame growth limit stops it from inlining them into the dispatch in a large
-    // file, and the out-of-line walk measured 10-15% slower.
+    // GCC's stack-frame growth limit stopped it from inlining them into the dispatch in a large
+    // file (the bench's), and the out-of-line walk measured 5-6% slower on R1.
     Entry stack[max_bvh_depth];
     slab.with_octant([&](auto octant) {
         constexpr unsigned O = decltype(octant)::value;
@@ -76,15 +76,7 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
                     // node is in the line just tested, so the address costs nothing). For a leaf
                     // `first` is a primitive slot and the address meaningless, which a prefetch
                     // tolerates (it never faults). R1 -3 to -7%, R2 on igea -10%.
-#ifdef PF_LEAF
-                    if constexpr (requires { on_leaf.address(0u); }) {
-                        const auto& nn = nodes[current];
-                        __builtin_prefetch(nn.is_leaf()
-                                               ? on_leaf.address(nn.first)
-                                               : static_cast<const void*>(nodes + nn.first));
-                    } else
-#endif
-                        __builtin_prefetch(nodes + nodes[current].first);
+                    __builtin_prefetch(nodes + nodes[current].first);
                     if (both) __builtin_prefetch(nodes + nodes[left + !right_first].first);
                     continue;
                 }
