@@ -15,7 +15,9 @@
 #include "bvhkit/math/select.hpp"
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
+#include "bvhkit/primitives/triangle_pack.hpp"
 #include "bvhkit/query/nearest.hpp"
+#include "bvhkit/query/nearest_wide.hpp"
 
 namespace bvhkit {
 
@@ -50,8 +52,40 @@ class ClosestPointMesh {
     MeshPoint<T> closest_point(const Vec<T, 3>& p, NearestScratch<T>& scratch,
                                T max_distance_squared = std::numeric_limits<T>::infinity(),
                                Stats&& stats = {}) const {
-        const NearestSlot<T> n = nearest(bvh_, p, distance(), scratch, max_distance_squared, stats);
-        return n ? point_of(n.slot, p) : MeshPoint<T>{};
+        NearestSlot<T> best;
+        T radius2 = max_distance_squared;
+        T search2 = widened(radius2, p);
+        const auto open_leaf = [&](std::uint32_t first, std::uint32_t groups) {
+            for (std::uint32_t g = first; g < first + groups; ++g) {
+                const TrianglePack4<T>& pack = packs_[g];
+                for (int l = 0; l < 4; ++l)
+                    if (pack.slot[l] != invalid_index) stats.primitive();
+                // The pack's distances decide which lanes to measure exactly: Ericson's, so the
+                // answer is the same as testing every triangle with it.
+                for (unsigned m = pack.lanes_within(p, search2); m; m &= m - 1) {
+                    const std::uint32_t s = pack.slot[__builtin_ctz(m)];
+                    const T d2 = length_squared(bvhkit::closest_point(tris_[s], p).point - p);
+                    if (d2 < best.distance_squared && d2 <= radius2) {
+                        best = {s, d2};
+                        radius2 = d2;
+                        search2 = widened(radius2, p);
+                    }
+                }
+            }
+        };
+        struct OpenLeaf {
+            decltype(open_leaf)& open;
+            const TrianglePack4<T>* packs;
+            void operator()(std::uint32_t first, std::uint32_t groups) { open(first, groups); }
+            void prefetch(std::uint32_t first) const {
+                const char* line = reinterpret_cast<const char*>(packs + first);
+                __builtin_prefetch(line);
+                __builtin_prefetch(line + 64);
+                __builtin_prefetch(line + 128);
+            }
+        };
+        nearest_wide(wide_, p, scratch, radius2, OpenLeaf{open_leaf, packs_.data()}, stats);
+        return best ? point_of(best.slot, p) : MeshPoint<T>{};
     }
     MeshPoint<T> closest_point(const Vec<T, 3>& p) const {
         thread_local NearestScratch<T> scratch;
@@ -109,6 +143,27 @@ class ClosestPointMesh {
         // slot's third corner reaching one float past its triangle.
         tris_.push_back(Triangle<T>{});
         triangle_count_ = tris.size();
+
+        wide_ = collapse_to_wide(bvh_);
+        packs_.assign(wide_.group_count(), TrianglePack4<T>{});
+        for (std::size_t i = 0; i < wide_.group_slots.size(); ++i)
+            if (const std::uint32_t s = wide_.group_slots[i]; s != invalid_index)
+                packs_[i / 4].set(int(i % 4), tris_[s], s);
+        magnitude_ = 0;
+        if (!bvh_.empty())
+            for (std::size_t a = 0; a < 3; ++a)
+                magnitude_ = std::max({magnitude_, std::abs(bvh_.root().bounds.min[a]),
+                                       std::abs(bvh_.root().bounds.max[a])});
+    }
+    /// The squared radius within which a pack's distance makes a triangle worth measuring
+    /// exactly: the search radius widened by what rounding can put between the pack's formula and
+    /// Ericson's (a few hundred ulps of the lengths involved, with room to spare).
+    T widened(T radius2, const Vec<T, 3>& p) const {
+        if (!(radius2 < std::numeric_limits<T>::infinity())) return radius2;
+        const T scale = std::max({magnitude_, std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
+        const T r = std::sqrt(radius2);
+        const T slack = T(1024) * std::numeric_limits<T>::epsilon() * (r + scale);
+        return (r + slack) * (r + slack);
     }
     /// The squared distance to the triangle in a leaf slot, for nearest().
     struct SlotDistance {
@@ -160,7 +215,10 @@ class ClosestPointMesh {
     }
 
     AabbBvh<T, 3> bvh_;
-    std::vector<Triangle<T>> tris_;  // leaf-slot order, then one of padding
+    std::vector<Triangle<T>> tris_;        // leaf-slot order, then one of padding
+    WideBvh4<T> wide_;                     // bvh_ collapsed, for closest_point
+    std::vector<TrianglePack4<T>> packs_;  // wide_'s leaf groups: triangles four abreast
+    T magnitude_ = 0;                      // the largest coordinate's magnitude, for widened()
     std::size_t triangle_count_ = 0;
 };
 

@@ -1,0 +1,187 @@
+#pragma once
+// TrianglePack4<T>: four triangles side by side (one array per corner and axis), and the squared
+// distance from a point to all four at once: for float on x86 in SSE, with no data-dependent
+// jumps; elsewhere lane by lane from the same code. A best-first nearest query tests most
+// triangles only to reject them, and the branchy closest-point code (Ericson, primitives/
+// closest_point.hpp) mispredicted on most of them; here a leaf's triangles cost one pass.
+//
+// The distance is the least of the three edges' (each the segment's closest point, clamped) and,
+// when the point's projection on the plane falls inside, the distance to the plane. Near an edge
+// a misjudged "inside" changes little: the plane distance is a lower bound there, and the edge's
+// distance differs from the interior one only to second order. Rounding is what the caller's
+// slack must cover (see ClosestPointMesh); slivers, whose plane and "inside" test are
+// ill-conditioned, are flagged in `exact_lanes` so the caller measures them exactly instead.
+#include <cstdint>
+
+#include "bvhkit/math/select.hpp"
+#include "bvhkit/primitives/triangle.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace bvhkit {
+
+namespace pack_detail {
+
+using bvhkit::max_of;
+using bvhkit::min_of;
+
+template <class T>
+inline T select(bool m, T a, T b) {
+    return m ? a : b;
+}
+/// n / d clamped to [0, 1]; 0 when d is 0 (a segment of zero length).
+template <class T>
+inline T ratio01(T n, T d) {
+    return n > T(0) ? (n < d ? n / d : T(1)) : T(0);
+}
+
+#if defined(__SSE2__)
+/// Four float lanes, so the distance below is written once for SSE and scalars.
+struct F4 {
+    __m128 v;
+    F4() = default;
+    F4(__m128 x) : v(x) {}
+    F4(float s) : v(_mm_set1_ps(s)) {}
+};
+struct Mask4 {
+    __m128 v;
+};
+inline F4 operator+(F4 a, F4 b) {
+    return _mm_add_ps(a.v, b.v);
+}
+inline F4 operator-(F4 a, F4 b) {
+    return _mm_sub_ps(a.v, b.v);
+}
+inline F4 operator*(F4 a, F4 b) {
+    return _mm_mul_ps(a.v, b.v);
+}
+inline F4 operator/(F4 a, F4 b) {
+    return _mm_div_ps(a.v, b.v);
+}
+inline Mask4 operator>(F4 a, F4 b) {
+    return {_mm_cmpgt_ps(a.v, b.v)};
+}
+inline Mask4 operator>=(F4 a, F4 b) {
+    return {_mm_cmpge_ps(a.v, b.v)};
+}
+inline Mask4 operator<=(F4 a, F4 b) {
+    return {_mm_cmple_ps(a.v, b.v)};
+}
+inline Mask4 operator&(Mask4 a, Mask4 b) {
+    return {_mm_and_ps(a.v, b.v)};
+}
+// As std::min / std::max: (b < a ? b : a), minps giving its first operand when the test holds.
+inline F4 min_of(F4 a, F4 b) {
+    return _mm_min_ps(b.v, a.v);
+}
+inline F4 max_of(F4 a, F4 b) {
+    return _mm_max_ps(b.v, a.v);
+}
+inline F4 select(Mask4 m, F4 a, F4 b) {
+    return _mm_or_ps(_mm_and_ps(m.v, a.v), _mm_andnot_ps(m.v, b.v));
+}
+inline F4 ratio01(F4 n, F4 d) {
+    // 0 / 0 is NaN, and maxps gives its second operand (0 here) when the first is NaN.
+    return _mm_min_ps(_mm_max_ps(_mm_div_ps(n.v, d.v), _mm_setzero_ps()), _mm_set1_ps(1.0f));
+}
+#endif
+
+/// Squared distance from p to the triangle (a, b, c), each lane its own triangle.
+template <class L>
+inline L triangle_distance_squared(const L a[3], const L b[3], const L c[3], const L p[3]) {
+    const auto dot = [](const L* x, const L* y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
+    L ab[3], ac[3], bc[3], ap[3], bp[3];
+    for (int i = 0; i < 3; ++i) {
+        ab[i] = b[i] - a[i], ac[i] = c[i] - a[i], bc[i] = c[i] - b[i];
+        ap[i] = p[i] - a[i], bp[i] = p[i] - b[i];
+    }
+    const L d1 = dot(ab, ap), d2 = dot(ac, ap);
+    const L aa = dot(ab, ab), cc = dot(ac, ac), ac_ab = dot(ab, ac);
+    // The closest point of the segment from `from` along `edge`, at (p - from) = `rel`.
+    const auto segment = [&](const L* rel, const L* edge, L along, L length2) {
+        const L t = ratio01(along, length2);
+        L s = L(0);
+        for (int i = 0; i < 3; ++i) {
+            const L q = rel[i] - t * edge[i];
+            s = s + q * q;
+        }
+        return s;
+    };
+    const L edges = min_of(min_of(segment(ap, ab, d1, aa), segment(ap, ac, d2, cc)),
+                           segment(bp, bc, dot(bc, bp), dot(bc, bc)));
+    // The projection's barycentrics, times det (Cramer's rule on the 2x2 normal equations).
+    const L det = aa * cc - ac_ab * ac_ab;
+    const L u = cc * d1 - ac_ab * d2, v = aa * d2 - ac_ab * d1;
+    const auto inside = (det > L(0)) & (u >= L(0)) & (v >= L(0)) & (u + v <= det);
+    L n[3];
+    for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3, k = (i + 2) % 3;
+        n[i] = ab[j] * ac[k] - ab[k] * ac[j];
+    }
+    const L h = dot(n, ap);
+    const L plane = h * h / dot(n, n);
+    return select(inside, min_of(edges, plane), edges);
+}
+
+}  // namespace pack_detail
+
+template <class T>
+struct alignas(16) TrianglePack4 {
+    T corner[3][3][4];      // corner[vertex][axis][lane]
+    std::uint32_t slot[4];  // the caller's index of each lane's triangle; invalid_index: empty
+    std::uint32_t exact_lanes = 0;  // bit per lane: a sliver, to be measured exactly by the caller
+
+    TrianglePack4() {
+        for (auto& v : corner)
+            for (auto& a : v)
+                for (T& x : a) x = T(0);
+        for (auto& s : slot) s = invalid_index;
+    }
+
+    void set(int lane, const Triangle<T>& t, std::uint32_t s) {
+        const Vec<T, 3>* v[3] = {&t.p0, &t.p1, &t.p2};
+        for (int k = 0; k < 3; ++k)
+            for (int a = 0; a < 3; ++a) corner[k][a][lane] = (*v[k])[a];
+        slot[lane] = s;
+        // A sliver: sin^2 of its widest angle at p0 below 1e-3, measured in double.
+        const Vec<double, 3> p0(t.p0), ab = Vec<double, 3>(t.p1) - p0,
+                                       ac = Vec<double, 3>(t.p2) - p0;
+        const double aa = dot(ab, ab), cc = dot(ac, ac), m = dot(ab, ac);
+        if (!(aa * cc - m * m > 1e-3 * aa * cc)) exact_lanes |= 1u << lane;
+    }
+
+    /// Bit per lane: a triangle whose squared distance from p is at most `bound`, or a sliver.
+    unsigned lanes_within(const Vec<T, 3>& p, T bound) const {
+        unsigned used = 0;
+        for (int l = 0; l < 4; ++l) used |= unsigned(slot[l] != invalid_index) << l;
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>) {
+            using pack_detail::F4;
+            F4 a[3], b[3], c[3], q[3];
+            for (int i = 0; i < 3; ++i) {
+                a[i] = _mm_load_ps(corner[0][i]), b[i] = _mm_load_ps(corner[1][i]);
+                c[i] = _mm_load_ps(corner[2][i]), q[i] = F4(p[i]);
+            }
+            const F4 d = pack_detail::triangle_distance_squared(a, b, c, q);
+            const unsigned near = unsigned(_mm_movemask_ps(_mm_cmple_ps(d.v, _mm_set1_ps(bound))));
+            return (near | exact_lanes) & used;
+        }
+#endif
+        unsigned near = 0;
+        for (int l = 0; l < 4; ++l) near |= unsigned(distance_squared(l, p) <= bound) << l;
+        return (near | exact_lanes) & used;
+    }
+
+    /// The squared distance of one lane's triangle from p, by the same formula, lane alone.
+    T distance_squared(int lane, const Vec<T, 3>& p) const {
+        T a[3], b[3], c[3], q[3];
+        for (int i = 0; i < 3; ++i)
+            a[i] = corner[0][i][lane], b[i] = corner[1][i][lane], c[i] = corner[2][i][lane],
+            q[i] = p[i];
+        return pack_detail::triangle_distance_squared(a, b, c, q);
+    }
+};
+
+}  // namespace bvhkit

@@ -1,0 +1,113 @@
+#pragma once
+// The best-first nearest walk of nearest.hpp over a WideBvh4: a min-heap of nodes keyed by their
+// squared distance from the point and a search radius that shrinks as closer primitives are
+// found. A node measures its four children at once; leaf children within the radius are opened
+// on the spot (shrinking the radius before the inner children are judged), the nearest inner
+// child is walked into, and the others within the radius wait in the heap.
+//
+// on_leaf(first_group, group_count) opens a leaf child and may lower `radius2`; the optional
+// on_leaf.prefetch(first_group) is asked for ahead of it.
+#include "bvhkit/bvh/wide_bvh.hpp"
+#include "bvhkit/query/nearest.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace bvhkit {
+
+namespace wide_detail {
+
+/// Squared distances from p to the node's child boxes (0 inside) in `d`; returns a bit per
+/// child that exists and lies within `radius2`.
+template <class T>
+[[gnu::always_inline]] inline unsigned children_within(const WideNode4<T>& node, const Vec<T, 3>& p,
+                                                       T radius2, T d[4]) {
+#if defined(__SSE2__)
+    if constexpr (std::is_same_v<T, float>) {
+        __m128 sum = _mm_setzero_ps();
+        for (int a = 0; a < 3; ++a) {
+            const __m128 q = _mm_set1_ps(p[a]);
+            const __m128 gap = _mm_max_ps(_mm_max_ps(_mm_sub_ps(_mm_load_ps(node.lo[a]), q),
+                                                     _mm_sub_ps(q, _mm_load_ps(node.hi[a]))),
+                                          _mm_setzero_ps());
+            sum = _mm_add_ps(sum, _mm_mul_ps(gap, gap));
+        }
+        _mm_storeu_ps(d, sum);
+        const __m128i none = _mm_set1_epi32(-1);  // invalid_index
+        const __m128i child = _mm_load_si128(reinterpret_cast<const __m128i*>(node.child));
+        const int absent = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(child, none)));
+        return unsigned(_mm_movemask_ps(_mm_cmple_ps(sum, _mm_set1_ps(radius2))) & ~absent);
+    }
+#endif
+    unsigned within = 0;
+    for (int c = 0; c < 4; ++c) {
+        T s = 0;
+        for (int a = 0; a < 3; ++a) {
+            const T g = max_of(max_of(node.lo[a][c] - p[a], p[a] - node.hi[a][c]), T(0));
+            s += g * g;
+        }
+        d[c] = s;
+        within |= unsigned(node.has(c) && s <= radius2) << c;
+    }
+    return within;
+}
+
+}  // namespace wide_detail
+
+template <class T, class OnLeaf, class Stats>
+void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>& scratch,
+                  T& radius2, OnLeaf&& on_leaf, Stats&& stats) {
+    if (wide.empty()) return;
+    const WideNode4<T>* nodes = wide.nodes.data();
+    MinHeap4 heap(scratch.heap, [](const NearestEntry<T>& e) { return e.distance_squared; });
+    heap.push({T(0), 0});
+    while (!heap.empty()) {
+        const NearestEntry<T> e = heap.pop();
+        if (e.distance_squared > radius2) break;  // every node left is farther still
+        std::uint32_t current = e.node;
+        while (true) {
+            const WideNode4<T>& node = nodes[current];
+            T d[4];
+            unsigned within = wide_detail::children_within(node, p, radius2, d);
+            for (int c = 0; c < 4; ++c)
+                if (node.has(c)) stats.node();
+            unsigned leaves = 0;
+            for (int c = 0; c < 4; ++c) leaves |= unsigned(node.groups[c] != 0) << c;
+            leaves &= within;
+            // Ask for every child within the radius before opening any: the leaves' triangles
+            // and the inner nodes' two lines load together instead of one after another.
+            for (unsigned m = within; m; m &= m - 1) {
+                const int c = __builtin_ctz(m);
+                if (leaves >> c & 1u) {
+                    if constexpr (requires { on_leaf.prefetch(0u); })
+                        on_leaf.prefetch(node.child[c]);
+                } else {
+                    const char* line = reinterpret_cast<const char*>(nodes + node.child[c]);
+                    __builtin_prefetch(line);
+                    __builtin_prefetch(line + 64);
+                }
+            }
+            for (unsigned m = leaves; m; m &= m - 1) {
+                const int c = __builtin_ctz(m);
+                on_leaf(node.child[c], node.groups[c]);
+            }
+            // The nearest inner child within the (perhaps smaller) radius is next; the others wait.
+            int next = -1;
+            for (unsigned m = within & ~leaves; m; m &= m - 1) {
+                const int c = __builtin_ctz(m);
+                if (d[c] > radius2) continue;
+                if (next < 0 || d[c] < d[next]) {
+                    if (next >= 0) heap.push({d[next], node.child[next]});
+                    next = c;
+                } else {
+                    heap.push({d[c], node.child[c]});
+                }
+            }
+            if (next < 0) break;
+            current = node.child[next];
+        }
+    }
+}
+
+}  // namespace bvhkit
