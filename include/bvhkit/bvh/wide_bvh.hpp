@@ -52,6 +52,7 @@ WideBvh4<T> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limi
     // Primitives under each binary node, children before parents (a reverse preorder).
     std::vector<std::uint32_t> preorder, under(nodes.size(), 0), stack{0};
     preorder.reserve(nodes.size());
+    out.group_slots.reserve(bvh.primitive_indices.size() + bvh.primitive_indices.size() / 2);
     while (!stack.empty()) {
         const std::uint32_t n = stack.back();
         stack.pop_back();
@@ -67,9 +68,10 @@ WideBvh4<T> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limi
     };
 
     // A leaf child: the slots of every binary leaf under n, in groups of four.
+    std::vector<std::uint32_t> todo;
     const auto append_leaf = [&](std::uint32_t n, std::uint32_t& first, std::uint32_t& groups) {
         first = std::uint32_t(out.group_slots.size() / 4);
-        std::vector<std::uint32_t> todo{n};
+        todo.assign(1, n);
         while (!todo.empty()) {
             const auto& b = nodes[todo.back()];
             todo.pop_back();
@@ -86,6 +88,7 @@ WideBvh4<T> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limi
 
     // Work items: (binary node, wide node to fill). Preorder, so a parent precedes its children.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};
+    out.nodes.reserve(nodes.size() / 3 + 1);
     out.nodes.emplace_back();
     while (!work.empty()) {
         const auto [b, w] = work.back();

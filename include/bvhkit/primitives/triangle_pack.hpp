@@ -121,7 +121,7 @@ inline L triangle_distance_squared(const L a[3], const L b[3], const L c[3], con
         n[i] = ab[j] * ac[k] - ab[k] * ac[j];
     }
     const L h = dot(n, ap);
-    const L plane = h * h / dot(n, n);
+    const L plane = h * (h / dot(n, n));  // h * h could overflow where the quotient does not
     return select(inside, min_of(edges, plane), edges);
 }
 
@@ -145,17 +145,29 @@ struct alignas(16) TrianglePack4 {
         for (int k = 0; k < 3; ++k)
             for (int a = 0; a < 3; ++a) corner[k][a][lane] = (*v[k])[a];
         slot[lane] = s;
-        // A sliver: sin^2 of its widest angle at p0 below 1e-3, measured in double.
+        // Measured exactly by the caller: a sliver (sin^2 of its angle at p0 below 1e-3), and a
+        // triangle whose products of four lengths (det below) would near T's overflow or
+        // denormals. Measured in double.
         const Vec<double, 3> p0(t.p0), ab = Vec<double, 3>(t.p1) - p0,
                                        ac = Vec<double, 3>(t.p2) - p0;
         const double aa = dot(ab, ab), cc = dot(ac, ac), m = dot(ab, ac);
-        if (!(aa * cc - m * m > 1e-3 * aa * cc)) exact_lanes |= 1u << lane;
+        const double low = double(std::numeric_limits<T>::min()) * 1e8;
+        const double high = double(std::numeric_limits<T>::max()) * 1e-8;
+        const bool sliver = !(aa * cc - m * m > 1e-3 * aa * cc);
+        const bool out_of_range = !(aa * cc >= low && aa * cc <= high);
+        if (sliver || out_of_range) exact_lanes |= 1u << lane;
+    }
+
+    /// Bit per lane that holds a triangle.
+    unsigned used_lanes() const {
+        unsigned used = 0;
+        for (int l = 0; l < 4; ++l) used |= unsigned(slot[l] != invalid_index) << l;
+        return used;
     }
 
     /// Bit per lane: a triangle whose squared distance from p is at most `bound`, or a sliver.
     unsigned lanes_within(const Vec<T, 3>& p, T bound) const {
-        unsigned used = 0;
-        for (int l = 0; l < 4; ++l) used |= unsigned(slot[l] != invalid_index) << l;
+        const unsigned used = used_lanes();
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>) {
             using pack_detail::F4;

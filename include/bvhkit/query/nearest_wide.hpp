@@ -53,6 +53,20 @@ template <class T>
     return within;
 }
 
+/// A bit per child that is a leaf.
+template <class T>
+[[gnu::always_inline]] inline unsigned leaf_children(const WideNode4<T>& node) {
+#if defined(__SSE2__)
+    const __m128i groups = _mm_load_si128(reinterpret_cast<const __m128i*>(node.groups));
+    const __m128i inner = _mm_cmpeq_epi32(groups, _mm_setzero_si128());
+    return unsigned(~_mm_movemask_ps(_mm_castsi128_ps(inner))) & 15u;
+#else
+    unsigned leaves = 0;
+    for (int c = 0; c < 4; ++c) leaves |= unsigned(node.groups[c] != 0) << c;
+    return leaves;
+#endif
+}
+
 }  // namespace wide_detail
 
 template <class T, class OnLeaf, class Stats>
@@ -72,39 +86,40 @@ void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>
             unsigned within = wide_detail::children_within(node, p, radius2, d);
             for (int c = 0; c < 4; ++c)
                 if (node.has(c)) stats.node();
-            unsigned leaves = 0;
-            for (int c = 0; c < 4; ++c) leaves |= unsigned(node.groups[c] != 0) << c;
-            leaves &= within;
+            const unsigned leaves = wide_detail::leaf_children(node) & within;
             // Ask for every child within the radius before opening any: the leaves' triangles
-            // and the inner nodes' two lines load together instead of one after another.
-            for (unsigned m = within; m; m &= m - 1) {
-                const int c = __builtin_ctz(m);
-                if (leaves >> c & 1u) {
-                    if constexpr (requires { on_leaf.prefetch(0u); })
-                        on_leaf.prefetch(node.child[c]);
-                } else {
-                    const char* line = reinterpret_cast<const char*>(nodes + node.child[c]);
-                    __builtin_prefetch(line);
-                    __builtin_prefetch(line + 64);
-                }
+            // and the inner nodes' lines load together instead of one after another. Without
+            // jumps: a lane out of the radius asks for the node at hand, which is loaded already.
+            for (int c = 0; c < 4; ++c) {
+                const char* line = reinterpret_cast<const char*>(nodes + node.child[c]);
+                if constexpr (requires { on_leaf.address(0u); })
+                    line = leaves >> c & 1u
+                               ? static_cast<const char*>(on_leaf.address(node.child[c]))
+                               : line;
+                line = within >> c & 1u ? line : reinterpret_cast<const char*>(&node);
+                __builtin_prefetch(line);
+                __builtin_prefetch(line + 64);
+                __builtin_prefetch(line + 128);
             }
             for (unsigned m = leaves; m; m &= m - 1) {
                 const int c = __builtin_ctz(m);
                 on_leaf(node.child[c], node.groups[c]);
             }
             // The nearest inner child within the (perhaps smaller) radius is next; the others wait.
-            int next = -1;
-            for (unsigned m = within & ~leaves; m; m &= m - 1) {
+            unsigned inner = within & ~leaves;
+            if (leaves)
+                for (unsigned m = inner; m; m &= m - 1)
+                    inner &= ~(unsigned(d[__builtin_ctz(m)] > radius2) << __builtin_ctz(m));
+            if (!inner) break;
+            int next = __builtin_ctz(inner);
+            for (unsigned m = inner & (inner - 1); m; m &= m - 1) {
                 const int c = __builtin_ctz(m);
-                if (d[c] > radius2) continue;
-                if (next < 0 || d[c] < d[next]) {
-                    if (next >= 0) heap.push({d[next], node.child[next]});
-                    next = c;
-                } else {
-                    heap.push({d[c], node.child[c]});
-                }
+                next = d[c] < d[next] ? c : next;
             }
-            if (next < 0) break;
+            for (unsigned m = inner & ~(1u << next); m; m &= m - 1) {
+                const int c = __builtin_ctz(m);
+                heap.push({d[c], node.child[c]});
+            }
             current = node.child[next];
         }
     }
