@@ -25,7 +25,9 @@ ClosestPoint<T> closest_point(const Triangle<T>& tri, const Vec<T, 3>& p) {
     if (d3 >= T(0) && d4 <= d3) return {tri.p1, T(1), T(0)};  // vertex region p1
 
     const T vc = d1 * d4 - d3 * d2;
-    if (vc <= T(0) && d1 >= T(0) && d3 <= T(0)) {  // edge region p0-p1
+    // d1 - d3 is |ab|^2: an edge p0-p1 of no length (p0 == p1, as rounding can make) has no
+    // region of its own, and the triangle is then the segment p0-p2, handled below.
+    if (vc <= T(0) && d1 >= T(0) && d3 <= T(0) && d1 > d3) {  // edge region p0-p1
         const T s = d1 / (d1 - d3);
         return {tri.p0 + ab * s, s, T(0)};
     }

@@ -154,7 +154,7 @@ void k_nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, std::size_t k, Di
         bvh, p, scratch, [&] { return radius2; },
         [&](std::uint32_t s) {
             const T d2 = distance(s, p, radius2);
-            if (d2 > radius2) return;
+            if (!(d2 <= radius2)) return;  // NaN included
             if (best.size() == k) {
                 if (!(d2 < best.front().first)) return;
                 std::pop_heap(best.begin(), best.end());
