@@ -92,7 +92,9 @@ class ClosestPointMesh {
             decltype(open_leaf)& open;
             const TrianglePack4<T>* packs;
             void operator()(std::uint32_t first, std::uint32_t groups) { open(first, groups); }
-            const void* address(std::uint32_t first) const { return packs + first; }
+            std::uintptr_t address(std::uint32_t first) const {
+                return reinterpret_cast<std::uintptr_t>(packs) + first * sizeof(*packs);
+            }
         };
         nearest_wide(wide_, p, scratch, radius2, OpenLeaf{open_leaf, packs_.data()}, stats);
         return best ? point_of(best.slot, p) : MeshPoint<T>{};

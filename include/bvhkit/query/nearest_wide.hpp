@@ -6,7 +6,7 @@
 // child is walked into, and the others within the radius wait in the heap.
 //
 // on_leaf(first_group, group_count) opens a leaf child and may lower `radius2`; the optional
-// on_leaf.prefetch(first_group) is asked for ahead of it.
+// on_leaf.address(first_group) gives the address of its data (as an integer) to prefetch.
 #include "bvhkit/bvh/wide_bvh.hpp"
 #include "bvhkit/query/nearest.hpp"
 
@@ -90,16 +90,17 @@ void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>
             // Ask for every child within the radius before opening any: the leaves' triangles
             // and the inner nodes' lines load together instead of one after another. Without
             // jumps: a lane out of the radius asks for the node at hand, which is loaded already.
+            // (Addresses are integers here: a lane's index is not always an index into nodes.)
+            const auto node_base = reinterpret_cast<std::uintptr_t>(nodes);
             for (int c = 0; c < 4; ++c) {
-                const char* line = reinterpret_cast<const char*>(nodes + node.child[c]);
+                std::uintptr_t line = node_base + std::uintptr_t(node.child[c]) * sizeof(node);
                 if constexpr (requires { on_leaf.address(0u); })
-                    line = leaves >> c & 1u
-                               ? static_cast<const char*>(on_leaf.address(node.child[c]))
-                               : line;
-                line = within >> c & 1u ? line : reinterpret_cast<const char*>(&node);
-                __builtin_prefetch(line);
-                __builtin_prefetch(line + 64);
-                __builtin_prefetch(line + 128);
+                    line = leaves >> c & 1u ? on_leaf.address(node.child[c]) : line;
+                line = within >> c & 1u ? line : reinterpret_cast<std::uintptr_t>(&node);
+                const char* at = reinterpret_cast<const char*>(line);
+                __builtin_prefetch(at);
+                __builtin_prefetch(at + 64);
+                __builtin_prefetch(at + 128);
             }
             for (unsigned m = leaves; m; m &= m - 1) {
                 const int c = __builtin_ctz(m);
