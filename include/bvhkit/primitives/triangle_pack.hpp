@@ -160,9 +160,15 @@ struct alignas(16) TrianglePack4 {
 
     /// Bit per lane that holds a triangle.
     unsigned used_lanes() const {
+#if defined(__SSE2__)
+        const __m128i none = _mm_set1_epi32(-1);  // invalid_index
+        const __m128i s = _mm_loadu_si128(reinterpret_cast<const __m128i*>(slot));
+        return unsigned(~_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(s, none)))) & 15u;
+#else
         unsigned used = 0;
         for (int l = 0; l < 4; ++l) used |= unsigned(slot[l] != invalid_index) << l;
         return used;
+#endif
     }
 
     /// Bit per lane: a triangle whose squared distance from p is at most `bound`, or a sliver.
