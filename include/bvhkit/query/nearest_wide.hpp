@@ -69,6 +69,8 @@ template <class T>
 
 }  // namespace wide_detail
 
+/// Walks `wide` best first from p while nodes lie within `radius2`, calling on_leaf for each leaf
+/// child within it (see above); stats.node() counts child boxes measured.
 template <class T, class OnLeaf, class Stats>
 void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>& scratch,
                   T& radius2, OnLeaf&& on_leaf, Stats&& stats) {
@@ -83,7 +85,7 @@ void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>
         while (true) {
             const WideNode4<T>& node = nodes[current];
             T d[4];
-            unsigned within = wide_detail::children_within(node, p, radius2, d);
+            const unsigned within = wide_detail::children_within(node, p, radius2, d);
             for (int c = 0; c < 4; ++c)
                 if (node.has(c)) stats.node();
             const unsigned leaves = wide_detail::leaf_children(node) & within;
