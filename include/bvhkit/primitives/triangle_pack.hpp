@@ -192,6 +192,17 @@ struct alignas(16) TrianglePack4 {
         return (near | exact_lanes) & used;
     }
 
+    /// One lane's triangle, times `scale`.
+    Triangle<T> triangle(int lane, T scale = T(1)) const {
+        Triangle<T> t;
+        for (int i = 0; i < 3; ++i) {
+            t.p0[i] = corner[0][i][lane] * scale;
+            t.p1[i] = corner[1][i][lane] * scale;
+            t.p2[i] = corner[2][i][lane] * scale;
+        }
+        return t;
+    }
+
     /// The squared distance of one lane's triangle from p, by the same formula, lane alone.
     T distance_squared(int lane, const Vec<T, 3>& p) const {
         T a[3], b[3], c[3], q[3];

@@ -78,8 +78,12 @@ class ClosestPointMesh {
                 // closest point, so the answer is the one testing every triangle with it gives.
                 const unsigned lanes = scaled_ok ? pack.lanes_within(ps, bound) : pack.used_lanes();
                 for (unsigned m = lanes; m; m &= m - 1) {
-                    const std::uint32_t s = pack.slot[__builtin_ctz(m)];
-                    const T d2 = length_squared(bvhkit::closest_point(tris_[s], p).point - p);
+                    const int l = __builtin_ctz(m);
+                    const std::uint32_t s = pack.slot[l];
+                    // The pack's own copy, in cache already, when it unscales exactly.
+                    const Triangle<T> t =
+                        packs_unscale_exactly_ ? pack.triangle(l, T(1) / pack_scale_) : tris_[s];
+                    const T d2 = length_squared(bvhkit::closest_point(t, p).point - p);
                     if (d2 < best.distance_squared && d2 <= radius2) {
                         best = {s, d2};
                         radius2 = d2;
@@ -166,7 +170,7 @@ class ClosestPointMesh {
                 magnitude = std::max({magnitude, std::abs(bvh_.root().bounds.min[a]),
                                       std::abs(bvh_.root().bounds.max[a])});
         pack_scale_ = magnitude > T(0) && std::isfinite(magnitude)
-                          ? std::ldexp(T(1), -std::ilogb(magnitude))
+                          ? std::ldexp(T(1), std::clamp(-std::ilogb(magnitude), -120, 120))
                           : T(1);
         packs_.assign(wide_.group_count(), TrianglePack4<T>{});
         for (std::size_t i = 0; i < wide_.group_slots.size(); ++i) {
@@ -175,6 +179,17 @@ class ClosestPointMesh {
             const Triangle<T>& t = tris_[s];
             packs_[i / 4].set(int(i % 4),
                               {t.p0 * pack_scale_, t.p1 * pack_scale_, t.p2 * pack_scale_}, s);
+        }
+        // A power of two scales exactly unless a coordinate falls into denormals; then the walk
+        // measures from tris_ instead.
+        packs_unscale_exactly_ = true;
+        for (std::size_t i = 0; i < wide_.group_slots.size(); ++i) {
+            const std::uint32_t s = wide_.group_slots[i];
+            if (s == invalid_index) continue;
+            const Triangle<T> back = packs_[i / 4].triangle(int(i % 4), T(1) / pack_scale_);
+            const Triangle<T>& t = tris_[s];
+            if (!(back.p0 == t.p0 && back.p1 == t.p1 && back.p2 == t.p2))
+                packs_unscale_exactly_ = false;
         }
     }
     /// The squared radius, in pack units, within which a pack's distance makes a triangle worth
@@ -241,6 +256,7 @@ class ClosestPointMesh {
     WideBvh4<T> wide_;                     // bvh_ collapsed, for closest_point
     std::vector<TrianglePack4<T>> packs_;  // wide_'s leaf groups: triangles four abreast
     T pack_scale_ = 1;                     // packs_ hold the triangles times this (a power of 2)
+    bool packs_unscale_exactly_ = true;    // and dividing by it gives tris_ back, bit for bit
     std::size_t triangle_count_ = 0;
 };
 
