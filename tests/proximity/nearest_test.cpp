@@ -383,6 +383,32 @@ TEST(NearestWide, NonFinitePointHasNoClosestPoint) {
     }
 }
 
+TEST(NearestWide, PacksThatDoNotScaleBackExactly) {
+    // One triangle near 1e30 sets the packs' scale to about 2^-100; the small triangles near the
+    // origin (coordinates ~1e-12) then scale into float's denormals and do not come back bit for
+    // bit, so the walk must measure candidates from the triangle array. Every answer must still
+    // equal brute force, to the bit, in the same triangle or an exact tie.
+    auto tris = test::random_soup<float>(test::scaled(400, 5), 53);
+    for (auto& t : tris)
+        for (Vec3f* v : {&t.p0, &t.p1, &t.p2}) *v = *v * 1e-12f;
+    tris.push_back({{1e30f, 0.0f, 0.0f}, {1e30f, 1e29f, 0.0f}, {1e30f, 0.0f, 1e29f}});
+    const ClosestPointMesh<float> mesh(tris);
+    test::Random rng(54);
+    for (std::size_t i = 0; i < test::scaled(500, 5); ++i) {
+        const Vec3f p = rng.unit_vector<float>() * float(1e-12 * rng.uniform(0.0, 2.0));
+        std::uint32_t want_triangle = 0;
+        float want = std::numeric_limits<float>::infinity();
+        for (std::uint32_t k = 0; k < tris.size(); ++k)
+            if (const float d = distance2(tris[k], p); d < want) want = d, want_triangle = k;
+        const auto got = mesh.closest_point(p);
+        ASSERT_TRUE(got) << "point " << i;
+        ASSERT_EQ(got.distance_squared, want) << "point " << i;
+        if (got.triangle != want_triangle) {
+            ASSERT_EQ(distance2(tris[got.triangle], p), want) << "point " << i;
+        }
+    }
+}
+
 TEST(NearestWide, PointBeyondThePackScale) {
     // A mesh of magnitude 1e-25 and a point at 1e15: the point scaled as the packs are (by about
     // 1e25) is not finite in float, so every triangle is measured exactly. Still the brute-force
