@@ -409,6 +409,29 @@ TEST(NearestWide, PacksThatDoNotScaleBackExactly) {
     }
 }
 
+// A review's case: Ericson's rounded closest point lies an ulp outside the triangle's box, so its
+// distance (2^-50) is below the box's (2^-48). Pruning boxes against the plain radius lost it;
+// they are pruned against the widened one, in closest_point, k_nearest and within_radius alike.
+TEST(NearestWide, EricsonsPointOutsideTheBox) {
+    const Trianglef t{{-0x1.3cb95ap+0f, -0x1.8b6328p+0f, -0x1.e2826cp-2f},
+                      {-0x1.82e3eap-1f, -0x1.7ebba4p+0f, -0x1.8047d8p+0f},
+                      {-0x1.eeb6c8p-1f, 0x1.ecd2f8p-3f, 0x1.11ef44p-2f}};
+    const Vec3f p{-0x1.eeb6c8p-1f, 0x1.ecd3p-3f, 0x1.11ef3ep-2f};
+    const float ericson = distance2(t, p);
+    ASSERT_LT(ericson, t.bounds().distance_squared(p));  // the premise
+    const ClosestPointMesh<float> one(std::vector<Trianglef>{t});
+    NearestScratch<float> scratch;
+    const auto got = one.closest_point(p, scratch, 0x1p-49f);
+    ASSERT_TRUE(got);
+    EXPECT_EQ(got.distance_squared, ericson);
+    std::vector<MeshPoint<float>> out;
+    one.k_nearest(p, 1, out, scratch);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].distance_squared, ericson);
+    one.within_radius(p, std::sqrt(0x1p-49f), out);
+    EXPECT_EQ(out.size(), 1u);
+}
+
 TEST(NearestWide, PointBeyondThePackScale) {
     // A mesh of magnitude 1e-25 and a point at 1e15: the point scaled as the packs are (by about
     // 1e25) is not finite in float, so every triangle is measured exactly. Still the brute-force

@@ -11,6 +11,7 @@
 
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/primitives/triangle_pack.hpp"
+#include "bvhkit/query/closest_point_mesh.hpp"
 #include "random_geometry.hpp"
 #include "test_support.hpp"
 
@@ -19,11 +20,11 @@ namespace {
 
 enum class Shape {
     Well,           // three random corners
-    SliverAtP0,     // the angle at p0 tiny (sin^2 far below 1e-3): must be flagged
+    SliverAtP0,     // the angle at p0 tiny (sin^2 far below 1e-2): must be flagged
     FlatAtP0,       // the angle at p0 near 180 degrees: must be flagged
     NeedleAtP1,     // the tiny angle at p1, a moderate one at p0: not a sliver by the rule
     NeedleAtP2,     // the tiny angle at p2
-    NearThreshold,  // sin^2 of the angle at p0 in [2e-3, 1e-2]: not flagged, poorly conditioned
+    NearThreshold,  // sin^2 of the angle at p0 in [1.2e-2, 5e-2]: not flagged, poorly conditioned
     Collinear,      // p2 on the line through p0 and p1
     ZeroEdge,       // two corners equal
     AllEqual,       // a point
@@ -68,7 +69,7 @@ Triangle<T> make_triangle(Shape shape, const Vec3d& centre, double size, test::R
             break;
         }
         case Shape::NearThreshold: {
-            const double s = std::sqrt(rng.uniform(2e-3, 1e-2));  // sin of the angle at p0
+            const double s = std::sqrt(rng.uniform(1.2e-2, 5e-2));  // sin of the angle at p0
             b = a + u * (size * rng.uniform(0.3, 1));
             c = a + (u * std::sqrt(1 - s * s) * (rng.uniform() < 0.5 ? 1 : -1) + w * s) *
                         (size * rng.uniform(0.3, 1));
@@ -146,27 +147,30 @@ Vec<T, 3> query_point(const Triangle<T>& t, double size, bool near, test::Random
 /// to a corner (it also bounds every edge); then dot and cross products. The plane distance is
 /// h / |n| with n = ab x ac, |n| = |ab| |ac| sin A: n's components carry ~2 eps |ab| |ac| each
 /// (3.5 in length), the dot product h = n . ap another ~3 eps |n| |ap|, ap one eps |ap|; so the
-/// distance errs by up to ~8 eps S / sin A to first order. An "inside" misjudged near an edge moves
-/// the answer by the barycentric error, a few eps |ab| / sin A; the edge terms carry a few eps S.
-/// So E = K eps S / sin A with K = 16, twice the first-order bound (the worst measured over many
-/// seeds: ~1 eps S / sin A in float, ~5 in double far from the origin). With sin A >= sqrt(1e-3)
-/// for an unflagged lane, E <= 506 eps S: half the slack ClosestPointMesh widens its radius by
-/// (1024 eps (r + coordinate scale)), so a pack that passes cannot make the mesh miss a triangle.
-/// A wrong formula (a sign, a missing term, a wrong clamp) errs by a fraction of the size, orders
-/// of magnitude above E.
-/// In squared terms: |pack - ref| <= 2 E sqrt(ref) + E^2, plus 1e-6 ref for the roundings of the
-/// squares. (A plain relative bound such as 1e-4 ref does not fit: the error of the distance is
-/// absolute, ~eps S, so the relative error of its square grows as eps S / d near the surface; the
-/// E^2 term plays the part of an absolute term in S^2, here ~(16 eps / sin A)^2 S^2 ~ 4e-12 S^2
-/// for float, far tighter than 1e-9 S^2.)
+/// distance errs by up to ~8 eps S / sin A to first order. An "inside" misjudged near the edge
+/// p1-p2 is worse: Cramer's rule divides by det = |ab|^2 |ac|^2 sin^2 A, so the barycentrics err
+/// by ~eps S / (|ab| sin^2 A), and for a point near the plane the edge's distance returned instead
+/// is larger by that much times the edge's length: first order, ~eps S / sin^2 A (a review found
+/// a thin triangle at sin^2 A = 1e-3 past 1024 eps S). So E = 16 eps S / sin A + 4 eps S / sin^2 A
+/// (the worst measured by the review at sin^2 A >= 1e-2: ~1.5 eps S / sin^2 A). With sin^2 A >=
+/// 1e-2 for an unflagged lane, E <= 560 eps S, within the slack ClosestPointMesh widens its radius
+/// by (1024 eps (r + coordinate scale)), so a pack that passes cannot make the mesh miss a
+/// triangle. A wrong formula (a sign, a missing term, a wrong clamp) errs by a fraction of the
+/// size, orders of magnitude above E. In squared terms: |pack - ref| <= 2 E sqrt(ref) + E^2, plus
+/// 1e-6 ref for the roundings of the squares. (A plain relative bound such as 1e-4 ref does not
+/// fit: the error of the distance is absolute, ~eps S, so the relative error of its square grows as
+/// eps S / d near the surface; the E^2 term plays the part of an absolute term in S^2, at most
+/// ~(560 eps)^2 S^2 ~ 4.4e-9 S^2 for float at the sliver cut, and far less for well-shaped
+/// triangles.)
 template <class T>
 double tolerance(const Triangle<T>& t, const Vec<T, 3>& p, double ref) {
     const Triangle<double> d = widen(t);
     const Vec3d q(p);
     const double s = std::sqrt(
         std::max({length_squared(d.p0 - q), length_squared(d.p1 - q), length_squared(d.p2 - q)}));
-    const double sin_a = std::sqrt(std::max(sin2_at_p0(d), 1e-3));
-    const double e = 16.0 * double(std::numeric_limits<T>::epsilon()) * s / sin_a;
+    const double sin2_a = std::max(sin2_at_p0(d), 1e-2);
+    const double eps = double(std::numeric_limits<T>::epsilon());
+    const double e = 16.0 * eps * s / std::sqrt(sin2_a) + 4.0 * eps * s / sin2_a;
     return 2 * e * std::sqrt(ref) + e * e + 1e-6 * ref;
 }
 
@@ -194,7 +198,7 @@ void check_packs(double size, const Vec3d& offset, std::size_t pack_count, std::
             pack.set(l, tris[l], std::uint32_t(100 + l));
             ASSERT_EQ(pack.slot[l], std::uint32_t(100 + l));
             used |= 1u << l;
-            // The flag: set below sin^2 = 1e-3; clear above it for a triangle whose products of
+            // The flag: set below sin^2 = 1e-2; clear above it for a triangle whose products of
             // four lengths (aa * cc) lie well inside T's range (set() also flags those near
             // overflow or denormals). Margins for the rounding.
             const Triangle<double> wide = widen(tris[l]);
@@ -204,10 +208,10 @@ void check_packs(double size, const Vec3d& offset, std::size_t pack_count, std::
             const bool in_range = aacc > double(std::numeric_limits<T>::min()) * 1e10 &&
                                   aacc < double(std::numeric_limits<T>::max()) * 1e-10;
             const bool flagged = pack.exact_lanes >> l & 1u;
-            if (s2 < 0.9e-3) {
+            if (s2 < 0.9e-2) {
                 ASSERT_TRUE(flagged) << "shape " << int(shape) << " sin^2 " << s2;
             }
-            if (s2 > 1.1e-3 && in_range) {
+            if (s2 > 1.1e-2 && in_range) {
                 ASSERT_FALSE(flagged) << "shape " << int(shape) << " sin^2 " << s2;
             }
             // Equal corners stay equal when rounded: always a sliver. (A thin or collinear one
@@ -397,6 +401,62 @@ TEST(TrianglePack, LanesAreIndependent) {
             ASSERT_FALSE(pack.lanes_within(p, d * (1 - 1e-6f)) >> l & 1u);
         }
     }
+}
+
+// A review's counterexample to the first sliver cut (sin^2 = 1e-3): a triangle pointed at p0,
+// just thin enough to pass a cut at 1e-3, and points on its plane just inside the edge p1-p2,
+// where the inside test's error (growing as 1/sin^2 of the angle at p0) made the pack return the
+// edge's distance, thousands of ulps above the plane's. At sin^2 >= 1e-2 lanes stay unflagged
+// only where the pack is within tolerance; thinner ones must be flagged.
+TEST(TrianglePack, ThinTriangleNearItsFarEdge) {
+    test::Random rng(77);
+    for (int k = 0; k < 2000; ++k) {
+        const double aim = rng.uniform(2e-4, 3e-2);  // about sin^2 of the angle at p0
+        const double s = std::sqrt(aim), c = std::sqrt(1 - aim);
+        const double len = rng.uniform(0.5, 2.0);
+        const Trianglef t{{0.0f, 0.0f, 0.0f},
+                          {float(len), 0.0f, 0.0f},
+                          {float(len * c * rng.uniform(0.9, 1.1)), float(len * s), 0.0f}};
+        const double s2 = sin2_at_p0(widen(t));
+        TrianglePack4<float> pack;
+        pack.set(0, t, 0);
+        const bool flagged = pack.exact_lanes & 1u;
+        if (s2 < 0.9e-2) {
+            ASSERT_TRUE(flagged) << "sin^2 " << s2;
+            continue;
+        }
+        // A point inside, near the edge p1-p2 (up to 0.2% of the way to p0), a hair above the
+        // plane: where the inside test's error band lies.
+        const double w = rng.uniform(0.0, 1.0);
+        const Vec3d on_edge = Vec3d(t.p1) * (1 - w) + Vec3d(t.p2) * w;
+        const Vec3d q = on_edge * (1 - 2e-3 * rng.uniform()) + Vec3d(0, 0, 1e-7 * rng.uniform());
+        const Vec3f p(q);
+        const double ref = reference(t, p);
+        const double d = double(pack.distance_squared(0, p));
+        ASSERT_LE(std::abs(d - ref), tolerance(t, p, ref))
+            << "sin^2 " << s2 << " pack " << d << " ref " << ref;
+    }
+}
+
+// The review's triangle itself (sin^2 at p0 = 1.007e-3) and its point, 3.4e-8 from the interior
+// and 2.4e-4 from the edge p1-p2: with the cut at 1e-3 the pack said 2.4e-4 and the mesh found
+// nothing within Ericson's own distance.
+TEST(TrianglePack, ReviewedThinTriangle) {
+    const Trianglef t{{0x1.9327aap-3f, 0x1.acc892p-3f, -0x1.b4e702p-1f},
+                      {-0x1.247606p-1f, -0x1.b43016p-2f, -0x1.2a507ep-3f},
+                      {-0x1.2b9154p-1f, -0x1.91c544p-2f, -0x1.0e9a3ep-3f}};
+    const Vec3f p{-0x1.2a893cp-1f, -0x1.9645f8p-2f, -0x1.129becp-3f};
+    const float ericson = length_squared(closest_point(t, p).point - p);
+    const ClosestPointMesh<float> one(std::vector<Trianglef>{t});
+    NearestScratch<float> scratch;
+    const auto got = one.closest_point(p, scratch, ericson);
+    ASSERT_TRUE(got);
+    EXPECT_EQ(got.distance_squared, ericson);
+    // With a point triangle a little farther than it, and no search limit.
+    Vec3f x = p;
+    x[2] += std::sqrt(ericson) * 1.0001f;
+    const ClosestPointMesh<float> two(std::vector<Trianglef>{t, {x, x, x}});
+    EXPECT_EQ(two.closest_point(p, scratch).triangle, 0u);
 }
 
 }  // namespace

@@ -63,12 +63,15 @@ class ClosestPointMesh {
                                Stats&& stats = {}) const {
         if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) return {};
         NearestSlot<T> best;
+        // radius2 accepts (Ericson's distance must be within it); search2, radius2 widened by
+        // what rounding can put between Ericson's distance and any bound on it, prunes boxes and
+        // packs. The packs hold the mesh scaled to unit magnitude (see build): p likewise.
         T radius2 = max_distance_squared;
-        // The packs hold the mesh scaled to unit magnitude (see build): p and the bound likewise.
+        const T magnitude = std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
+        T search2 = widened(radius2, magnitude);
         const Vec<T, 3> ps = p * pack_scale_;
         const bool scaled_ok = std::isfinite(ps[0]) && std::isfinite(ps[1]) && std::isfinite(ps[2]);
-        const T ps_magnitude = std::max({std::abs(ps[0]), std::abs(ps[1]), std::abs(ps[2])});
-        T bound = pack_bound(radius2, ps_magnitude);
+        const T scale2 = pack_scale_ * pack_scale_;
         const auto open_leaf = [&](std::uint32_t first, std::uint32_t groups) {
             for (std::uint32_t g = first; g < first + groups; ++g) {
                 const TrianglePack4<T>& pack = packs_[g];
@@ -76,7 +79,8 @@ class ClosestPointMesh {
                     if (pack.slot[l] != invalid_index) stats.primitive();
                 // The pack's distances decide which lanes to measure exactly, with Ericson's
                 // closest point, so the answer is the one testing every triangle with it gives.
-                const unsigned lanes = scaled_ok ? pack.lanes_within(ps, bound) : pack.used_lanes();
+                const unsigned lanes =
+                    scaled_ok ? pack.lanes_within(ps, search2 * scale2) : pack.used_lanes();
                 for (unsigned m = lanes; m; m &= m - 1) {
                     const int l = __builtin_ctz(m);
                     const std::uint32_t s = pack.slot[l];
@@ -87,7 +91,7 @@ class ClosestPointMesh {
                     if (d2 < best.distance_squared && d2 <= radius2) {
                         best = {s, d2};
                         radius2 = d2;
-                        bound = pack_bound(radius2, ps_magnitude);
+                        search2 = widened(radius2, magnitude);
                     }
                 }
             }
@@ -100,7 +104,7 @@ class ClosestPointMesh {
                 return reinterpret_cast<std::uintptr_t>(packs) + first * sizeof(*packs);
             }
         };
-        nearest_wide(wide_, p, scratch, radius2, OpenLeaf{open_leaf, packs_.data()}, stats);
+        nearest_wide(wide_, p, scratch, search2, OpenLeaf{open_leaf, packs_.data()}, stats);
         return best ? point_of(best.slot, p) : MeshPoint<T>{};
     }
     MeshPoint<T> closest_point(const Vec<T, 3>& p) const {
@@ -161,17 +165,21 @@ class ClosestPointMesh {
         triangle_count_ = tris.size();
 
         wide_ = collapse_to_wide(bvh_);
-        // The packs hold the triangles scaled by a power of two (exactly, barring overflow) that
-        // brings the largest coordinate to [1, 2): the pack formula's products of four lengths
-        // then neither overflow nor sink into denormals, for meshes in any unit.
+        // The packs hold the triangles scaled by a power of two (exact, barring denormals) that
+        // brings the largest coordinate to [1, 2) (for all but meshes within a few binades of
+        // T's range): the pack formula's products of four lengths then neither overflow nor
+        // sink into denormals, for meshes in any unit.
         T magnitude = 0;
         if (!bvh_.empty())
             for (std::size_t a = 0; a < 3; ++a)
                 magnitude = std::max({magnitude, std::abs(bvh_.root().bounds.min[a]),
                                       std::abs(bvh_.root().bounds.max[a])});
-        pack_scale_ = magnitude > T(0) && std::isfinite(magnitude)
-                          ? std::ldexp(T(1), std::clamp(-std::ilogb(magnitude), -120, 120))
-                          : T(1);
+        magnitude_ = magnitude;
+        constexpr int max_shift = std::numeric_limits<T>::max_exponent - 8;
+        pack_scale_ =
+            magnitude > T(0) && std::isfinite(magnitude)
+                ? std::ldexp(T(1), std::clamp(-std::ilogb(magnitude), -max_shift, max_shift))
+                : T(1);
         packs_.assign(wide_.group_count(), TrianglePack4<T>{});
         for (std::size_t i = 0; i < wide_.group_slots.size(); ++i) {
             const std::uint32_t s = wide_.group_slots[i];
@@ -192,31 +200,38 @@ class ClosestPointMesh {
                 packs_unscale_exactly_ = false;
         }
     }
-    /// The squared radius, in pack units, within which a pack's distance makes a triangle worth
-    /// measuring exactly: the search radius widened by what rounding can put between the pack's
-    /// formula and Ericson's (a few hundred ulps of the lengths involved, with room to spare; the
-    /// mesh's magnitude is below 2 in pack units).
-    T pack_bound(T radius2, T point_magnitude) const {
-        if (!(radius2 < std::numeric_limits<T>::infinity())) return radius2;
-        const T r = std::sqrt(radius2) * pack_scale_;
-        const T slack = T(1024) * std::numeric_limits<T>::epsilon() * (r + T(2) + point_magnitude);
+    /// `radius2` widened by what rounding can put between Ericson's distance to a triangle and
+    /// any bound on it: the pack's distance, the triangle's box, a node's box (Ericson's point can
+    /// land an ulp outside the triangle's box). 1024 ulps of the lengths involved: the largest
+    /// gap measured between a pack's distance and Ericson's was ~150 ulps on triangles that are
+    /// not flagged as slivers. `point_magnitude` is the query point's largest |coordinate|.
+    T widened(T radius2, T point_magnitude) const {
+        if (!(radius2 > T(0) && radius2 < std::numeric_limits<T>::infinity())) return radius2;
+        const T r = std::sqrt(radius2);
+        const T slack =
+            T(1024) * std::numeric_limits<T>::epsilon() * (r + magnitude_ + point_magnitude);
         return (r + slack) * (r + slack);
     }
     /// The squared distance to the triangle in a leaf slot, for nearest().
     struct SlotDistance {
+        const ClosestPointMesh* mesh;
         const Triangle<T>* tris;
         T operator()(std::uint32_t slot, const Vec<T, 3>& p, T bound) const {
             const Triangle<T>& t = tris[slot];
             // The triangle's box is a cheap lower bound: most triangles of a leaf fail it.
             const T box_d2 = box_distance_squared(t, p);
-            if (box_d2 > bound) return box_d2;
+            if (box_d2 > widen(p, bound)) return box_d2;
             return length_squared(bvhkit::closest_point(t, p).point - p);
+        }
+        /// The bound the walks prune boxes with: see widened().
+        T widen(const Vec<T, 3>& p, T bound) const {
+            return mesh->widened(bound, std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}));
         }
         /// Asks for a leaf's first triangle ahead of time (nearest() calls it for leaves it will
         /// open later).
         void prefetch(std::uint32_t slot) const { __builtin_prefetch(tris + slot); }
     };
-    SlotDistance distance() const { return {tris_.data()}; }
+    SlotDistance distance() const { return {this, tris_.data()}; }
     /// Squared distance from p to the triangle's box. For float on x86 in SSE: each corner is one
     /// 4-float load (the fourth lane, the next coordinate, masked off), ~15 instructions where the
     /// scalar form takes ~100 (measured: a fifth of an N1 query).
@@ -255,6 +270,7 @@ class ClosestPointMesh {
     std::vector<Triangle<T>> tris_;        // leaf-slot order, then one of padding
     WideBvh4<T> wide_;                     // bvh_ collapsed, for closest_point
     std::vector<TrianglePack4<T>> packs_;  // wide_'s leaf groups: triangles four abreast
+    T magnitude_ = 0;                      // the mesh's largest |coordinate|
     T pack_scale_ = 1;                     // packs_ hold the triangles times this (a power of 2)
     bool packs_unscale_exactly_ = true;    // and dividing by it gives tris_ back, bit for bit
     std::size_t triangle_count_ = 0;

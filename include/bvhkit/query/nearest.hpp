@@ -15,7 +15,9 @@
 // distance from `point` to the primitive in leaf slot `slot` (bvh.primitive_indices[slot] is the
 // caller's index), or any value above `bound` when it is farther than `bound` (so a cheap test
 // can reject it without the exact distance). ClosestPointMesh (closest_point_mesh.hpp) supplies it
-// for triangles.
+// for triangles. A functor whose rounded distances can fall below the boxes' (Ericson's closest
+// point can land an ulp outside the triangle's box) offers widen(point, bound): the walks then
+// prune boxes against that larger bound, and accept primitives against the bound itself.
 #include <algorithm>
 #include <limits>
 #include <vector>
@@ -51,6 +53,15 @@ struct NearestSlot {
 };
 
 namespace nearest_detail {
+
+/// The squared radius to prune boxes with, for a search radius of `radius2`.
+template <class Distance, class T, std::size_t N>
+T prune_radius2(const Distance& distance, const Vec<T, N>& p, T radius2) {
+    if constexpr (requires { distance.widen(p, radius2); })
+        return distance.widen(p, radius2);
+    else
+        return radius2;
+}
 
 /// The best-first walk. `radius2()` is the current squared search radius (it shrinks as
 /// on_slot(slot, d2) finds closer primitives).
@@ -135,7 +146,8 @@ NearestSlot<T> nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, Distance&
         }
     };
     nearest_detail::best_first(
-        bvh, p, scratch, [&] { return radius2; }, OnSlot{distance, p, best, radius2}, stats);
+        bvh, p, scratch, [&] { return nearest_detail::prune_radius2(distance, p, radius2); },
+        OnSlot{distance, p, best, radius2}, stats);
     return best;
 }
 
@@ -151,7 +163,7 @@ void k_nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, std::size_t k, Di
     best.clear();
     T radius2 = max_distance_squared;
     nearest_detail::best_first(
-        bvh, p, scratch, [&] { return radius2; },
+        bvh, p, scratch, [&] { return nearest_detail::prune_radius2(distance, p, radius2); },
         [&](std::uint32_t s) {
             const T d2 = distance(s, p, radius2);
             if (!(d2 <= radius2)) return;  // NaN included
@@ -176,9 +188,10 @@ bool within_radius(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, T radius, Dis
                    OnFound&& on_found, Stats&& stats = {}) {
     if (bvh.empty()) return true;
     const T r2 = radius * radius;
+    const T prune2 = nearest_detail::prune_radius2(distance, p, r2);
     const auto* nodes = bvh.nodes.data();
     stats.node();
-    if (nodes[0].bounds.distance_squared(p) > r2) return true;
+    if (nodes[0].bounds.distance_squared(p) > prune2) return true;
     std::uint32_t stack[max_bvh_depth];
     std::uint32_t size = 0, current = 0;
     while (true) {
@@ -193,8 +206,8 @@ bool within_radius(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, T radius, Dis
             const std::uint32_t l = node.left();
             stats.node();
             stats.node();
-            const bool hl = nodes[l].bounds.distance_squared(p) <= r2;
-            const bool hr = nodes[l + 1].bounds.distance_squared(p) <= r2;
+            const bool hl = nodes[l].bounds.distance_squared(p) <= prune2;
+            const bool hr = nodes[l + 1].bounds.distance_squared(p) <= prune2;
             if (hl || hr) {
                 if (hl && hr) stack[size++] = l + 1;
                 current = hl ? l : l + 1;
