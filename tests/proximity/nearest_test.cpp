@@ -432,6 +432,42 @@ TEST(NearestWide, EricsonsPointOutsideTheBox) {
     EXPECT_EQ(out.size(), 1u);
 }
 
+// Points on the mesh (its corners, and points on faces and edges), searched with a radius equal
+// to the brute-force distance, often exactly 0: the answer must be found. The pack's rounded
+// distance there may be above Ericson's, so the widening must not skip a zero radius.
+TEST(NearestWide, RadiusEqualToTheDistanceFindsIt) {
+    for (const float offset : {0.0f, 1000.0f}) {
+        auto tris = test::random_soup<float>(test::scaled(300, 3), 55);
+        for (auto& t : tris)
+            for (Vec3f* v : {&t.p0, &t.p1, &t.p2}) *v = *v + Vec3f(offset);
+        const ClosestPointMesh<float> mesh(tris);
+        NearestScratch<float> scratch;
+        std::vector<MeshPoint<float>> out;
+        test::Random rng(56);
+        std::size_t zeros = 0;
+        for (std::size_t i = 0; i < tris.size(); ++i) {
+            const Trianglef& t = tris[i];
+            const float a = float(rng.uniform()), b = float(rng.uniform()) * (1 - a);
+            const Vec3f on_edge = t.p0 + (t.p1 - t.p0) * a;
+            for (const Vec3f& p : {t.p0, t.p1 + Vec3f(0.0f), on_edge,
+                                   t.p0 + (t.p1 - t.p0) * a + (t.p2 - t.p0) * b}) {
+                float want = std::numeric_limits<float>::infinity();
+                for (const auto& u : tris) want = std::min(want, distance2(u, p));
+                zeros += want == 0.0f;
+                const auto got = mesh.closest_point(p, scratch, want);
+                ASSERT_TRUE(got) << "triangle " << i << " offset " << offset << " d2 " << want;
+                EXPECT_EQ(got.distance_squared, want);
+                // (sqrt(want)^2 can round below want: then no triangle is within, rightly.)
+                const float r = std::sqrt(want);
+                if (!(r * r >= want)) continue;
+                mesh.within_radius(p, r, out);
+                EXPECT_FALSE(out.empty()) << "triangle " << i << " offset " << offset;
+            }
+        }
+        EXPECT_GT(zeros, tris.size());  // the premise: many searches with a radius of 0
+    }
+}
+
 TEST(NearestWide, PointBeyondThePackScale) {
     // A mesh of magnitude 1e-25 and a point at 1e15: the point scaled as the packs are (by about
     // 1e25) is not finite in float, so every triangle is measured exactly. Still the brute-force

@@ -206,7 +206,7 @@ class ClosestPointMesh {
     /// gap measured between a pack's distance and Ericson's was ~150 ulps on triangles that are
     /// not flagged as slivers. `point_magnitude` is the query point's largest |coordinate|.
     T widened(T radius2, T point_magnitude) const {
-        if (!(radius2 > T(0) && radius2 < std::numeric_limits<T>::infinity())) return radius2;
+        if (!(radius2 >= T(0) && radius2 < std::numeric_limits<T>::infinity())) return radius2;
         const T r = std::sqrt(radius2);
         const T slack =
             T(1024) * std::numeric_limits<T>::epsilon() * (r + magnitude_ + point_magnitude);
