@@ -468,6 +468,126 @@ TEST(NearestWide, RadiusEqualToTheDistanceFindsIt) {
     }
 }
 
+// Small adversarial meshes against brute force (after the fuzz a review ran): sizes from 1e-10 to
+// 1e9 and offsets up to 1e6; degenerate, duplicate, NaN, nearly flat triangles and shared edges;
+// points far, on corners, on edges, on faces and a hair off them; search radii of infinity, 0,
+// -1, NaN, exactly the brute-force distance and a little above. closest_point must agree with
+// Ericson's closest point on every triangle, bit for bit, on whether there is an answer and on
+// its squared distance.
+template <class T>
+void fuzz_closest_point(std::uint64_t seed) {
+    using V = Vec<T, 3>;
+    test::Random rng(seed);
+    const T inf = std::numeric_limits<T>::infinity();
+    const auto random_vec = [&] {
+        return V(T(rng.uniform(-1, 1)), T(rng.uniform(-1, 1)), T(rng.uniform(-1, 1)));
+    };
+    for (std::size_t trial = 0; trial < test::scaled(60, 3); ++trial) {
+        const std::uint32_t n = 1 + rng.below(200);
+        const T offset = rng.below(3) == 0 ? T(0) : T(std::pow(10.0, int(rng.below(9)) - 2));
+        const T scale = rng.below(4) == 0 ? T(1) : T(std::pow(10.0, int(rng.below(20)) - 10));
+        std::vector<Triangle<T>> tris;
+        for (std::uint32_t i = 0; i < n; ++i) {
+            V a = random_vec() * scale + V(offset);
+            const T size = scale * T(std::pow(10.0, -4 * rng.uniform()));
+            V b = a + random_vec() * size, c = a + random_vec() * size;
+            switch (rng.below(12)) {
+                case 0:
+                    c = a + (b - a) * T(rng.uniform());
+                    break;  // collinear
+                case 1:
+                    b = a;
+                    break;
+                case 2:
+                    b = c = a;
+                    break;
+                case 3:
+                    if (!tris.empty()) {
+                        tris.push_back(tris[rng.below(std::uint32_t(tris.size()))]);
+                        continue;
+                    }
+                    break;
+                case 4:
+                    a[0] = std::numeric_limits<T>::quiet_NaN();
+                    break;
+                case 5:
+                    c = a + (b - a) * T(0.5) + random_vec() * (size * T(1e-3));
+                    break;
+                case 6:
+                    if (!tris.empty()) {
+                        const auto& q = tris[rng.below(std::uint32_t(tris.size()))];
+                        a = q.p1, b = q.p0;  // a shared edge
+                    }
+                    break;
+                default:
+                    break;
+            }
+            tris.push_back({a, b, c});
+        }
+        const ClosestPointMesh<T> mesh(tris);
+        NearestScratch<T> scratch;
+        for (int k = 0; k < 120; ++k) {
+            const auto& q = tris[rng.below(std::uint32_t(tris.size()))];
+            V p;
+            switch (k % 6) {
+                case 0:
+                    p = random_vec() * (scale * T(1.5)) + V(offset);
+                    break;
+                case 1:
+                    p = q.p0;
+                    break;
+                case 2:
+                    p = q.p0 + (q.p1 - q.p0) * T(rng.uniform());
+                    break;
+                default: {
+                    T u = T(rng.uniform()), v = T(rng.uniform());
+                    if (u + v > 1) u = 1 - u, v = 1 - v;
+                    p = q.p0 * (1 - u - v) + q.p1 * u + q.p2 * v +
+                        random_vec() * (scale * T(std::pow(10.0, -8 * rng.uniform())));
+                }
+            }
+            if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) continue;
+            T want = inf;
+            for (const auto& t : tris) want = std::min(want, distance2(t, p));
+            T limit = inf;
+            switch (rng.below(6)) {
+                case 1:
+                    limit = 0;
+                    break;
+                case 2:
+                    limit = -1;
+                    break;
+                case 3:
+                    limit = std::numeric_limits<T>::quiet_NaN();
+                    break;
+                case 4:
+                    limit = want;
+                    break;
+                case 5:
+                    limit = want * T(1.0001);
+                    break;
+                default:
+                    break;
+            }
+            const bool expected = want <= limit && want < inf;
+            const auto got = mesh.closest_point(p, scratch, limit);
+            ASSERT_EQ(bool(got), expected)
+                << "trial " << trial << " point " << k << " want " << want << " limit " << limit;
+            if (got) {
+                ASSERT_EQ(got.distance_squared, want) << "trial " << trial << " point " << k;
+            }
+        }
+    }
+}
+
+TEST(NearestWide, FuzzAgainstBruteForce) {
+    for (std::uint64_t seed : {1, 2, 3}) {
+        SCOPED_TRACE(::testing::Message() << "seed " << seed);
+        fuzz_closest_point<float>(seed);
+        fuzz_closest_point<double>(seed + 100);
+    }
+}
+
 TEST(NearestWide, PointBeyondThePackScale) {
     // A mesh of magnitude 1e-25 and a point at 1e15: the point scaled as the packs are (by about
     // 1e25) is not finite in float, so every triangle is measured exactly. Still the brute-force
