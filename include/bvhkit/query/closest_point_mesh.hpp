@@ -71,7 +71,6 @@ class ClosestPointMesh {
         T search2 = widened(radius2, magnitude);
         const Vec<T, 3> ps = p * pack_scale_;
         const bool scaled_ok = std::isfinite(ps[0]) && std::isfinite(ps[1]) && std::isfinite(ps[2]);
-        const T scale2 = pack_scale_ * pack_scale_;
         const auto open_leaf = [&](std::uint32_t first, std::uint32_t groups) {
             for (std::uint32_t g = first; g < first + groups; ++g) {
                 const TrianglePack4<T>& pack = packs_[g];
@@ -80,7 +79,8 @@ class ClosestPointMesh {
                 // The pack's distances decide which lanes to measure exactly, with Ericson's
                 // closest point, so the answer is the one testing every triangle with it gives.
                 const unsigned lanes =
-                    scaled_ok ? pack.lanes_within(ps, search2 * scale2) : pack.used_lanes();
+                    scaled_ok ? pack.lanes_within(ps, search2 * pack_scale_ * pack_scale_)
+                              : pack.used_lanes();
                 for (unsigned m = lanes; m; m &= m - 1) {
                     const int l = __builtin_ctz(m);
                     const std::uint32_t s = pack.slot[l];
