@@ -5,6 +5,7 @@
 // operand is unpredictable; the geometric tests that clamp and compare on every call
 // (volumes/rss.hpp) measured ~10% faster without those jumps.
 #include <algorithm>
+#include <cstdint>
 #include <type_traits>
 
 #if defined(__SSE2__)
@@ -37,6 +38,20 @@ inline T max_of(T a, T b) {
         return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(b), _mm_set_sd(a)));
 #endif
     return std::max(a, b);
+}
+
+/// A bit per lane i of v[0..3] (16-byte aligned) whose value is x: one SSE compare, for the
+/// four-wide nodes and packs that mark their empty lanes with a sentinel.
+[[gnu::always_inline]] inline unsigned lanes_equal(const std::uint32_t v[4], std::uint32_t x) {
+#if defined(__SSE2__)
+    const __m128i lanes = _mm_load_si128(reinterpret_cast<const __m128i*>(v));
+    const __m128i equal = _mm_cmpeq_epi32(lanes, _mm_set1_epi32(int(x)));
+    return unsigned(_mm_movemask_ps(_mm_castsi128_ps(equal)));
+#else
+    unsigned bits = 0;
+    for (int i = 0; i < 4; ++i) bits |= unsigned(v[i] == x) << i;
+    return bits;
+#endif
 }
 
 /// x limited to [lo, hi] (lo <= hi), as min_of(max_of(x, lo), hi).

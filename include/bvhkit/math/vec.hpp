@@ -103,6 +103,12 @@ constexpr Vec<T, N> max(const Vec<T, N>& a, const Vec<T, N>& b) {
     return r;
 }
 template <class T, std::size_t N>
+Vec<T, N> abs(const Vec<T, N>& a) {
+    Vec<T, N> r;
+    for (std::size_t i = 0; i < N; ++i) r[i] = std::abs(a[i]);
+    return r;
+}
+template <class T, std::size_t N>
 constexpr T min_component(const Vec<T, N>& a) {
     T m = a[0];
     for (std::size_t i = 1; i < N; ++i) m = a[i] < m ? a[i] : m;

@@ -26,7 +26,6 @@ namespace bvhkit {
 
 namespace pack_detail {
 
-using bvhkit::max_of;
 using bvhkit::min_of;
 
 template <class T>
@@ -77,9 +76,6 @@ inline Mask4 operator&(Mask4 a, Mask4 b) {
 // As std::min / std::max: (b < a ? b : a), minps giving its first operand when the test holds.
 inline F4 min_of(F4 a, F4 b) {
     return _mm_min_ps(b.v, a.v);
-}
-inline F4 max_of(F4 a, F4 b) {
-    return _mm_max_ps(b.v, a.v);
 }
 inline F4 select(Mask4 m, F4 a, F4 b) {
     return _mm_or_ps(_mm_and_ps(m.v, a.v), _mm_andnot_ps(m.v, b.v));
@@ -163,17 +159,7 @@ struct alignas(16) TrianglePack4 {
     }
 
     /// Bit per lane that holds a triangle.
-    unsigned used_lanes() const {
-#if defined(__SSE2__)
-        const __m128i none = _mm_set1_epi32(-1);  // invalid_index
-        const __m128i s = _mm_loadu_si128(reinterpret_cast<const __m128i*>(slot));
-        return unsigned(~_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(s, none)))) & 15u;
-#else
-        unsigned used = 0;
-        for (int l = 0; l < 4; ++l) used |= unsigned(slot[l] != invalid_index) << l;
-        return used;
-#endif
-    }
+    unsigned used_lanes() const { return 15u & ~lanes_equal(slot, invalid_index); }
 
     /// Bit per lane: a triangle whose squared distance from p is at most `bound`, or a sliver.
     unsigned lanes_within(const Vec<T, 3>& p, T bound) const {

@@ -8,6 +8,7 @@
 // on_leaf(first_group, group_count) opens a leaf child and may lower `radius2`; the optional
 // on_leaf.address(first_group) gives the address of its data (as an integer) to prefetch.
 #include "bvhkit/bvh/wide_bvh.hpp"
+#include "bvhkit/math/select.hpp"
 #include "bvhkit/query/nearest.hpp"
 
 #if defined(__SSE2__)
@@ -34,10 +35,8 @@ template <class T>
             sum = _mm_add_ps(sum, _mm_mul_ps(gap, gap));
         }
         _mm_storeu_ps(d, sum);
-        const __m128i none = _mm_set1_epi32(-1);  // invalid_index
-        const __m128i child = _mm_load_si128(reinterpret_cast<const __m128i*>(node.child));
-        const int absent = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(child, none)));
-        return unsigned(_mm_movemask_ps(_mm_cmple_ps(sum, _mm_set1_ps(radius2))) & ~absent);
+        return unsigned(_mm_movemask_ps(_mm_cmple_ps(sum, _mm_set1_ps(radius2)))) &
+               ~lanes_equal(node.child, invalid_index);
     }
 #endif
     unsigned within = 0;
@@ -56,15 +55,7 @@ template <class T>
 /// A bit per child that is a leaf.
 template <class T>
 [[gnu::always_inline]] inline unsigned leaf_children(const WideNode4<T>& node) {
-#if defined(__SSE2__)
-    const __m128i groups = _mm_load_si128(reinterpret_cast<const __m128i*>(node.groups));
-    const __m128i inner = _mm_cmpeq_epi32(groups, _mm_setzero_si128());
-    return unsigned(~_mm_movemask_ps(_mm_castsi128_ps(inner))) & 15u;
-#else
-    unsigned leaves = 0;
-    for (int c = 0; c < 4; ++c) leaves |= unsigned(node.groups[c] != 0) << c;
-    return leaves;
-#endif
+    return 15u & ~lanes_equal(node.groups, 0u);
 }
 
 }  // namespace wide_detail
