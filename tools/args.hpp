@@ -1,6 +1,7 @@
 #pragma once
 // A small command-line parser shared by the subcommands: `--name value`, `--flag`, positionals.
 // Unknown options and missing values are errors that name the option.
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <set>
@@ -60,5 +61,11 @@ class Args {
     std::map<std::string, std::string> values_;
     std::vector<std::string> positional_;
 };
+
+/// A command line that cannot run: one error line naming what is wrong, then the usage; exit 2.
+inline int usage_error(const char* command, const std::string& what, const char* help) {
+    std::fprintf(stderr, "bvhkit %s: error: %s\n\n%s", command, what.c_str(), help);
+    return 2;
+}
 
 }  // namespace bvhkit::tools

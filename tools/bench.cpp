@@ -1,4 +1,4 @@
-// `bvhkit bench rays|dynamic|nearest ...`: the same-run comparisons against the peers.
+// `bvhkit bench rays|dynamic|nearest|collide ...`: the same-run comparisons against the peers.
 #include <cstdio>
 #include <filesystem>
 #include <string_view>
@@ -16,7 +16,7 @@ constexpr const char* kRaysHelp =
     R"(usage: bvhkit bench rays [MESH ...] [--json] [--reps N] [--rays N]
                          [--size N] [--builder NAME]
 
-Workload R of BENCHMARKS.md for bvhkit and Embree 3 (when installed), in this process, one thread
+Workload R of docs/workloads.md for bvhkit and Embree 3 (when installed), in this process, one thread
 each: build, R1 (camera rays, SIZE x SIZE), R2 (random rays), R3 (R2 as occlusion queries).
 Times are medians of N repetitions; speedup = Embree ms / bvhkit ms (> 1: bvhkit is faster).
 MESH is a file (OBJ, PLY, STL) or a generator spec such as sphere:subdiv=7; the default is the
@@ -55,7 +55,7 @@ constexpr const char* kNearestHelp =
     R"(usage: bvhkit bench nearest [MESH ...] [--json] [--reps N] [--points N] [--builder NAME]
                             [--scaling]
 
-Workload N1 of BENCHMARKS.md for bvhkit and CGAL 5.5's AABB_tree (when installed), in this process,
+Workload N1 of docs/workloads.md for bvhkit and CGAL 5.5's AABB_tree (when installed), in this process,
 one thread each: closest point, squared distance and triangle for N points uniform in the mesh's
 box grown by 10%. Query times are medians of N interleaved repetitions (bvhkit, CGAL, bvhkit, ...);
 speedup = bvhkit queries/s over CGAL's. Default meshes: the shared bunny and igea when present.
@@ -99,8 +99,8 @@ int bench_command(int argc, char** argv) {
     if (what == "collide") return bench_collide_command(argc - 1, argv + 1);
     if (what == "nearest") return bench_nearest(argc - 1, argv + 1);
     std::fprintf(what == "--help" || what == "-h" ? stdout : stderr,
-                 "usage: bvhkit bench rays|dynamic|nearest [...]   (bvhkit bench rays --help, "
-                 "bvhkit bench dynamic --help, bvhkit bench nearest --help)\n");
+                 "usage: bvhkit bench rays|dynamic|nearest|collide [...]   (bvhkit bench "
+                 "WORKLOAD --help for each)\n");
     return what == "--help" || what == "-h" ? 0 : 2;
 }
 

@@ -1,6 +1,6 @@
 // `bvhkit closest`: the closest point on the user's mesh to each of the user's points, in the
-// BENCHMARKS.md formats (points: 3 float32 each; result: float32 x y z, float32 squared distance,
-// uint32 triangle index per point).
+// docs/workloads.md formats (points: 3 float32 each; result: float32 x y z, float32 squared
+// distance, uint32 triangle index per point).
 #include <chrono>
 #include <cstdio>
 #include <cstring>

@@ -1,5 +1,5 @@
 // `bvhkit collide MESH_A MESH_B --poses FILE --out FILE [--bv ...]` and `bvhkit bench collide`.
-// Poses and results use the binary formats of ../shared/BENCHMARKS.md: a pose is 12 float32 (a
+// Poses and results use the binary formats of docs/workloads.md: a pose is 12 float32 (a
 // row-major rotation, then a translation) placing B in A's frame; a collision result is 5 packed
 // bytes per pose (uint8 collided, uint32 number of intersecting triangle pairs, little-endian).
 #include <cstdio>
@@ -15,6 +15,7 @@
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
+#include "bvhkit/volumes/obb_rss.hpp"
 #include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
 #include "collide_bench.hpp"
@@ -26,7 +27,7 @@ namespace bvhkit::tools {
 namespace {
 
 constexpr const char* kCollideHelp =
-    R"(usage: bvhkit collide MESH_A MESH_B --poses FILE --out FILE [--bv aabb|obb|rss|sphere|kdop18]
+    R"(usage: bvhkit collide MESH_A MESH_B --poses FILE --out FILE [--bv aabb|obb|rss|obbrss|sphere|kdop18]
                       [--rule larger|a|b|simultaneous|by-overlap]
 
 For each pose (12 float32: row-major rotation R, translation t; B placed at x' = R x + t in A's
@@ -63,9 +64,9 @@ constexpr const char* kBenchHelp =
     R"(usage: bvhkit bench collide [MESH ...] [--json] [--reps N] [--poses N] [--distance-poses N]
                              [--seed N]
 
-Workloads C1 and C2 of BENCHMARKS.md: the mesh against a copy of itself under N random rigid
+Workloads C1 and C2 of docs/workloads.md: the mesh against a copy of itself under N random rigid
 poses (C1: yes/no and all-pairs collision) and the distance at the poses where they do not
-collide (C2), for bvhkit with each volume type (aabb, obb, rss, sphere, kdop18) and FCL 0.7
+collide (C2), for bvhkit with each volume type (aabb, obb, rss, obbrss, sphere, kdop18) and FCL 0.7
 (BVHModel<OBBRSS> and <OBB>; FCL has no OBB distance) in this process, one thread each. Times
 are medians of N repetitions interleaved round-robin across the libraries; vs_fcl_best = bvhkit
 queries/s over FCL's best volume type. The agreement of the answers is printed to stderr.
@@ -86,10 +87,13 @@ int collide_command(int argc, char** argv) {
         std::fputs(kCollideHelp, stdout);
         return 0;
     }
-    if (args.positional().size() != 2 || !args.has("--poses") || !args.has("--out")) {
-        std::fputs(kCollideHelp, stderr);
-        return 2;
-    }
+    if (args.positional().size() != 2)
+        return usage_error(
+            "collide",
+            "takes two meshes MESH_A MESH_B, got " + std::to_string(args.positional().size()),
+            kCollideHelp);
+    if (!args.has("--poses") || !args.has("--out"))
+        return usage_error("collide", "--poses FILE and --out FILE are required", kCollideHelp);
     const TriangleMesh ma = load_mesh(args.positional()[0]);
     const TriangleMesh mb = load_mesh(args.positional()[1]);
     const auto poses = read_pose_file(args.value("--poses"));
@@ -102,13 +106,26 @@ int collide_command(int argc, char** argv) {
         collide_all<Obb<float>>(ma, mb, poses, rule, out);
     else if (bv == "rss")
         collide_all<Rss<float>>(ma, mb, poses, rule, out);
+    else if (bv == "obbrss")
+        collide_all<ObbRss<float>>(ma, mb, poses, rule, out);
     else if (bv == "sphere")
         collide_all<Sphere<float>>(ma, mb, poses, rule, out);
     else if (bv == "kdop18")
         collide_all<Kdop<float, 18>>(ma, mb, poses, rule, out);
     else
-        throw Error("--bv: unknown bounding volume '" + bv + "' (aabb, obb, rss, sphere, kdop18)");
+        throw Error("--bv: unknown bounding volume '" + bv +
+                    "' (aabb, obb, rss, obbrss, sphere, kdop18)");
     write_bytes(args.value("--out"), out);
+    std::size_t colliding = 0, pairs = 0;
+    for (std::size_t i = 0; i + 5 <= out.size(); i += 5) {
+        colliding += out[i];
+        std::uint32_t n = 0;
+        for (int k = 0; k < 4; ++k) n |= std::uint32_t(out[i + 1 + k]) << (8 * k);
+        pairs += n;
+    }
+    std::fprintf(
+        stderr, "collide: %zu poses (%s), %zu colliding, %zu intersecting pairs in all; wrote %s\n",
+        poses.size(), bv.c_str(), colliding, pairs, args.value("--out").c_str());
     return 0;
 }
 

@@ -1,8 +1,10 @@
 // `bvhkit distance MESH_A MESH_B --poses FILE --out FILE`: for each pose (12 float32, B placed in
 // A's frame) the float32 distance between the models, or -1 where they collide
-// (../shared/BENCHMARKS.md).
+// (docs/workloads.md).
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 
 #include "args.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
@@ -10,6 +12,7 @@
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
+#include "bvhkit/volumes/obb_rss.hpp"
 #include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
 #include "commands.hpp"
@@ -19,7 +22,7 @@ namespace bvhkit::tools {
 namespace {
 
 constexpr const char* kHelp =
-    R"(usage: bvhkit distance MESH_A MESH_B --poses FILE --out FILE [--bv rss|obb|aabb|sphere|kdop18]
+    R"(usage: bvhkit distance MESH_A MESH_B --poses FILE --out FILE [--bv rss|obbrss|obb|aabb|sphere|kdop18]
 
 For each pose (12 float32: row-major rotation R, translation t; B placed at x' = R x + t in A's
 frame) writes the float32 minimum distance between the two meshes, or -1 where they touch or
@@ -48,10 +51,13 @@ int distance_command(int argc, char** argv) {
         std::fputs(kHelp, stdout);
         return 0;
     }
-    if (args.positional().size() != 2 || !args.has("--poses") || !args.has("--out")) {
-        std::fputs(kHelp, stderr);
-        return 2;
-    }
+    if (args.positional().size() != 2)
+        return usage_error(
+            "distance",
+            "takes two meshes MESH_A MESH_B, got " + std::to_string(args.positional().size()),
+            kHelp);
+    if (!args.has("--poses") || !args.has("--out"))
+        return usage_error("distance", "--poses FILE and --out FILE are required", kHelp);
     const TriangleMesh ma = load_mesh(args.positional()[0]);
     const TriangleMesh mb = load_mesh(args.positional()[1]);
     const auto poses = read_pose_file(args.value("--poses"));
@@ -61,6 +67,8 @@ int distance_command(int argc, char** argv) {
         distance_all<Rss<float>>(ma, mb, poses, out);
     else if (bv == "obb")
         distance_all<Obb<float>>(ma, mb, poses, out);
+    else if (bv == "obbrss")
+        distance_all<ObbRss<float>>(ma, mb, poses, out);
     else if (bv == "aabb")
         distance_all<Aabb3f>(ma, mb, poses, out);
     else if (bv == "sphere")
@@ -68,8 +76,23 @@ int distance_command(int argc, char** argv) {
     else if (bv == "kdop18")
         distance_all<Kdop<float, 18>>(ma, mb, poses, out);
     else
-        throw Error("--bv: unknown bounding volume '" + bv + "' (rss, obb, aabb, sphere, kdop18)");
+        throw Error("--bv: unknown bounding volume '" + bv +
+                    "' (rss, obbrss, obb, aabb, sphere, kdop18)");
     write_bytes(args.value("--out"), out);
+    std::size_t colliding = 0;
+    float nearest = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i + 4 <= out.size(); i += 4) {
+        float d;
+        std::memcpy(&d, out.data() + i, 4);
+        if (d < 0)
+            ++colliding;
+        else
+            nearest = std::min(nearest, d);
+    }
+    std::fprintf(
+        stderr,
+        "distance: %zu poses (%s), %zu colliding, smallest distance of the rest %g; wrote %s\n",
+        poses.size(), bv.c_str(), colliding, nearest, args.value("--out").c_str());
     return 0;
 }
 

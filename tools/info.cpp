@@ -29,13 +29,9 @@ int info_command(int argc, char** argv) {
         return 0;
     }
     if (args.positional().size() != 1) throw Error("info takes one mesh (see --help)");
-    const TriangleMesh mesh = load_mesh(args.positional()[0]);
-    const Aabb3f b = mesh.bounds();
-    if (!args.flag("--json"))
-        std::printf("%s: %zu triangles, %zu vertices, bounds (%g %g %g) - (%g %g %g)\n\n",
-                    args.positional()[0].c_str(), mesh.triangle_count(), mesh.vertices.size(),
-                    b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]);
-
+    // Every option is checked before anything is printed, so an error stands alone.
+    if (args.flag("--all-builders") && args.has("--builder"))
+        throw Error("--builder and --all-builders exclude each other");
     std::vector<std::pair<std::string, BuildOptions>> builders;
     if (args.flag("--all-builders")) {
         builders = all_builder_configurations();
@@ -43,6 +39,13 @@ int info_command(int argc, char** argv) {
         const std::string name = args.value("--builder", "binned-sah");
         builders.emplace_back(name, parse_builder(name));
     }
+    const TriangleMesh mesh = load_mesh(args.positional()[0]);
+    const Aabb3f b = mesh.bounds();
+    if (!args.flag("--json"))
+        std::printf("%s: %zu triangles, %zu vertices, bounds (%g %g %g) - (%g %g %g)\n\n",
+                    args.positional()[0].c_str(), mesh.triangle_count(), mesh.vertices.size(),
+                    b.min[0], b.min[1], b.min[2], b.max[0], b.max[1], b.max[2]);
+
     const std::vector<Ray3f> rays = random_rays(b, 100000, 1);
     std::vector<bench::Row> rows;
     for (const auto& [name, options] : builders) {

@@ -33,7 +33,8 @@ const Subcommand kSubcommands[] = {
 
 void print_usage(std::FILE* out) {
     std::fprintf(out,
-                 "usage: bvhkit SUBCOMMAND [ARGS...]   (bvhkit SUBCOMMAND --help for details)\n\n");
+                 "usage: bvhkit SUBCOMMAND [ARGS...]   (bvhkit SUBCOMMAND --help for details)\n"
+                 "       bvhkit --version\n\n");
     for (const auto& s : kSubcommands) std::fprintf(out, "  %-12s %s\n", s.name, s.summary);
 }
 
@@ -45,8 +46,11 @@ int main(int argc, char** argv) {
         print_usage(argc < 2 ? stderr : stdout);
         return argc < 2 ? 2 : 0;
     }
+    const std::string_view name =
+        std::string_view(argv[1]) == "--version" || std::string_view(argv[1]) == "-V" ? "version"
+                                                                                      : argv[1];
     for (const auto& s : kSubcommands) {
-        if (std::string_view(argv[1]) != s.name) continue;
+        if (name != s.name) continue;
         try {
             return s.run(argc - 1, argv + 1);
         } catch (const bvhkit::Error& e) {

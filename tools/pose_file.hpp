@@ -1,5 +1,5 @@
 #pragma once
-// Pose files (../shared/BENCHMARKS.md): 12 float32 per pose, a row-major 3x3 rotation R then a
+// Pose files (docs/workloads.md): 12 float32 per pose, a row-major 3x3 rotation R then a
 // translation t; and the little-endian byte writer the result files share.
 #include <cstring>
 #include <fstream>

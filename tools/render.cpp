@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "args.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
@@ -16,7 +17,7 @@ namespace bvhkit::tools {
 namespace {
 
 constexpr const char* kHelp =
-    R"(usage: bvhkit render [MESH] -o IMAGE.png [--heatmap] [--size WxH] [--builder NAME]
+    R"(usage: bvhkit render [MESH] -o IMAGE.png [--heatmap [--scale N]] [--size WxH] [--builder NAME]
 
 Renders MESH (a file or a generator spec; default: sphere:subdiv=7,displacement=0.25) through its BVH
 with the camera of workload R1. The default picture is shaded by the surface normal; --heatmap colours
@@ -24,24 +25,97 @@ each pixel by the number of BVH nodes its ray tested, with the scale drawn at th
 
   -o FILE         the PNG to write (required)
   --heatmap       traversal-cost heat map instead of shading
-  --size WxH      image size (default 800x800)
+  --scale N       heat map: a fixed scale whose top is N nodes per ray, so that pictures of
+                  different trees compare (default: the 99.5th percentile of this picture)
+  --turn DEG      turn the mesh by DEG degrees about the vertical axis through its centre
+                  first (the camera stays where workload R1 puts it)
+  --size WxH      image size (default 800x800; at most 4096x4096 pixels in all)
   --builder NAME  builder (default binned-sah; see bvhkit info --all-builders)
 )";
 
+// A picture takes about 48 bytes a pixel while it is traced (the ray, its cost, the colour), so the
+// pixel count is bounded to keep a render under ~1 GB; each side is bounded as the ray sets are.
+constexpr std::uint64_t kMaxPixels = std::uint64_t(1) << 24;  // 4096 x 4096
+
 void parse_size(const std::string& s, std::uint32_t& w, std::uint32_t& h) {
-    unsigned a = 0, b = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(s.c_str(), "%u%c%u%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') ||
-        a < 16 || b < 16 || a > 16384 || b > 16384)
-        throw Error("--size '" + s + "': expected WxH with each side in [16, 16384]");
-    w = a;
-    h = b;
+    const std::string what = "--size '" + s + "': expected WxH with each side in [16, 16384] and " +
+                             "at most " + std::to_string(kMaxPixels) + " pixels in all";
+    const std::size_t x = s.find_first_of("xX");
+    if (x == std::string::npos) throw Error(what);
+    const auto side = [&](const std::string& part) {
+        if (part.empty() || part.size() > 5 ||
+            part.find_first_not_of("0123456789") != std::string::npos)
+            throw Error(what);
+        const unsigned long v = std::stoul(part);
+        if (v < 16 || v > 16384) throw Error(what);
+        return std::uint32_t(v);
+    };
+    w = side(s.substr(0, x));
+    h = side(s.substr(x + 1));
+    if (std::uint64_t(w) * h > kMaxPixels) throw Error(what);
+}
+
+double parse_degrees(const std::string& s) {
+    char* end = nullptr;
+    const double deg = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0' || !std::isfinite(deg) || std::fabs(deg) > 3600)
+        throw Error("--turn '" + s + "': expected degrees in [-3600, 3600]");
+    return deg;
+}
+
+// Turns the mesh about the vertical (y) axis through its box centre, in double.
+void turn_about_vertical(TriangleMesh& mesh, double degrees) {
+    const double a = degrees * 3.14159265358979323846 / 180.0, c = std::cos(a), s = std::sin(a);
+    const Vec3f centre = mesh.bounds().centroid();
+    for (Vec3f& v : mesh.vertices) {
+        const double x = double(v[0]) - centre[0], z = double(v[2]) - centre[2];
+        v[0] = float(centre[0] + c * x + s * z);
+        v[2] = float(centre[2] - s * x + c * z);
+    }
+}
+
+// The heat map's scale bar: ticks at round numbers of nodes per ray, labelled.
+void draw_scale(Image& image, std::uint32_t scale_top, bool fixed) {
+    const std::uint32_t width = image.width, height = image.height;
+    const std::uint32_t bar_top = height - 34, bar_bottom = height - 22;
+    image.fill(0, bar_top - 4, width, height, {20, 20, 24});
+    const std::uint32_t bar_left = 8, bar_width = width - 16;
+    for (std::uint32_t x = bar_left; x < bar_left + bar_width; ++x)
+        image.fill(x, bar_top, x + 1, bar_bottom, heat_colour(double(x - bar_left) / bar_width));
+    const Rgb white{240, 240, 240};
+    // A step of 1, 2 or 5 times a power of ten giving at most five intervals.
+    std::uint32_t step = 1;
+    for (std::uint32_t p = 1; p <= scale_top; p *= 10) {
+        if (scale_top / p <= 5) {
+            step = p;
+            break;
+        }
+        if (scale_top / (2 * p) <= 5) {
+            step = 2 * p;
+            break;
+        }
+        if (scale_top / (5 * p) <= 5) {
+            step = 5 * p;
+            break;
+        }
+    }
+    for (std::uint32_t v = 0; v <= scale_top; v += step) {
+        const std::uint32_t x =
+            bar_left + std::uint32_t(std::uint64_t(bar_width - 1) * v / scale_top);
+        image.fill(x, bar_bottom, x + 1, bar_bottom + 3, white);
+        const std::string label = std::to_string(v);
+        const std::uint32_t w = std::uint32_t(label.size()) * 8;
+        image.text(std::min(x - std::min(x, w / 2), width - w - 4), height - 16, label, white, 2);
+    }
+    const std::string unit =
+        fixed ? "nodes per ray" : "nodes per ray, top at the 99.5th percentile";
+    image.text(bar_left, bar_top - 16, unit, white, 2);
 }
 
 }  // namespace
 
 int render_command(int argc, char** argv) {
-    const Args args(argc, argv, {"-o", "--size", "--builder"}, {"--heatmap"});
+    const Args args(argc, argv, {"-o", "--size", "--builder", "--scale", "--turn"}, {"--heatmap"});
     if (args.help()) {
         std::fputs(kHelp, stdout);
         return 0;
@@ -52,10 +126,14 @@ int render_command(int argc, char** argv) {
         args.positional().empty() ? "sphere:subdiv=7,displacement=0.25" : args.positional()[0];
     std::uint32_t width = 800, height = 800;
     if (args.has("--size")) parse_size(args.value("--size"), width, height);
+    if (args.has("--scale") && !args.flag("--heatmap")) throw Error("--scale goes with --heatmap");
+    const auto fixed_scale = std::uint32_t(args.integer("--scale", 0, 1, 1000000));
+    const BuildOptions build_options = parse_builder(args.value("--builder", "binned-sah"));
 
-    const TriangleMesh mesh = load_mesh(spec);
+    TriangleMesh mesh = load_mesh(spec);
+    if (args.has("--turn")) turn_about_vertical(mesh, parse_degrees(args.value("--turn")));
     const auto t0 = std::chrono::steady_clock::now();
-    const TriangleBvh<float> bvh(mesh, parse_builder(args.value("--builder", "binned-sah")));
+    const TriangleBvh<float> bvh(mesh, build_options);
     const double build_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     const std::vector<Ray3f> rays = camera_rays(mesh.bounds(), width, height);
@@ -96,18 +174,11 @@ int render_command(int argc, char** argv) {
         std::vector<std::uint32_t> sorted = cost;
         const std::size_t k = sorted.size() * 995 / 1000;
         std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-        const std::uint32_t scale_top = std::max<std::uint32_t>(1, sorted[k]);
+        const std::uint32_t scale_top =
+            fixed_scale ? fixed_scale : std::max<std::uint32_t>(1, sorted[k]);
         for (std::size_t i = 0; i < rays.size(); ++i)
             image.pixels[i] = heat_colour(double(cost[i]) / scale_top);
-        // The scale: a bar along the bottom, labelled 0 and the maximum.
-        const std::uint32_t bar_top = height - 28, bar_bottom = height - 16;
-        image.fill(0, bar_top - 4, width, height, {20, 20, 24});
-        for (std::uint32_t x = 8; x + 8 < width; ++x)
-            image.fill(x, bar_top, x + 1, bar_bottom, heat_colour(double(x - 8) / (width - 16)));
-        const Rgb white{240, 240, 240};
-        image.text(8, height - 12, "0", white, 2);
-        const std::string top = std::to_string(scale_top) + "+ nodes/ray";
-        image.text(width - 8 - std::uint32_t(top.size()) * 8, height - 12, top, white, 2);
+        draw_scale(image, scale_top, fixed_scale != 0);
     }
     write_png(args.value("-o"), image);
 

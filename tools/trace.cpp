@@ -1,4 +1,4 @@
-// `bvhkit trace`: the user's rays through the user's mesh, hits written in the BENCHMARKS.md
+// `bvhkit trace`: the user's rays through the user's mesh, hits written in the docs/workloads.md
 // format.
 #include <chrono>
 #include <cstdio>

@@ -1,5 +1,5 @@
 // Google Benchmark micro-benchmarks: build per builder, traversal per ray kind. Inputs: a
-// procedural sphere (always there) and the shared bunny when ../shared/data is present.
+// procedural sphere (always there) and the bunny when a data folder has it (data_files.hpp).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>

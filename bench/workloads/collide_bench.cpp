@@ -12,6 +12,7 @@
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
+#include "bvhkit/volumes/obb_rss.hpp"
 #include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
 
@@ -24,7 +25,11 @@
 namespace bvhkit::bench {
 
 bool have_fcl() {
-    return BVHKIT_HAVE_FCL + 0 != 0;
+#if BVHKIT_HAVE_FCL
+    return true;
+#else
+    return false;
+#endif
 }
 
 namespace {
@@ -143,6 +148,7 @@ std::vector<Row> run_collide_bench(const CollideBenchOptions& options, std::FILE
         runners.push_back(bvhkit_runner<Aabb3f>(mesh, "aabb"));
         runners.push_back(bvhkit_runner<Obb<float>>(mesh, "obb"));
         runners.push_back(bvhkit_runner<Rss<float>>(mesh, "rss"));
+        runners.push_back(bvhkit_runner<ObbRss<float>>(mesh, "obbrss"));
         runners.push_back(bvhkit_runner<Sphere<float>>(mesh, "sphere"));
         runners.push_back(bvhkit_runner<Kdop<float, 18>>(mesh, "kdop18"));
 #if BVHKIT_HAVE_FCL

@@ -1,5 +1,5 @@
 #pragma once
-// Workloads C1 and C2 of ../shared/BENCHMARKS.md: a mesh against a copy of itself under 1,000
+// Workloads C1 and C2 of docs/workloads.md: a mesh against a copy of itself under 1,000
 // random rigid poses (yes/no and all-pairs collision), and distance at the poses where the copies
 // do not collide; bvhkit with each of its volume types and (when installed) FCL 0.7 with
 // BVHModel<OBBRSS> and BVHModel<OBB>, in the same process, one thread, medians of repetitions

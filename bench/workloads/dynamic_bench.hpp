@@ -1,5 +1,5 @@
 #pragma once
-// Workloads D1, D2, D3 of ../shared/BENCHMARKS.md: the dynamic tree as a broadphase, against Box2D
+// Workloads D1, D2, D3 of docs/workloads.md: the dynamic tree as a broadphase, against Box2D
 // 2.4.1's b2BroadPhase (D1, 2D) and Bullet's btDbvtBroadphase (D2, 3D) in the same process.
 #include <cstdio>
 #include <vector>

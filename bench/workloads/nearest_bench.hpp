@@ -1,5 +1,5 @@
 #pragma once
-// Workload N1 of ../shared/BENCHMARKS.md: closest point, squared distance and triangle for 100,000
+// Workload N1 of docs/workloads.md: closest point, squared distance and triangle for 100,000
 // points uniform in the mesh's box grown by 10%, for bvhkit (ClosestPointMesh) and CGAL 5.5's
 // AABB_tree (closest_point_and_primitive after accelerate_distance_queries()) in the same process,
 // one thread each, medians of interleaved repetitions. With `scaling`, also bvhkit alone on one

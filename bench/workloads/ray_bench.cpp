@@ -9,7 +9,11 @@
 namespace bvhkit::bench {
 
 bool have_embree() {
-    return BVHKIT_HAVE_EMBREE + 0 != 0;
+#if BVHKIT_HAVE_EMBREE
+    return true;
+#else
+    return false;
+#endif
 }
 
 namespace {
@@ -30,7 +34,8 @@ struct Workload {
 std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progress) {
     std::vector<Row> rows;
     BuildOptions build_options = parse_builder(options.builder);
-    build_options.threads = 1;  // single thread, as Embree is run here (issue 2's comparison)
+    build_options.threads =
+        1;  // single thread, as Embree is run here (the workload compares one thread each)
     for (const std::string& arg : options.meshes) {
         const TriangleMesh mesh = load_mesh(arg);
         const std::string name = mesh_name(arg);

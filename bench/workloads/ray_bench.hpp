@@ -1,5 +1,5 @@
 #pragma once
-// Workload R of ../shared/BENCHMARKS.md: build, R1 primary rays, R2 incoherent rays, R3 occlusion,
+// Workload R of docs/workloads.md: build, R1 primary rays, R2 incoherent rays, R3 occlusion,
 // for bvhkit and (when installed) Embree 3 in the same process, one thread each, medians of
 // repetitions.
 #include <span>

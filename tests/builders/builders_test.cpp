@@ -1,4 +1,4 @@
-// The builders of issue 5 (bottom-up, insertion, LBVH) and the reinsertion optimizer: every tree
+// The bottom-up, insertion and LBVH builders and the reinsertion optimizer: every tree
 // passes validate() and gives the brute-force answer to every ray; the optimizer never raises the
 // SAH cost; the parallel path builds the same tree as the serial one; depth limits hold.
 #include <gtest/gtest.h>

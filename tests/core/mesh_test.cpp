@@ -71,7 +71,7 @@ INSTANTIATE_TEST_SUITE_P(Meshes, SharedMeshes, ::testing::ValuesIn(kMeshes), tes
 TEST(SharedMeshesQuality, SweepSahCostIsNoWorseThanBinnedOnEveryMesh) {
     for (const char* name : kMeshes) {
         const auto path = test::shared_mesh(name);
-        if (path.empty()) GTEST_SKIP() << "shared meshes not found under " << test::data_dir();
+        if (path.empty()) GTEST_SKIP() << "shared meshes not found in " << test::data_dirs_text();
         const TriangleMesh mesh = read_mesh(path);
         BuildOptions sweep;
         sweep.builder = Builder::SweepSah;

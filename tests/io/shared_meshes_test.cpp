@@ -1,5 +1,6 @@
-// The real meshes of ../shared/data: triangle counts as listed in its README (an independent
-// source), plausible vertex counts, every index in range and finite bounds.
+// The real test meshes (data/ and BVHKIT_DATA_DIR): triangle counts as listed in data/README.md and
+// docs/workloads.md (an independent source), plausible vertex counts, every index in range and
+// finite bounds.
 #include <gtest/gtest.h>
 
 #include <cctype>

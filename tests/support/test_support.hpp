@@ -9,17 +9,27 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
+
+#include "bvhkit/mesh/data_files.hpp"
 
 namespace bvhkit::test {
 
-inline std::filesystem::path data_dir() {
-    return BVHKIT_DATA_DIR;
+/// Where the tests look for meshes by name: BVHKIT_DATA_DIR from the environment, the folder the
+/// build was configured with, then the repository's data/ (spot.obj and teapot.obj ship there).
+inline std::vector<std::filesystem::path> data_dirs() {
+    return data_search_path(BVHKIT_DATA_DIR, BVHKIT_SHIPPED_DATA_DIR);
 }
 
-/// Path of a shared mesh, or an empty path when ../shared/data is absent (callers GTEST_SKIP).
+inline std::string data_dirs_text() {
+    std::string s;
+    for (const auto& d : data_dirs()) s += (s.empty() ? "" : ", ") + d.string();
+    return s;
+}
+
+/// Path of a test mesh, or an empty path when no data folder has it (callers GTEST_SKIP).
 inline std::filesystem::path shared_mesh(std::string_view name) {
-    const auto p = data_dir() / std::string(name);
-    return std::filesystem::exists(p) ? p : std::filesystem::path{};
+    return find_data_file(name, data_dirs());
 }
 
 inline bool small_scale() {
@@ -51,8 +61,8 @@ struct MeshFileName {
 
 }  // namespace bvhkit::test
 
-#define BVHKIT_REQUIRE_MESH(var, name)                                                          \
-    const auto var = ::bvhkit::test::shared_mesh(name);                                         \
-    if (var.empty())                                                                            \
-    GTEST_SKIP() << "shared mesh " << name << " not found under " << ::bvhkit::test::data_dir() \
-                 << "; skipping"
+#define BVHKIT_REQUIRE_MESH(var, name)                                                      \
+    const auto var = ::bvhkit::test::shared_mesh(name);                                     \
+    if (var.empty())                                                                        \
+    GTEST_SKIP() << "mesh " << name << " not found in " << ::bvhkit::test::data_dirs_text() \
+                 << " (scripts/fetch-meshes.sh, then set BVHKIT_DATA_DIR)"

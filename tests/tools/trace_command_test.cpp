@@ -1,4 +1,4 @@
-// End to end: `bvhkit trace` on ray files in the BENCHMARKS.md format must write the brute-force
+// End to end: `bvhkit trace` on ray files in the docs/workloads.md format must write the brute-force
 // hits (closest hit over every triangle) for workload R1 and R2 rays on every shared mesh; and the
 // command's errors must be clear.
 #include <gtest/gtest.h>
