@@ -7,6 +7,7 @@
 // when the SAH cost has grown a lot. A primitive whose new box is non-finite contributes nothing
 // (it can never be hit); rebuild to drop it from the tree for good.
 #include <span>
+#include <vector>
 
 #include "bvhkit/bvh/bvh.hpp"
 
@@ -33,6 +34,10 @@ void refit(Bvh<Aabb<T, N>>& bvh, BoxOf&& primitive_box) {
 template <class T, std::size_t N>
 void refit(Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes) {
     refit(bvh, [&](std::uint32_t i) { return primitive_boxes[i]; });
+}
+template <class T, std::size_t N>
+void refit(Bvh<Aabb<T, N>>& bvh, const std::vector<Aabb<T, N>>& primitive_boxes) {
+    refit(bvh, std::span<const Aabb<T, N>>(primitive_boxes));
 }
 
 }  // namespace bvhkit

@@ -14,6 +14,7 @@
 
 #include "bvhkit/bvh/bvh.hpp"
 #include "bvhkit/error.hpp"
+#include "bvhkit/primitives/hit.hpp"  // invalid_index
 
 namespace bvhkit {
 

@@ -1,5 +1,5 @@
 #pragma once
-// The ray and hit files of ../shared/BENCHMARKS.md (little-endian, no header):
+// The ray and hit files of docs/workloads.md (little-endian, no header):
 // rays: 8 float32 per ray (origin xyz, direction xyz, tmin, tmax);
 // hits: per ray, float32 t (+inf on a miss) then uint32 primitive index (0xFFFFFFFF on a miss).
 #include <filesystem>

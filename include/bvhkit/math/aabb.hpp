@@ -39,7 +39,7 @@ struct Aabb {
     constexpr VecT centroid() const { return (min + max) * T(0.5); }
     constexpr std::size_t largest_axis() const { return bvhkit::largest_axis(extent()); }
 
-    /// The SAH measure: surface area in 3D, perimeter in 2D (the seed's "SA"); 0 when empty.
+    /// The SAH measure: surface area in 3D, perimeter in 2D (the SAH's "SA" term); 0 when empty.
     constexpr T area() const {
         const VecT e = extent();
         if constexpr (N == 2) {

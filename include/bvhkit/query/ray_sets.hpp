@@ -1,5 +1,5 @@
 #pragma once
-// The ray sets of workload R (../shared/BENCHMARKS.md), deterministic so every library and every
+// The ray sets of workload R (docs/workloads.md), deterministic so every library and every
 // run traces the same rays.
 #include <cstdint>
 #include <vector>

@@ -2,7 +2,8 @@
 // Aabb<T, 3> as a BoundingVolume. Under a pose, B's box becomes an oriented box in A's frame and
 // the test is the exact 15-axis box-box separating-axis test (Gottschalk, Lin, Manocha 1996), so
 // the AABB tree answers exactly what an OBB tree would for these boxes. Distance lower bound: the
-// largest gap along the 6 face normals.
+// largest gap along the 15 axes, or the gap of the circumscribed spheres when larger
+// (bounding_volume.hpp, boxes_gap).
 #include "bvhkit/math/aabb.hpp"
 #include "bvhkit/volumes/bounding_volume.hpp"
 

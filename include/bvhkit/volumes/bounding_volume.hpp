@@ -1,4 +1,5 @@
 #pragma once
+// clang-format off
 // The BoundingVolume concept, shared by Aabb, Sphere, Obb and Kdop<K>: every operation the tree
 // builders and the tree-vs-tree queries need, gathered in VolumeTraits<V> so that a volume type
 // from elsewhere (Aabb lives in math/) joins without being edited.
@@ -12,11 +13,13 @@
 //   VolumeTraits<V>::overlaps(a, b, prepared) b given in B's frame; may be conservative (never
 //                                            says "apart" for volumes that meet)
 //   VolumeTraits<V>::size(v)                 squared "radius", what the descend-larger rule
-//   compares VolumeTraits<V>::distance_lower_bound(a, b, prepared)  never more than the true
-//   distance
+//                                            compares
+//   VolumeTraits<V>::distance_lower_bound(a, b, prepared)
+//                                            never more than the true distance
 //
 // `slack` widens every test under a pose by an absolute amount, so that the rounding of a
 // triangle transformed into A's frame at a leaf can never make a pair the volumes culled touch.
+// clang-format on
 #include <concepts>
 #include <span>
 

@@ -12,8 +12,8 @@
 // conservative: A's K/2 slabs against B's AABB part (carried into A's frame as an oriented box),
 // then B's three face normals against A's AABB part. It never reports "apart" for volumes that
 // meet, and may report "overlap" for some that do not. Distance lower bound: the largest of those
-// gaps, or the box-box bound of the AABB parts. The 2D Kdop<T, 8> offers fit, merge and same-frame
-// overlap only.
+// gaps, or the box-box bound of the AABB parts. The 2D Kdop<T, 8> (K = 8) is the volume type alone:
+// it has no VolumeTraits, so it cannot serve a CollisionModel.
 #include <array>
 
 #include "bvhkit/volumes/bounding_volume.hpp"

@@ -3,7 +3,8 @@
 // them). Fitted by the covariance of the triangles' surfaces: the eigenvectors of the
 // area-weighted covariance matrix are the axes (Gottschalk, Lin, Manocha 1996, "OBBTree"); the
 // matrix is diagonalized by cyclic Jacobi rotations. Overlap under a pose: the exact 15-axis
-// separating-axis test. Distance lower bound: the largest gap along the 6 face normals.
+// separating-axis test. Distance lower bound: the largest gap along the 15 axes, or
+// the gap of the circumscribed spheres when larger (bounding_volume.hpp, boxes_gap).
 #include "bvhkit/volumes/bounding_volume.hpp"
 
 namespace bvhkit {

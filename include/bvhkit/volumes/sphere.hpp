@@ -43,11 +43,13 @@ struct VolumeTraits<Sphere<T>> {
         return {c, r * (T(1) + detail::fit_pad<T>)};
     }
     static bool overlaps(const V& a, const V& b) {
+        if (a.radius < T(0) || b.radius < T(0)) return false;  // an empty sphere meets nothing
         const T r = a.radius + b.radius;
         return length_squared(a.center - b.center) <= r * r;
     }
     static Prepared prepare(const Transform<T>& pose, T slack) { return {pose, slack}; }
     static bool overlaps(const V& a, const V& b, const Prepared& p) {
+        if (a.radius < T(0) || b.radius < T(0)) return false;
         const T r = a.radius + b.radius + p.slack;
         return length_squared(a.center - (p.r * b.center + p.t)) <= r * r;
     }
