@@ -6,6 +6,7 @@
 // The tree's quality degrades as primitives drift from where they were when it was built; rebuild
 // when the SAH cost has grown a lot. A primitive whose new box is non-finite contributes nothing
 // (it can never be hit); rebuild to drop it from the tree for good.
+#include <concepts>
 #include <span>
 #include <vector>
 
@@ -15,6 +16,7 @@ namespace bvhkit {
 
 /// `primitive_box(i)` returns the current box of primitive i (the caller's index).
 template <class T, std::size_t N, class BoxOf>
+requires std::invocable<BoxOf&, std::uint32_t>
 void refit(Bvh<Aabb<T, N>>& bvh, BoxOf&& primitive_box) {
     for (std::size_t n = bvh.nodes.size(); n-- > 0;) {
         auto& node = bvh.nodes[n];
