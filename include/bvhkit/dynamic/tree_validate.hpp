@@ -119,7 +119,7 @@ void validate_tree(const TreeParts<T, N, U>& t) {
                 stack.push_back(c);
             }
             if (n.child1 == n.child2) broken(node_name(i) + " has the same child twice");
-            const int h = 1 + std::max(t.nodes[n.child1].height, t.nodes[n.child2].height);
+            const int h = 1 + std::max<int>(t.nodes[n.child1].height, t.nodes[n.child2].height);
             if (n.height != h)
                 broken(node_name(i) + " has height " + std::to_string(n.height) + ", expected " +
                        std::to_string(h));
