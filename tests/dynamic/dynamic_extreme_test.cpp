@@ -172,3 +172,79 @@ TEST(DynamicTreeExtreme, ShiftOriginAtTheEndOfTheRange) {
 }
 
 }  // namespace
+
+namespace {
+
+// A NaN in any query input used to match every proxy (each comparison with NaN is false, so no box
+// was ever rejected). Now it throws an Error naming the argument, and infinite or empty query boxes
+// keep a defined answer.
+TEST(DynamicTreeExtreme, NanQueriesAreRefused) {
+    using bvhkit::Aabb2f;
+    using bvhkit::Vec2f;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    DynamicTree<float, 2> t;
+    for (int i = 0; i < 20; ++i) t.create(Aabb2f({float(i), 0}, {float(i) + 1, 1}));
+    int reported = 0;
+    const auto count = [&](ProxyId) { return ++reported, true; };
+    const auto count_cast = [&](ProxyId, float) { return ++reported, -1.0f; };
+    const auto expect_error = [&](auto&& call, const char* needle) {
+        try {
+            call();
+            ADD_FAILURE() << needle << ": NaN accepted";
+        } catch (const bvhkit::Error& e) {
+            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+        }
+    };
+    expect_error([&] { t.query(Aabb2f({nan, 0}, {1, 1}), count); }, "box.min[0] is nan");
+    expect_error([&] { t.query(Aabb2f({0, 0}, {1, nan}), count); }, "box.max[1] is nan");
+    expect_error([&] { t.query_point(Vec2f{0.5f, nan}, count); }, "p[1] is nan");
+    expect_error(
+        [&] {
+            t.ray_cast(Vec2f{nan, 0.5f}, Vec2f{1, 0}, 1.0f, count_cast);
+        },
+        "origin[0] is nan");
+    expect_error(
+        [&] {
+            t.ray_cast(Vec2f{-1, 0.5f}, Vec2f{nan, nan}, 1.0f, count_cast);
+        },
+        "direction[0] is nan");
+    expect_error(
+        [&] {
+            t.ray_cast(Vec2f{-1, 0.5f}, Vec2f{1, 0}, nan, count_cast);
+        },
+        "max_fraction is nan");
+    expect_error(
+        [&] {
+            t.box_cast(Aabb2f({nan, 0}, {1, 1}), Vec2f{1, 0}, 1.0f, count_cast);
+        },
+        "min.x is nan");
+    expect_error(
+        [&] {
+            t.box_cast(Aabb2f({0, 0}, {1, 1}), Vec2f{0, nan}, 1.0f, count_cast);
+        },
+        "translation[1] is nan");
+    expect_error(
+        [&] {
+            t.box_cast(Aabb2f({0, 0}, {1, 1}), Vec2f{1, 0}, nan, count_cast);
+        },
+        "max_fraction is nan");
+    EXPECT_EQ(reported, 0);
+    // Defined answers for infinite and empty input.
+    t.query(Aabb2f({-inf, -inf}, {inf, inf}), count);
+    EXPECT_EQ(reported, 20);
+    reported = 0;
+    t.query(Aabb2f({3, 1}, {2, 0}), count);  // min > max: empty
+    EXPECT_EQ(reported, 0);
+    t.ray_cast(Vec2f{-1, 0.5f}, Vec2f{1, 0}, inf, count_cast);  // unbounded ray
+    EXPECT_EQ(reported, 20);
+    reported = 0;
+    t.query_point(Vec2f{inf, 0.5f}, count);
+    EXPECT_EQ(reported, 0);
+    // Non-finite boxes on create and move were already refused; still are.
+    EXPECT_THROW(t.create(Aabb2f({0, 0}, {inf, 1})), bvhkit::Error);
+    EXPECT_THROW(t.move(0, Aabb2f({nan, 0}, {1, 1})), bvhkit::Error);
+    t.validate();
+}
+
+}  // namespace

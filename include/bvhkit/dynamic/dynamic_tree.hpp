@@ -252,12 +252,22 @@ class DynamicTree {
     /// stops.
     template <class F>
     void query(const Box& box, F&& callback, QueryStats* stats = nullptr) const {
+        dynamic_detail::check_not_nan(box.min, "box.min", "DynamicTree::query");
+        dynamic_detail::check_not_nan(box.max, "box.max", "DynamicTree::query");
+        for (std::size_t i = 0; i < N; ++i)
+            if (box.min[i] > box.max[i]) return;  // empty: overlaps nothing
         const Guard guard(walks_);
         dynamic_detail::query_box(view(), box, callback, stats);
     }
     /// Every proxy whose box contains `p`. callback(ProxyId) -> bool, false stops.
+    ///
+    /// Query input: a NaN anywhere (box, point, origin, direction, translation, max_fraction)
+    /// throws bvhkit::Error before the walk (a NaN compares false and would match everything).
+    /// A query box may be infinite (-inf..inf finds every proxy) or empty (min > max: nothing);
+    /// ray origins and directions and cast boxes must be finite; max_fraction may be inf.
     template <class F>
     void query_point(const VecT& p, F&& callback, QueryStats* stats = nullptr) const {
+        dynamic_detail::check_not_nan(p, "p", "DynamicTree::query_point");
         const Guard guard(walks_);
         dynamic_detail::query_point(view(), p, callback, stats);
     }
@@ -267,6 +277,9 @@ class DynamicTree {
     template <class F>
     void ray_cast(const VecT& origin, const VecT& direction, T max_fraction, F&& callback,
                   QueryStats* stats = nullptr) const {
+        dynamic_detail::check_vector(origin, "origin", "DynamicTree::ray_cast");
+        dynamic_detail::check_vector(direction, "direction", "DynamicTree::ray_cast");
+        check_fraction(max_fraction, "DynamicTree::ray_cast");
         const Guard guard(walks_);
         dynamic_detail::cast(view(), dynamic_detail::Segment<T, N>(origin, direction), VecT{},
                              max_fraction, callback, stats);
@@ -276,6 +289,9 @@ class DynamicTree {
     template <class F>
     void box_cast(const Box& box, const VecT& translation, T max_fraction, F&& callback,
                   QueryStats* stats = nullptr) const {
+        dynamic_detail::check_box(box, "DynamicTree::box_cast");
+        dynamic_detail::check_vector(translation, "translation", "DynamicTree::box_cast");
+        check_fraction(max_fraction, "DynamicTree::box_cast");
         const Guard guard(walks_);
         dynamic_detail::cast(
             view(), dynamic_detail::Segment<T, N>(dynamic_detail::safe_centroid(box), translation),
@@ -485,6 +501,12 @@ class DynamicTree {
             throw Error(std::string(where) +
                         ": called while a query, cast, for_each_node or pair callback of this "
                         "tree is running; collect the changes and apply them after it returns");
+    }
+
+    static void check_fraction(T max_fraction, const char* where) {
+        if (std::isnan(max_fraction))
+            throw Error(std::string(where) + ": max_fraction is nan (must be a number; >= 0 " +
+                        "to find anything, inf for an unbounded ray)");
     }
 
     void check_id(ProxyId id, const char* where) const {

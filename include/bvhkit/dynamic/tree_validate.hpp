@@ -45,6 +45,16 @@ void check_vector(const Vec<T, N>& v, const char* what, const char* where) {
                         format_value(v[i]) + " (must be finite)");
 }
 
+/// Throws when a query's vector holds a NaN (every comparison with it is false, so the walk would
+/// report every proxy). Infinities stay allowed: a box from -inf to inf is a query for everything.
+template <class T, std::size_t N>
+void check_not_nan(const Vec<T, N>& v, const char* what, const char* where) {
+    for (std::size_t i = 0; i < N; ++i)
+        if (std::isnan(v[i]))
+            throw Error(std::string(where) + ": " + what + "[" + std::to_string(i) +
+                        "] is nan (a query must not hold NaN)");
+}
+
 /// Everything validate() needs to see of a tree.
 template <class T, std::size_t N, class U>
 struct TreeParts {
