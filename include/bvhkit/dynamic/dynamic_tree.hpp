@@ -21,6 +21,13 @@
 // and bound (or seed 000's greedy descent), then a walk up to the root refitting each ancestor and
 // applying the best of the four rotations. Removal replaces the leaf's parent by its sibling and
 // walks up alike.
+//
+// Callbacks: while a query, cast, for_each_node or pair callback of a tree runs, the calls that
+// change its structure (create, destroy, move, enlarge, rebuild, optimize, clear, shift_origin,
+// shrink_to_fit, find_pairs, update_pairs) throw bvhkit::Error, in every build, instead of
+// reallocating the nodes under the walk; collect the changes and apply them after the call returns
+// (as a physics engine's locked world does). Read-only calls (nested queries, box(), user_data())
+// are fine. Many threads may run const queries on one tree at once while nothing changes it.
 #include <algorithm>
 #include <cstdint>
 #include <string>
@@ -56,6 +63,7 @@ class DynamicTree {
     /// Adds a proxy with the given (tight) box; it is in the move buffer until the next
     /// find_pairs().
     ProxyId create(const Box& box, const UserData& user_data = {}) {
+        check_not_walking("DynamicTree::create");
         dynamic_detail::check_box(box, "DynamicTree::create");
         const ProxyId id = alloc_proxy();
         const std::int32_t leaf = alloc_node();
@@ -75,6 +83,7 @@ class DynamicTree {
     }
 
     void destroy(ProxyId id) {
+        check_not_walking("DynamicTree::destroy");
         check_id(id, "DynamicTree::destroy");
         Proxy& p = proxies_[id];
         remove_leaf(p.node);
@@ -91,6 +100,7 @@ class DynamicTree {
     /// restructured (remove + insert) only when the box leaves the fat box, or when the fat box has
     /// become far larger than a fresh one would be; returns whether that happened.
     bool move(ProxyId id, const Box& box, const VecT& displacement = VecT{}) {
+        check_not_walking("DynamicTree::move");
         check_id(id, "DynamicTree::move");
         dynamic_detail::check_box(box, "DynamicTree::move");
         dynamic_detail::check_vector(displacement, "displacement", "DynamicTree::move");
@@ -118,6 +128,7 @@ class DynamicTree {
     /// are grown in place, without restructuring (cheap, for many moves in a row; quality suffers
     /// until rebuild(false) rebuilds the grown part). Returns whether anything was grown.
     bool enlarge(ProxyId id, const Box& box, const VecT& displacement = VecT{}) {
+        check_not_walking("DynamicTree::enlarge");
         check_id(id, "DynamicTree::enlarge");
         dynamic_detail::check_box(box, "DynamicTree::enlarge");
         dynamic_detail::check_vector(displacement, "displacement", "DynamicTree::enlarge");
@@ -144,6 +155,7 @@ class DynamicTree {
     /// Rebuilds the tree top-down with binned SAH. full = false rebuilds only the part above the
     /// leaves that enlarge() touched, keeping every untouched subtree as it is.
     void rebuild(bool full = true) {
+        check_not_walking("DynamicTree::rebuild");
         if (root_ == dynamic_detail::kNullNode) return;
         auto& items = build_.items;
         items.clear();
@@ -154,7 +166,7 @@ class DynamicTree {
             Node& n = nodes_[i];
             if (n.is_leaf() || (!full && !n.enlarged)) {
                 n.enlarged = 0;
-                items.push_back({n.box.centroid(), i});
+                items.push_back({dynamic_detail::safe_centroid(n.box), i});
             } else {
                 stack.push(n.child1);
                 stack.push(n.child2);
@@ -171,14 +183,17 @@ class DynamicTree {
     /// that look worst placed, those whose parent's area is the largest relative to their own.
     /// Returns how many.
     int optimize(int max_reinsertions) {
+        check_not_walking("DynamicTree::optimize");
         if (max_reinsertions <= 0 || proxy_count_ < 3) return 0;
         auto& cand = optimize_scratch_;
         cand.clear();
         for (std::int32_t id = 0; id < static_cast<std::int32_t>(proxies_.size()); ++id) {
             const std::int32_t leaf = proxies_[id].node;
             if (leaf == dynamic_detail::kNullNode || leaf == root_) continue;
-            const T own = std::max(nodes_[leaf].box.area(), std::numeric_limits<T>::min());
-            cand.push_back({nodes_[nodes_[leaf].parent].box.area() / own, leaf});
+            const double own = std::max(dynamic_detail::box_area(nodes_[leaf].box),
+                                        double(std::numeric_limits<T>::min()));
+            const double ratio = dynamic_detail::box_area(nodes_[nodes_[leaf].parent].box) / own;
+            cand.push_back({ratio == ratio ? ratio : 0.0, leaf});  // inf / inf: not a candidate
         }
         const std::size_t k =
             std::min<std::size_t>(cand.size(), static_cast<std::size_t>(max_reinsertions));
@@ -197,6 +212,7 @@ class DynamicTree {
 
     /// Removes every proxy (keeps the memory).
     void clear() {
+        check_not_walking("DynamicTree::clear");
         nodes_.clear();
         proxies_.clear();
         move_buffer_.clear();
@@ -236,11 +252,23 @@ class DynamicTree {
     /// stops.
     template <class F>
     void query(const Box& box, F&& callback, QueryStats* stats = nullptr) const {
+        dynamic_detail::check_not_nan(box.min, "box.min", "DynamicTree::query");
+        dynamic_detail::check_not_nan(box.max, "box.max", "DynamicTree::query");
+        for (std::size_t i = 0; i < N; ++i)
+            if (box.min[i] > box.max[i]) return;  // empty: overlaps nothing
+        const Guard guard(walks_);
         dynamic_detail::query_box(view(), box, callback, stats);
     }
     /// Every proxy whose box contains `p`. callback(ProxyId) -> bool, false stops.
+    ///
+    /// Query input: a NaN anywhere (box, point, origin, direction, translation, max_fraction)
+    /// throws bvhkit::Error before the walk (a NaN compares false and would match everything).
+    /// A query box may be infinite (-inf..inf finds every proxy) or empty (min > max: nothing);
+    /// ray origins and directions and cast boxes must be finite; max_fraction may be inf.
     template <class F>
     void query_point(const VecT& p, F&& callback, QueryStats* stats = nullptr) const {
+        dynamic_detail::check_not_nan(p, "p", "DynamicTree::query_point");
+        const Guard guard(walks_);
         dynamic_detail::query_point(view(), p, callback, stats);
     }
     /// The segment origin + s * direction, s in [0, max_fraction], against the proxies' boxes.
@@ -249,6 +277,10 @@ class DynamicTree {
     template <class F>
     void ray_cast(const VecT& origin, const VecT& direction, T max_fraction, F&& callback,
                   QueryStats* stats = nullptr) const {
+        dynamic_detail::check_vector(origin, "origin", "DynamicTree::ray_cast");
+        dynamic_detail::check_vector(direction, "direction", "DynamicTree::ray_cast");
+        check_fraction(max_fraction, "DynamicTree::ray_cast");
+        const Guard guard(walks_);
         dynamic_detail::cast(view(), dynamic_detail::Segment<T, N>(origin, direction), VecT{},
                              max_fraction, callback, stats);
     }
@@ -257,14 +289,20 @@ class DynamicTree {
     template <class F>
     void box_cast(const Box& box, const VecT& translation, T max_fraction, F&& callback,
                   QueryStats* stats = nullptr) const {
-        dynamic_detail::cast(view(), dynamic_detail::Segment<T, N>(box.centroid(), translation),
-                             box.extent() * T(0.5), max_fraction, callback, stats);
+        dynamic_detail::check_box(box, "DynamicTree::box_cast");
+        dynamic_detail::check_vector(translation, "translation", "DynamicTree::box_cast");
+        check_fraction(max_fraction, "DynamicTree::box_cast");
+        const Guard guard(walks_);
+        dynamic_detail::cast(
+            view(), dynamic_detail::Segment<T, N>(dynamic_detail::safe_centroid(box), translation),
+            box.max * T(0.5) - box.min * T(0.5), max_fraction, callback, stats);
     }
     /// Every pair (proxy of this tree, proxy of `other`) whose boxes overlap.
     /// callback(ProxyId mine, ProxyId theirs) -> bool, false stops.
     template <class U2, class F>
     void query_tree(const DynamicTree<T, N, U2>& other, F&& callback,
                     QueryStats* stats = nullptr) const {
+        const Guard guard(walks_), other_guard(other.walks_);
         dynamic_detail::query_tree(view(), other.view(), callback, stats);
     }
 
@@ -273,6 +311,8 @@ class DynamicTree {
     /// The overlapping pairs (of the tight boxes) that involve a proxy moved or created since the
     /// last call, each once, as (a, b) with a < b, sorted. Clears the move buffer.
     void find_pairs(std::vector<ProxyPair>& out) {
+        check_not_walking("DynamicTree::find_pairs");
+        const Guard guard(walks_);
         out.clear();
         auto& buf = move_buffer_;
         std::sort(buf.begin(), buf.end());
@@ -298,6 +338,7 @@ class DynamicTree {
     template <class F>
     void find_pairs(F&& callback) {
         find_pairs(pair_scratch_);
+        const Guard guard(walks_);  // the callback must not change pair_scratch_ either
         for (const ProxyPair& p : pair_scratch_) callback(p.a, p.b);
     }
     /// Proxies waiting in the move buffer (may hold duplicates and destroyed ids).
@@ -315,14 +356,14 @@ class DynamicTree {
     double sah_cost() const {
         double s = 0;
         for (const Node& n : nodes_)
-            if (n.height > 0) s += double(n.box.area());
+            if (n.height > 0) s += dynamic_detail::box_area(n.box);
         return s;
     }
     /// sah_cost() over the root's area: how much larger than the root the internal nodes are in
     /// all.
     double area_ratio() const {
         if (root_ == dynamic_detail::kNullNode || nodes_[root_].is_leaf()) return 0;
-        const double root_area = double(nodes_[root_].box.area());
+        const double root_area = dynamic_detail::box_area(nodes_[root_].box);
         return root_area > 0 ? sah_cost() / root_area : 0;
     }
     std::size_t memory_bytes() const {
@@ -346,11 +387,27 @@ class DynamicTree {
         return s;
     }
     /// Moves the origin of the world to `new_origin`: every box b becomes b - new_origin (games do
-    /// this to keep coordinates small far from the start).
+    /// this to keep coordinates small far from the start). Throws bvhkit::Error, changing nothing,
+    /// when a proxy's box would leave the finite range; fat and internal boxes are clamped to it.
     void shift_origin(const VecT& new_origin) {
+        check_not_walking("DynamicTree::shift_origin");
         dynamic_detail::check_vector(new_origin, "new_origin", "DynamicTree::shift_origin");
+        for (std::size_t id = 0; id < proxies_.size(); ++id) {
+            const Proxy& p = proxies_[id];
+            if (p.node == dynamic_detail::kNullNode) continue;
+            const Box b(p.box.min - new_origin, p.box.max - new_origin);
+            for (std::size_t i = 0; i < N; ++i)
+                if (!std::isfinite(b.min[i]) || !std::isfinite(b.max[i]))
+                    throw Error("DynamicTree::shift_origin: new_origin[" + std::to_string(i) +
+                                "] = " + dynamic_detail::format_value(double(new_origin[i])) +
+                                " would move proxy " + std::to_string(id) +
+                                "'s box outside the finite range");
+        }
+        constexpr T big = std::numeric_limits<T>::max();
         for (Node& n : nodes_)
-            if (n.height >= 0) n.box = Box(n.box.min - new_origin, n.box.max - new_origin);
+            if (n.height >= 0)
+                n.box = Box(bvhkit::max(n.box.min - new_origin, VecT(-big)),
+                            bvhkit::min(n.box.max - new_origin, VecT(big)));
         for (Proxy& p : proxies_)
             if (p.node != dynamic_detail::kNullNode)
                 p.box = Box(p.box.min - new_origin, p.box.max - new_origin);
@@ -361,6 +418,7 @@ class DynamicTree {
     template <class F>
     void for_each_node(F&& visitor) const {
         if (root_ == dynamic_detail::kNullNode) return;
+        const Guard guard(walks_);
         struct Item {
             std::int32_t node, depth;
         };
@@ -382,6 +440,7 @@ class DynamicTree {
     friend class DynamicTree;
     using Node = dynamic_detail::Node<T, N>;
     using Proxy = dynamic_detail::Proxy<T, N, UserData>;
+    using Guard = dynamic_detail::WalkCounter::Guard;
 
     dynamic_detail::TreeView<T, N, UserData> view() const {
         return {nodes_.data(), proxies_.data(), root_};
@@ -405,21 +464,49 @@ class DynamicTree {
         for (std::size_t i = 0; i < N; ++i) r[i] = std::abs(v[i]);
         return r;
     }
+    /// The fat margin of a box: may be inf (the extent of a box spanning +-FLT_MAX overflows) but
+    /// never NaN, since a zero relative margin is not multiplied by that extent.
     T margin(const Box& box) const {
-        return options_.margin_absolute + options_.margin_relative * max_component(box.extent());
+        T m = options_.margin_absolute;
+        if (options_.margin_relative > T(0)) {
+            T e = T(0);
+            for (std::size_t i = 0; i < N; ++i) e = std::max(e, box.max[i] - box.min[i]);
+            m += options_.margin_relative * e;
+        }
+        return m;
     }
-    /// The box grown by the margin on every side, then stretched along the predicted displacement.
+    /// The box grown by the margin on every side, then stretched along the predicted displacement,
+    /// then clamped to the finite range: any finite box gets a finite fat box that contains it.
     Box fat_box(const Box& box, const VecT& displacement) const {
-        const VecT m(margin(box));
-        Box fat(box.min - m, box.max + m);
+        constexpr T big = std::numeric_limits<T>::max();
+        const T m = margin(box);
+        Box fat;
         for (std::size_t i = 0; i < N; ++i) {
-            const T s = options_.displacement_multiplier * displacement[i];
+            T lo = box.min[i] - m, hi = box.max[i] + m;
+            const T s = options_.displacement_multiplier * displacement[i];  // +-inf, never NaN
             if (s < 0)
-                fat.min[i] += s;
+                lo += s;
             else
-                fat.max[i] += s;
+                hi += s;
+            fat.min[i] = std::max(lo, -big);
+            fat.max[i] = std::min(hi, big);
         }
         return fat;
+    }
+
+    /// The structural calls throw while a walk of this tree runs (they would reallocate or relink
+    /// the nodes under it): from a query, cast, for_each_node or pair callback.
+    void check_not_walking(const char* where) const {
+        if (walks_.active())
+            throw Error(std::string(where) +
+                        ": called while a query, cast, for_each_node or pair callback of this "
+                        "tree is running; collect the changes and apply them after it returns");
+    }
+
+    static void check_fraction(T max_fraction, const char* where) {
+        if (std::isnan(max_fraction))
+            throw Error(std::string(where) + ": max_fraction is nan (must be a number; >= 0 " +
+                        "to find anything, inf for an unbounded ray)");
     }
 
     void check_id(ProxyId id, const char* where) const {
@@ -562,7 +649,8 @@ class DynamicTree {
     std::vector<dynamic_detail::SiblingCandidate<T>> heap_;
     std::vector<ProxyPair> pair_scratch_;
     dynamic_detail::BuildScratch<T, N> build_;
-    std::vector<std::pair<T, std::int32_t>> optimize_scratch_;
+    std::vector<std::pair<double, std::int32_t>> optimize_scratch_;
+    dynamic_detail::WalkCounter walks_;
 };
 
 using DynamicTree2f = DynamicTree<float, 2>;

@@ -19,29 +19,37 @@
 
 namespace bvhkit::dynamic_detail {
 
+/// Areas and SAH costs are computed in double whatever T is: for a float tree every extent (up to
+/// 2 * FLT_MAX) and every area (up to ~1e78) is then finite, so costs never overflow to inf and tie
+/// (which would turn the tree into a list). A double tree keeps them ordered while extents stay
+/// below ~1e150; past that it stays correct but may lose balance.
+using Cost = double;
+
+template <std::size_t N>
+inline Cost area_of_extents(const Cost (&e)[N]) {
+    if constexpr (N == 2) {
+        return 2 * (e[0] + e[1]);
+    } else {
+        return 2 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+    }
+}
+
 /// Area (perimeter in 2D) of a box known to be non-empty: Aabb::area() without its clamp at zero.
 template <class T, std::size_t N>
-inline T box_area(const Aabb<T, N>& a) {
-    if constexpr (N == 2) {
-        return T(2) * ((a.max[0] - a.min[0]) + (a.max[1] - a.min[1]));
-    } else {
-        const T x = a.max[0] - a.min[0], y = a.max[1] - a.min[1], z = a.max[2] - a.min[2];
-        return T(2) * (x * y + y * z + z * x);
-    }
+inline Cost box_area(const Aabb<T, N>& a) {
+    Cost e[N];
+    for (std::size_t i = 0; i < N; ++i) e[i] = Cost(a.max[i]) - Cost(a.min[i]);
+    return area_of_extents(e);
 }
 
 /// area(a u b) for two non-empty boxes, without building the union.
 template <class T, std::size_t N>
-inline T union_area(const Aabb<T, N>& a, const Aabb<T, N>& b) {
-    T e[N];
+inline Cost union_area(const Aabb<T, N>& a, const Aabb<T, N>& b) {
+    Cost e[N];
     for (std::size_t i = 0; i < N; ++i)
-        e[i] = (a.max[i] > b.max[i] ? a.max[i] : b.max[i]) -
-               (a.min[i] < b.min[i] ? a.min[i] : b.min[i]);
-    if constexpr (N == 2) {
-        return T(2) * (e[0] + e[1]);
-    } else {
-        return T(2) * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
-    }
+        e[i] = Cost(a.max[i] > b.max[i] ? a.max[i] : b.max[i]) -
+               Cost(a.min[i] < b.min[i] ? a.min[i] : b.min[i]);
+    return area_of_extents(e);
 }
 
 /// Recomputes an internal node's box, height and enlarged flag from its two children.
@@ -51,8 +59,8 @@ inline void refit(Node<T, N>* nodes, std::int32_t i) {
     const Node<T, N>& c1 = nodes[n.child1];
     const Node<T, N>& c2 = nodes[n.child2];
     n.box = unite(c1.box, c2.box);
-    n.height = static_cast<std::int16_t>(1 + std::max(c1.height, c2.height));
-    n.enlarged = static_cast<std::uint16_t>(n.enlarged | c1.enlarged | c2.enlarged);
+    n.height = 1 + std::max<std::int32_t>(c1.height, c2.height);
+    n.enlarged = n.enlarged | c1.enlarged | c2.enlarged;
 }
 
 /// Ties: identical or zero-size boxes make many siblings cost exactly the same, and the first one
@@ -60,12 +68,13 @@ inline void refit(Node<T, N>* nodes, std::int32_t i) {
 /// from the chosen sibling S (reached with total cost `cost`), while one of its children costs the
 /// same, go down into the tying child of smaller height: ties fill the shallowest branch.
 template <class T, std::size_t N>
-std::int32_t descend_ties(const Node<T, N>* nodes, std::int32_t s, const Aabb<T, N>& box, T cost) {
+std::int32_t descend_ties(const Node<T, N>* nodes, std::int32_t s, const Aabb<T, N>& box,
+                          Cost cost) {
     while (!nodes[s].is_leaf()) {
         const Node<T, N>& n = nodes[s];
-        const T inherited = cost - box_area(n.box);
-        const T cost1 = union_area(nodes[n.child1].box, box) + inherited;
-        const T cost2 = union_area(nodes[n.child2].box, box) + inherited;
+        const Cost inherited = cost - box_area(n.box);
+        const Cost cost1 = union_area(nodes[n.child1].box, box) + inherited;
+        const Cost cost2 = union_area(nodes[n.child2].box, box) + inherited;
         const bool tie1 = cost1 <= cost, tie2 = cost2 <= cost;
         if (!tie1 && !tie2) break;
         const bool take1 = tie1 && (!tie2 || nodes[n.child1].height <= nodes[n.child2].height);
@@ -87,10 +96,10 @@ std::int32_t find_sibling_greedy(const Node<T, N>* nodes, std::int32_t root,
     std::int32_t i = root;
     while (!nodes[i].is_leaf()) {
         const Node<T, N>& n = nodes[i];
-        const T stay = union_area(n.box, box);
-        const T grow = stay - box_area(n.box);
-        const T cost1 = union_area(nodes[n.child1].box, box) + grow;
-        const T cost2 = union_area(nodes[n.child2].box, box) + grow;
+        const Cost stay = union_area(n.box, box);
+        const Cost grow = stay - box_area(n.box);
+        const Cost cost1 = union_area(nodes[n.child1].box, box) + grow;
+        const Cost cost2 = union_area(nodes[n.child2].box, box) + grow;
         if (stay < cost1 && stay < cost2) break;
         const bool take1 =
             cost1 < cost2 || (cost1 == cost2 && nodes[n.child1].height <= nodes[n.child2].height);
@@ -104,7 +113,7 @@ std::int32_t find_sibling_greedy(const Node<T, N>* nodes, std::int32_t root,
 template <class T>
 struct SiblingCandidate {
     std::int32_t node;
-    T inherited;
+    Cost inherited;
 };
 
 /// Exact best sibling by branch and bound (Bittner, Hapala, Havran 2013; Catto, GDC 2019).
@@ -130,14 +139,14 @@ template <class T, std::size_t N>
 std::int32_t find_sibling_branch_and_bound(const Node<T, N>* nodes, std::int32_t root,
                                            const Aabb<T, N>& box,
                                            std::vector<SiblingCandidate<T>>& heap) {
-    const T leaf_area = box_area(box);
+    const Cost leaf_area = box_area(box);
     const auto later = [](const SiblingCandidate<T>& a, const SiblingCandidate<T>& b) {
         return a.inherited >
                b.inherited;  // std heap functions build a max-heap: invert for a min-heap
     };
     // The root as sibling: a new root above it, no ancestors to grow.
     std::int32_t best = root;
-    T best_cost = union_area(nodes[root].box, box);
+    Cost best_cost = union_area(nodes[root].box, box);
     heap.clear();
     if (!nodes[root].is_leaf()) heap.push_back({root, best_cost - box_area(nodes[root].box)});
     while (!heap.empty()) {
@@ -148,13 +157,13 @@ std::int32_t find_sibling_branch_and_bound(const Node<T, N>* nodes, std::int32_t
         const Node<T, N>& n = nodes[c.node];
         for (const std::int32_t child : {n.child1, n.child2}) {
             const Node<T, N>& cn = nodes[child];
-            const T cost = union_area(cn.box, box) + c.inherited;
+            const Cost cost = union_area(cn.box, box) + c.inherited;
             if (cost < best_cost) {
                 best_cost = cost;
                 best = child;
             }
             if (cn.is_leaf()) continue;
-            const T below = cost - box_area(cn.box);
+            const Cost below = cost - box_area(cn.box);
             if (below + leaf_area < best_cost) {
                 heap.push_back({child, below});
                 std::push_heap(heap.begin(), heap.end(), later);
@@ -184,18 +193,18 @@ void rotate(Node<T, N>* nodes, std::int32_t a) {
     if (nb.height < 1 && nc.height < 1) return;  // both leaves: nothing to rotate
 
     int best = 0;
-    T best_delta = T(0);
+    Cost best_delta = 0;
     if (!nb.is_leaf()) {
-        const T area_b = box_area(nb.box);
-        const T d1 = union_area(nc.box, nodes[nb.child2].box) - area_b;
-        const T d2 = union_area(nodes[nb.child1].box, nc.box) - area_b;
+        const Cost area_b = box_area(nb.box);
+        const Cost d1 = union_area(nc.box, nodes[nb.child2].box) - area_b;
+        const Cost d2 = union_area(nodes[nb.child1].box, nc.box) - area_b;
         if (d1 < best_delta) best_delta = d1, best = 1;
         if (d2 < best_delta) best_delta = d2, best = 2;
     }
     if (!nc.is_leaf()) {
-        const T area_c = box_area(nc.box);
-        const T d3 = union_area(nb.box, nodes[nc.child2].box) - area_c;
-        const T d4 = union_area(nodes[nc.child1].box, nb.box) - area_c;
+        const Cost area_c = box_area(nc.box);
+        const Cost d3 = union_area(nb.box, nodes[nc.child2].box) - area_c;
+        const Cost d4 = union_area(nodes[nc.child1].box, nb.box) - area_c;
         if (d3 < best_delta) best_delta = d3, best = 3;
         if (d4 < best_delta) best_delta = d4, best = 4;
     }

@@ -14,9 +14,25 @@
 #include <limits>
 #include <vector>
 
+#include "bvhkit/dynamic/tree_insertion.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
 
 namespace bvhkit::dynamic_detail {
+
+/// A box's centre computed from halves, so that boxes reaching +-FLT_MAX do not overflow to inf.
+template <class T, std::size_t N>
+Vec<T, N> safe_centroid(const Aabb<T, N>& b) {
+    return b.min * T(0.5) + b.max * T(0.5);
+}
+
+/// Bin of centroid coordinate c in [lo, hi] (lo < hi), out of `bins`. Uses halves and a ratio in
+/// [0, 1] so that neither the range nor its inverse can overflow (a range of 2 * FLT_MAX, or one of
+/// a few subnormals), which would give a NaN bin.
+template <class T>
+int bin_of(T c, T lo, T hi, int bins) {
+    const T r = (c * T(0.5) - lo * T(0.5)) / (hi * T(0.5) - lo * T(0.5));
+    return std::min(bins - 1, static_cast<int>(std::clamp(r, T(0), T(1)) * T(bins)));
+}
 
 template <class T, std::size_t N>
 struct BuildItem {
@@ -64,30 +80,30 @@ std::int32_t build_binned_sah(Node<T, N>* nodes, BuildScratch<T, N>& s, Alloc&& 
                 cbounds.grow(items[i].centroid);
             }
             std::int32_t mid = task.begin + (task.end - task.begin) / 2;
-            const Vec<T, N> extent = cbounds.extent();
-            if (max_component(extent) > T(0)) {
+            bool spread = false;
+            for (std::size_t axis = 0; axis < N; ++axis)
+                spread = spread || cbounds.max[axis] > cbounds.min[axis];
+            if (spread) {
                 int best_axis = -1, best_split = 0;
-                T best_cost = std::numeric_limits<T>::infinity();
+                Cost best_cost = std::numeric_limits<Cost>::infinity();
                 for (std::size_t axis = 0; axis < N; ++axis) {
-                    if (!(extent[axis] > T(0))) continue;
+                    const T lo = cbounds.min[axis], hi = cbounds.max[axis];
+                    if (!(hi > lo)) continue;
                     Aabb<T, N> bin_box[kBins];
                     int bin_count[kBins] = {};
-                    const T scale = T(kBins) / extent[axis];
                     for (std::int32_t i = task.begin; i < task.end; ++i) {
-                        const int b = std::min(
-                            kBins - 1, static_cast<int>(
-                                           (items[i].centroid[axis] - cbounds.min[axis]) * scale));
+                        const int b = bin_of(items[i].centroid[axis], lo, hi, kBins);
                         bin_box[b].grow(nodes[items[i].node].box);
                         ++bin_count[b];
                     }
                     // Right-to-left sweep stores the cost of everything right of each plane.
-                    T right_cost[kBins];
+                    Cost right_cost[kBins];
                     Aabb<T, N> acc;
                     int count = 0;
                     for (int b = kBins - 1; b > 0; --b) {
                         acc.grow(bin_box[b]);
                         count += bin_count[b];
-                        right_cost[b] = count ? acc.area() * T(count) : T(0);
+                        right_cost[b] = count ? box_area(acc) * Cost(count) : Cost(0);
                     }
                     acc = Aabb<T, N>();
                     count = 0;
@@ -95,19 +111,16 @@ std::int32_t build_binned_sah(Node<T, N>* nodes, BuildScratch<T, N>& s, Alloc&& 
                         acc.grow(bin_box[b]);
                         count += bin_count[b];
                         if (count == 0 || count == task.end - task.begin) continue;
-                        const T cost = acc.area() * T(count) + right_cost[b + 1];
+                        const Cost cost = box_area(acc) * Cost(count) + right_cost[b + 1];
                         if (cost < best_cost)
                             best_cost = cost, best_axis = int(axis), best_split = b;
                     }
                 }
                 if (best_axis >= 0) {
-                    const T lo = cbounds.min[best_axis];
-                    const T scale = T(kBins) / extent[best_axis];
+                    const T lo = cbounds.min[best_axis], hi = cbounds.max[best_axis];
                     auto* split = std::partition(
                         items.data() + task.begin, items.data() + task.end, [&](const auto& it) {
-                            const int b = std::min(
-                                kBins - 1, static_cast<int>((it.centroid[best_axis] - lo) * scale));
-                            return b <= best_split;
+                            return bin_of(it.centroid[best_axis], lo, hi, kBins) <= best_split;
                         });
                     mid = static_cast<std::int32_t>(split - items.data());
                     if (mid == task.begin || mid == task.end) {
@@ -137,8 +150,7 @@ std::int32_t build_binned_sah(Node<T, N>* nodes, BuildScratch<T, N>& s, Alloc&& 
     // Heights bottom-up: children were created after their parents.
     for (auto it = s.created.rbegin(); it != s.created.rend(); ++it) {
         Node<T, N>& n = nodes[*it];
-        n.height =
-            static_cast<std::int16_t>(1 + std::max(nodes[n.child1].height, nodes[n.child2].height));
+        n.height = 1 + std::max<std::int32_t>(nodes[n.child1].height, nodes[n.child2].height);
     }
     return root;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // The small types shared by the dynamic tree's parts: ids, the node and proxy records, the options
 // (fat margins, insertion strategy) and the statistics a query or the whole tree can report.
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -71,19 +72,22 @@ namespace dynamic_detail {
 inline constexpr std::int32_t kNullNode = -1;
 
 /// One node of the pool. 32 bytes for 2D float, 40 for 3D float. A leaf has child1 == kNullNode and
-/// keeps its proxy id in child2; a free node keeps the next free index in parent.
+/// keeps its proxy id in child2; a free node keeps the next free index in parent. The height has 31
+/// bits: a tree of 2^31 nodes (the pool's limit) cannot be taller than that, so no input (say tens
+/// of thousands of nested boxes with rotations off) can overflow it.
 template <class T, std::size_t N>
 struct Node {
     Aabb<T, N> box;  // fat box for a leaf, union of the children for an internal node
     std::int32_t parent = kNullNode;  // or the next free node
     std::int32_t child1 = kNullNode;
     std::int32_t child2 = kNullNode;  // a leaf's proxy id
-    std::int16_t height = 0;          // leaf 0, free -1
-    std::uint16_t enlarged = 0;       // set by enlarge(), cleared by rebuild()
+    std::int32_t height : 31 = 0;     // leaf 0, free -1
+    std::uint32_t enlarged : 1 = 0;   // set by enlarge(), cleared by rebuild()
 
     bool is_leaf() const { return child1 == kNullNode; }
     ProxyId proxy() const { return child2; }
 };
+static_assert(sizeof(Node<float, 2>) == 32 && sizeof(Node<float, 3>) == 40);
 
 /// What the tree keeps per proxy. A free slot has node == kNullNode and the next free id in
 /// next_free.
@@ -94,6 +98,36 @@ struct Proxy {
     std::int32_t node = kNullNode;
     std::int32_t next_free = kNullNode;
     bool moved = false;  // in the move buffer
+};
+
+/// How many walks (queries, find_pairs, for_each_node) are running over a tree right now. The
+/// structural calls refuse to run while it is non-zero, so a callback cannot change the node pool
+/// under the walk that called it. Atomic because const queries may run on many threads at once.
+/// A copied or moved tree starts with no walk.
+class WalkCounter {
+  public:
+    WalkCounter() = default;
+    WalkCounter(const WalkCounter&) noexcept {}
+    WalkCounter& operator=(const WalkCounter&) noexcept { return *this; }
+
+    bool active() const { return count_.load(std::memory_order_relaxed) != 0; }
+
+    /// Holds the counter up for its lifetime (also when a callback throws).
+    class Guard {
+      public:
+        explicit Guard(const WalkCounter& c) : c_(c) {
+            c_.count_.fetch_add(1, std::memory_order_relaxed);
+        }
+        ~Guard() { c_.count_.fetch_sub(1, std::memory_order_relaxed); }
+        Guard(const Guard&) = delete;
+        Guard& operator=(const Guard&) = delete;
+
+      private:
+        const WalkCounter& c_;
+    };
+
+  private:
+    mutable std::atomic<std::uint32_t> count_{0};
 };
 
 }  // namespace dynamic_detail

@@ -45,6 +45,16 @@ void check_vector(const Vec<T, N>& v, const char* what, const char* where) {
                         format_value(v[i]) + " (must be finite)");
 }
 
+/// Throws when a query's vector holds a NaN (every comparison with it is false, so the walk would
+/// report every proxy). Infinities stay allowed: a box from -inf to inf is a query for everything.
+template <class T, std::size_t N>
+void check_not_nan(const Vec<T, N>& v, const char* what, const char* where) {
+    for (std::size_t i = 0; i < N; ++i)
+        if (std::isnan(v[i]))
+            throw Error(std::string(where) + ": " + what + "[" + std::to_string(i) +
+                        "] is nan (a query must not hold NaN)");
+}
+
 /// Everything validate() needs to see of a tree.
 template <class T, std::size_t N, class U>
 struct TreeParts {
@@ -119,7 +129,7 @@ void validate_tree(const TreeParts<T, N, U>& t) {
                 stack.push_back(c);
             }
             if (n.child1 == n.child2) broken(node_name(i) + " has the same child twice");
-            const int h = 1 + std::max(t.nodes[n.child1].height, t.nodes[n.child2].height);
+            const int h = 1 + std::max<int>(t.nodes[n.child1].height, t.nodes[n.child2].height);
             if (n.height != h)
                 broken(node_name(i) + " has height " + std::to_string(n.height) + ", expected " +
                        std::to_string(h));
