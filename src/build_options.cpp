@@ -1,3 +1,4 @@
+#include <cmath>
 #include <string>
 
 #include "bvhkit/build/options.hpp"
@@ -65,6 +66,38 @@ std::vector<std::pair<std::string, BuildOptions>> all_builder_configurations() {
         out.emplace_back(out[i].first + "+opt", t);
     }
     return out;
+}
+
+namespace {
+
+[[noreturn]] void bad_option(const std::string& field, const std::string& value,
+                             const char* range) {
+    throw Error("BuildOptions::" + field + " = " + value + " is invalid; valid: " + range);
+}
+
+}  // namespace
+
+void validate_options(const BuildOptions& o) {
+    const auto u = [](auto v) { return std::to_string(v); };
+    if (static_cast<unsigned>(o.builder) > static_cast<unsigned>(Builder::Lbvh))
+        bad_option("builder", u(static_cast<unsigned>(o.builder)), "a Builder enumerator");
+    if (static_cast<unsigned>(o.axis_rule) > static_cast<unsigned>(SplitAxis::LargestVariance))
+        bad_option("axis_rule", u(static_cast<unsigned>(o.axis_rule)), "a SplitAxis enumerator");
+    if (static_cast<unsigned>(o.point_rule) > static_cast<unsigned>(SplitPoint::SpatialMedian))
+        bad_option("point_rule", u(static_cast<unsigned>(o.point_rule)), "a SplitPoint enumerator");
+    if (static_cast<unsigned>(o.non_finite) > static_cast<unsigned>(NonFinitePolicy::Reject))
+        bad_option("non_finite", u(static_cast<unsigned>(o.non_finite)),
+                   "a NonFinitePolicy enumerator");
+    if (o.bin_count < 2 || o.bin_count > 256) bad_option("bin_count", u(o.bin_count), "2..256");
+    if (o.max_leaf_size < 1) bad_option("max_leaf_size", u(o.max_leaf_size), ">= 1");
+    if (o.max_depth > max_bvh_depth)
+        bad_option("max_depth", u(o.max_depth), ("0.." + u(max_bvh_depth)).c_str());
+    if (!std::isfinite(o.costs.traversal) || o.costs.traversal < 0)
+        bad_option("costs.traversal", u(o.costs.traversal), "finite and >= 0");
+    if (!std::isfinite(o.costs.intersection) || !(o.costs.intersection > 0))
+        bad_option("costs.intersection", u(o.costs.intersection), "finite and > 0");
+    if (o.ploc_radius < 1 || o.ploc_radius > max_ploc_radius)
+        bad_option("ploc_radius", u(o.ploc_radius), ("1.." + u(max_ploc_radius)).c_str());
 }
 
 BuildOptions parse_builder(std::string_view name) {

@@ -2,6 +2,8 @@
 // coordinates.
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/refit.hpp"
 #include "bvhkit/bvh/validate.hpp"
@@ -244,4 +246,83 @@ TEST(Refit, MovedVerticesGiveAValidTreeOfTheSameShape) {
     refit(bvh, std::span<const Aabb3f>(moved.boxes));
     validate(bvh, moved.boxes);
     EXPECT_EQ(bvh.nodes.size(), shape);
+}
+
+TEST(BuildOptions, EveryInvalidFieldIsRejectedByName) {
+    const auto tris = test::random_soup<float>(200, 31);
+    const Boxes<float> in(tris);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    const std::vector<std::pair<std::string, std::function<void(BuildOptions&)>>> cases = {
+        {"bin_count", [](BuildOptions& o) { o.bin_count = 0; }},
+        {"bin_count", [](BuildOptions& o) { o.bin_count = 1; }},
+        {"bin_count", [](BuildOptions& o) { o.bin_count = 257; }},
+        {"bin_count", [](BuildOptions& o) { o.bin_count = 0xFFFFFFFFu; }},
+        {"max_leaf_size", [](BuildOptions& o) { o.max_leaf_size = 0; }},
+        {"max_depth", [](BuildOptions& o) { o.max_depth = max_bvh_depth + 1; }},
+        {"max_depth", [](BuildOptions& o) { o.max_depth = 0xFFFFFFFFu; }},
+        {"costs.traversal", [nan](BuildOptions& o) { o.costs.traversal = nan; }},
+        {"costs.traversal", [](BuildOptions& o) { o.costs.traversal = -1; }},
+        {"costs.traversal", [inf](BuildOptions& o) { o.costs.traversal = inf; }},
+        {"costs.intersection", [nan](BuildOptions& o) { o.costs.intersection = nan; }},
+        {"costs.intersection", [](BuildOptions& o) { o.costs.intersection = 0; }},
+        {"costs.intersection", [](BuildOptions& o) { o.costs.intersection = -2; }},
+        {"ploc_radius", [](BuildOptions& o) { o.ploc_radius = 0; }},
+        {"ploc_radius", [](BuildOptions& o) { o.ploc_radius = max_ploc_radius + 1; }},
+        {"ploc_radius", [](BuildOptions& o) { o.ploc_radius = 1u << 30; }},
+        {"builder", [](BuildOptions& o) { o.builder = static_cast<Builder>(99); }},
+        {"axis_rule", [](BuildOptions& o) { o.axis_rule = static_cast<SplitAxis>(7); }},
+        {"point_rule", [](BuildOptions& o) { o.point_rule = static_cast<SplitPoint>(7); }},
+        {"non_finite", [](BuildOptions& o) { o.non_finite = static_cast<NonFinitePolicy>(7); }},
+    };
+    for (const auto& [base_name, base] : configurations())
+        for (const auto& [field, set] : cases) {
+            SCOPED_TRACE(base_name + " / " + field);
+            BuildOptions o = base;
+            set(o);
+            try {
+                (void)build_bvh<float, 3>(in.boxes, in.centroids, o);
+                ADD_FAILURE() << "accepted";
+            } catch (const Error& e) {
+                const std::string what = e.what();
+                EXPECT_NE(what.find("BuildOptions::" + field + " "), std::string::npos) << what;
+                EXPECT_NE(what.find("valid"), std::string::npos) << what;
+            }
+        }
+    // The ends of each range are accepted.
+    for (const auto& [base_name, base] : configurations()) {
+        SCOPED_TRACE(base_name);
+        BuildOptions o = base;
+        o.bin_count = 2;
+        o.max_leaf_size = 1;
+        o.max_depth = 0;
+        o.ploc_radius = 1;
+        o.costs = {0.0, 1e-3};
+        EXPECT_NO_THROW(validate(build_bvh<float, 3>(in.boxes, in.centroids, o), in.boxes));
+        o.bin_count = 256;
+        o.max_depth = max_bvh_depth;
+        o.ploc_radius = max_ploc_radius;
+        o.max_leaf_size = 0xFFFFFFFFu;
+        EXPECT_NO_THROW(validate(build_bvh<float, 3>(in.boxes, in.centroids, o), in.boxes));
+    }
+}
+
+TEST(BuildOptions, HugeThreadCountsAreClampedToTheHardware) {
+    // 2^18 and more threads crashed inside oneTBB, 2^16 took ~1 GB: now clamped, same tree.
+    const auto tris = test::random_soup<float>(test::scaled(20000, 10), 32);
+    const Boxes<float> in(tris);
+    for (const auto& [name, base] : configurations()) {
+        if (base.optimize) continue;
+        SCOPED_TRACE(name);
+        BuildOptions serial = base, huge = base;
+        serial.threads = 1;
+        huge.threads = 0xFFFFFFFFu;
+        const auto a = build_bvh<float, 3>(in.boxes, in.centroids, serial);
+        const auto b = build_bvh<float, 3>(in.boxes, in.centroids, huge);
+        EXPECT_EQ(a.primitive_indices, b.primitive_indices);
+        ASSERT_EQ(a.nodes.size(), b.nodes.size());
+        huge.threads = 1u << 18;
+        EXPECT_NO_THROW(validate(build_bvh<float, 3>(in.boxes, in.centroids, huge), in.boxes));
+    }
+    EXPECT_GE(hardware_threads(), 1u);
 }

@@ -51,6 +51,7 @@ Bvh<Aabb<T, N>> build_unoptimized(BuildInput<T, N>& in, std::vector<std::uint32_
 template <class T, std::size_t N>
 Bvh<Aabb<T, N>> build_bvh(std::span<const Aabb<T, N>> boxes, std::span<const Vec<T, N>> centroids,
                           const BuildOptions& options = {}, BuildReport* report = nullptr) {
+    validate_options(options);
     BuildInput<T, N> in{boxes, centroids};
     if (report) report->skipped.clear();
     std::vector<Vec<T, N>> fixed_centroids;

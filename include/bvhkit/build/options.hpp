@@ -37,13 +37,17 @@ enum class NonFinitePolicy {
     Reject,  // throw bvhkit::Error naming the first such primitive
 };
 
+/// Every field is checked when a build starts (validate_options); a value outside the range given
+/// beside it throws bvhkit::Error naming the field and its range.
 struct BuildOptions {
     Builder builder = Builder::BinnedSah;
     std::uint32_t bin_count = 16;     // binned SAH: 2..256 (16 to 32 are good values)
-    std::uint32_t max_leaf_size = 8;  // a larger node is always split
+    std::uint32_t max_leaf_size = 8;  // >= 1; a larger node is always split
     std::uint32_t max_depth =
-        max_bvh_depth;  // a node at this depth becomes a leaf, whatever its size
-    SahCosts costs{};   // SAH builders: leaf cost vs split cost
+        max_bvh_depth;  // 0..max_bvh_depth; a node at this depth becomes a leaf, whatever its size
+    /// SAH builders and the bottom-up builders' collapse: leaf cost vs split cost. traversal
+    /// finite and >= 0, intersection finite and > 0.
+    SahCosts costs{};
     SplitAxis axis_rule = SplitAxis::LongestExtent;
     SplitPoint point_rule = SplitPoint::ObjectMedian;
     NonFinitePolicy non_finite = NonFinitePolicy::Skip;
@@ -53,10 +57,19 @@ struct BuildOptions {
     /// Threads for the builders when bvhkit was built with oneTBB: the top-down ones (binned and
     /// sweep SAH, the classic rules) split large nodes and whole subtrees in parallel, bottom-up
     /// and LBVH run their passes in parallel; insertion and the optimizer are serial. 0 = all,
-    /// 1 = serial, k = at most k. The tree is the same, bit for bit, for every value.
+    /// 1 = serial, k = at most k; any k above the hardware's concurrency is clamped to it. The tree
+    /// is the same, bit for bit, for every value.
     unsigned threads = 0;
-    std::uint32_t ploc_radius = 16;  // bottom-up: neighbours searched on each side
+    /// Bottom-up: neighbours searched on each side, 1..max_ploc_radius (each round costs
+    /// 2 * radius area evaluations per cluster).
+    std::uint32_t ploc_radius = 16;
 };
+
+inline constexpr std::uint32_t max_ploc_radius = 64;
+
+/// Throws bvhkit::Error naming the first field of `options` outside its valid range (see
+/// BuildOptions). build_bvh() calls it before anything else.
+void validate_options(const BuildOptions& options);
 
 struct BuildReport {
     std::vector<std::uint32_t> skipped;  // primitives left out for non-finite boxes, ascending

@@ -8,12 +8,15 @@
 //
 // `threads`: 0 uses every core TBB offers (or, inside with_threads, the arena's), 1 runs serially
 // on the calling thread, k limits TBB to k threads (a task arena). Code already inside with_threads
-// passes 0, so nested calls stay in that arena instead of making one each.
+// passes 0, so nested calls stay in that arena instead of making one each. A k above the hardware's
+// concurrency is clamped to it: more threads than cores only cost memory (oneTBB reserves per
+// thread, and fails outright for arenas of some 2^18 threads).
 #include <algorithm>
 #include <cstddef>
 
 #if defined(BVHKIT_HAVE_TBB)
 #include <tbb/blocked_range.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/partitioner.h>
@@ -31,12 +34,23 @@ constexpr bool have_parallel() {
 #endif
 }
 
-/// Calls f() in a task arena of `threads` threads when threads > 1, else directly. Inside, pass
-/// threads = 0 to parallel_for and parallel_invoke: they then run in this arena, at most `threads`
-/// wide, without making an arena per call.
+/// The most threads an arena is given: the hardware's concurrency (at least 1).
+inline unsigned hardware_threads() {
+#if defined(BVHKIT_HAVE_TBB)
+    static const unsigned n = static_cast<unsigned>(std::max(1, tbb::info::default_concurrency()));
+    return n;
+#else
+    return 1;
+#endif
+}
+
+/// Calls f() in a task arena of min(`threads`, hardware_threads()) threads when that is more than
+/// one, else directly. Inside, pass threads = 0 to parallel_for and parallel_invoke: they then run
+/// in this arena, at most `threads` wide, without making an arena per call.
 template <class F>
 void with_threads(unsigned threads, F&& f) {
 #if defined(BVHKIT_HAVE_TBB)
+    threads = std::min(threads, hardware_threads());
     if (threads > 1) {
         tbb::task_arena arena(static_cast<int>(threads));
         arena.execute(f);
