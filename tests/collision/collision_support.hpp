@@ -79,7 +79,7 @@ PairSet brute_force_self(const BasicTriangleMesh<T>& m, T pad) {
     return out;
 }
 
-/// The least distance over all triangle pairs (zero-area ones ignored); pairs whose boxes are
+/// The least distance over all triangle pairs (zero-area ones included); pairs whose boxes are
 /// already farther apart than the best so far cannot be closer and are skipped.
 template <class T>
 T brute_force_distance(const std::vector<Triangle<T>>& a, const std::vector<Triangle<T>>& b,
@@ -92,10 +92,8 @@ T brute_force_distance(const std::vector<Triangle<T>>& a, const std::vector<Tria
     }
     T best2 = std::numeric_limits<T>::infinity();
     for (std::size_t i = 0; i < a.size(); ++i) {
-        if (is_degenerate(a[i])) continue;
         const Aabb<T, 3> ba = a[i].bounds();
         for (std::size_t j = 0; j < b.size(); ++j) {
-            if (is_degenerate(bt[j])) continue;
             T gap2 = 0;
             for (int k = 0; k < 3; ++k) {
                 const T g = std::max({T(0), ba.min[k] - bb[j].max[k], bb[j].min[k] - ba.max[k]});

@@ -102,18 +102,6 @@ TEST(TriangleTriangle, Coplanar) {
     EXPECT_TRUE(triangles_intersect(a, Tri{{1, 0, 0}, {0, 1, 0}, {1, 1, 0}}));
 }
 
-TEST(TriangleTriangle, ZeroAreaTrianglesIntersectNothing) {
-    const Tri a{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-    const Tri needle{{0.2, 0.2, -1}, {0.2, 0.2, 1}, {0.2, 0.2, 0}};  // collinear, through a
-    const Tri point{{0.2, 0.2, 0}, {0.2, 0.2, 0}, {0.2, 0.2, 0}};    // on a
-    EXPECT_TRUE(is_degenerate(needle));
-    EXPECT_TRUE(is_degenerate(point));
-    EXPECT_FALSE(triangles_intersect(a, needle));
-    EXPECT_FALSE(triangles_intersect(needle, a));
-    EXPECT_FALSE(triangles_intersect(point, a));
-    EXPECT_FALSE(triangles_intersect(point, point));
-}
-
 TEST(TriangleDistance, MatchesDenseSampling) {
     SplitMix64 rng(5);
     for (int trial = 0; trial < int(scaled(200, 10)); ++trial) {
@@ -211,9 +199,8 @@ TEST(Degenerate, TouchingAtAVertexOrAnEdge) {
     check_touching<Kdop<float, 26>>();
 }
 
-TEST(Degenerate, ZeroAreaTrianglesAreIgnoredByModels) {
-    // A needle through a triangle, and a point on it: no contact, and the distance is that of the
-    // real triangles alone.
+TEST(Degenerate, ZeroAreaTrianglesCollideAsSegmentsAndPoints) {
+    // A needle through a triangle, and a point on it: both are contacts, and the distance is 0.
     TriangleMesh a, b;
     a.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     a.triangles = {{0, 1, 2}};
@@ -221,10 +208,20 @@ TEST(Degenerate, ZeroAreaTrianglesAreIgnoredByModels) {
                   {5, 0, 0},        {6, 0, 0},       {5, 1, 0}};
     b.triangles = {{0, 1, 2}, {2, 2, 2}, {3, 4, 5}};
     const CollisionModel<Obb<float>> ma(a), mb(b);
-    EXPECT_FALSE(collides(ma, mb, Transform<float>::identity()));
+    EXPECT_TRUE(collides(ma, mb, Transform<float>::identity()));
+    CollideResult<float> r;
+    collide(ma, mb, Transform<float>::identity(), {}, r);
+    PairSet got;
+    for (const auto& c : r.contacts) got.insert({c.triangle_a, c.triangle_b});
+    EXPECT_EQ(got, (PairSet{{0, 0}, {0, 1}}));
     const auto d = distance(ma, mb, Transform<float>::identity());
-    EXPECT_FLOAT_EQ(d.distance, 4.0f);
-    EXPECT_EQ(d.triangle_b, 2u);
+    EXPECT_EQ(d.distance, 0.0f);
+    // Lifted off the plane by 0.5: the needle still pierces it, the point is 0.5 away.
+    const Transform<float> up{Mat3<float>{}, Vec3f(0, 0, 0.5f)};
+    collide(ma, mb, up, {}, r);
+    ASSERT_EQ(r.contacts.size(), 1u);
+    EXPECT_EQ(r.contacts[0].triangle_b, 0u);
+    // The needle and the point share vertex index 2: neighbours, not a self-intersection.
     std::vector<Contact<float>> self;
     const CollisionModel<Obb<float>> mself(b);
     EXPECT_FALSE(self_collide(mself, self));

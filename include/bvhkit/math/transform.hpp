@@ -2,6 +2,12 @@
 // Mat3<T> and Transform<T>: a 3x3 matrix (rows) and a rigid transform x' = R x + t, the pose of one
 // model in the frame of another. Collision queries take the pose of B in A's frame and apply it to
 // B's volumes and triangles on the fly, so no mesh is ever copied or re-transformed per query.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "bvhkit/error.hpp"
 #include "bvhkit/math/vec.hpp"
 
 namespace bvhkit {
@@ -44,7 +50,8 @@ struct Mat3 {
     }
 };
 
-/// A rigid transform: apply(x) = R x + t with R a rotation (not checked).
+/// A rigid transform: apply(x) = R x + t with R a rotation (the collision queries check it:
+/// check_rigid_pose below).
 template <class T>
 struct Transform {
     Mat3<T> rotation{};
@@ -87,6 +94,47 @@ Mat3<T> rotation_from_quaternion(T w, T x, T y, T z) {
     r.row[1] = {2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)};
     r.row[2] = {2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)};
     return r;
+}
+
+/// How far R may be from a rotation and still count as one: max |(R^T R - I)_ij| and |det R - 1|.
+/// A rotation rounded to float is within ~1e-7 of one, and a few dozen float compositions stay
+/// well under 1e-5; a scale or shear of 1e-4 would already move a point 1 unit away by 1e-4,
+/// which no caller means by "rigid". Double: rounding is ~1e-16, so 1e-9 leaves the same room.
+template <class T>
+constexpr double rigid_tolerance() {
+    return sizeof(T) <= 4 ? 1e-4 : 1e-9;
+}
+
+/// Throws Error unless `pose` is finite and rigid (R^T R = I and det R = +1 within
+/// rigid_tolerance<T>()). `where` and `argument` name the call and the argument in the message.
+template <class T>
+void check_rigid_pose(const Transform<T>& pose, const char* where, const char* argument) {
+    const auto fail = [&](const std::string& why) {
+        throw Error(std::string(where) + ": " + argument + " " + why);
+    };
+    for (std::size_t i = 0; i < 3; ++i) {
+        if (!std::isfinite(double(pose.translation[i])))
+            fail("has a non-finite translation (NaN or infinity); a pose must be finite");
+        for (std::size_t j = 0; j < 3; ++j)
+            if (!std::isfinite(double(pose.rotation[i][j])))
+                fail("has a non-finite rotation entry (NaN or infinity); a pose must be finite");
+    }
+    const Mat3<double> r(pose.rotation);
+    double worst = 0;
+    for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) {
+            const double d = dot(r.column(i), r.column(j)) - (i == j ? 1.0 : 0.0);
+            worst = std::max(worst, std::fabs(d));
+        }
+    const double det = dot(r.row[0], cross(r.row[1], r.row[2]));
+    const double tol = rigid_tolerance<T>();
+    if (worst > tol || std::fabs(det - 1.0) > tol) {
+        std::ostringstream m;
+        m << "is not a rigid motion: its rotation must satisfy R^T R = I and det R = +1 within "
+          << tol << " (found max |R^T R - I| = " << worst << ", det R = " << det
+          << "); scaled, sheared or mirrored poses are not supported";
+        fail(m.str());
+    }
 }
 
 using Transformf = Transform<float>;

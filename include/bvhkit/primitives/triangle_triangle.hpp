@@ -1,24 +1,30 @@
 #pragma once
-// Triangle-triangle intersection with the intersection segment, after Moller 1997 ("A fast
-// triangle-triangle intersection test"): reject when one triangle lies strictly on one side of the
-// other's plane; otherwise each triangle meets the other's plane in a segment, both segments lie on
-// the planes' common line, and the triangles meet where those segments overlap.
+// Triangle-triangle intersection, decided exactly on the input coordinates (float or double), with
+// an intersection segment computed afterwards.
 //
-// Rules for the special cases (closed triangles: touching counts):
-// - Plane sides are orientation determinants orient(a, b, c, p) = (a - p) . ((b - p) x (c - p)),
-//   which are exactly zero when p is one of a, b, c: a vertex shared by two triangles (or an
-//   identical triangle) is always found "on the plane", so neighbours in a mesh and a model
-//   against its copy at the identity pose touch, with no epsilon to tune.
-// - Touching at a single vertex or along an edge is an intersection; the segment degenerates to
-//   the touching point, or is the shared piece of the edge.
-// - Coplanar triangles (every orientation zero) are tested in 2D, in the coordinate plane where
-//   the normal is largest: they intersect when an edge of one crosses or touches an edge of the
-//   other, or a vertex of one lies in or on the other. Their overlap is an area, not a segment:
-//   the segment reported runs between two points of the overlap region (vertices inside the other
-//   triangle, edge crossings) that are farthest apart, with `coplanar` set.
-// - A zero-area triangle (its edge cross product is exactly zero) is not a surface and intersects
-//   nothing, as it is never hit by a ray (primitives/triangle.hpp). The distance query ignores it
-//   likewise.
+// The decision uses orientation signs only (math/predicates.hpp: exact), never a constructed point:
+// - each triangle's corners against the other's plane; all strictly on one side: disjoint;
+// - otherwise, for two proper (non-zero-area), non-coplanar triangles, both meet the planes'
+//   common line in a segment, and those segments overlap exactly when two more orientations have
+//   the right signs (Guigue and Devillers 2003, "Fast and robust triangle-triangle overlap test
+//   using orientation predicates");
+// - coplanar triangles and zero-area ones take the general rule: two closed triangles meet exactly
+//   when an edge of one meets the other (an extreme point of their intersection lies on the
+//   boundary of one of them), each edge test again by orientation signs (detail below).
+//
+// Rules (closed triangles: touching counts):
+// - Touching at a single vertex or along an edge is an intersection; a vertex shared by two
+//   triangles, and a model against its copy at the identity pose, always touch.
+// - A zero-area triangle is the segment or point it is (its corners' hull) and meets what that
+//   segment or point meets.
+// - The segment: for crossing triangles, the overlap of the two cuts along the planes' common line,
+//   interpolated in double. For coplanar ones the overlap is an area: the segment runs between the
+//   two points of the overlap region (corners inside the other triangle, edge crossings) that are
+//   farthest apart, with `coplanar` set. A contact involving a zero-area triangle reports one
+//   point of it (p == q). The points are rounded to T; the decision never depends on them.
+#include <algorithm>
+
+#include "bvhkit/math/predicates.hpp"
 #include "bvhkit/primitives/triangle.hpp"
 
 namespace bvhkit {
@@ -30,154 +36,188 @@ struct TriangleIntersection {
     Vec<T, 3> p{}, q{};  // the intersection segment (p == q for a single touching point)
 };
 
+/// (a - p) . ((b - p) x (c - p)), evaluated in T (not exact; orient3d_sign gives the exact sign).
 template <class T>
 T orient3d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, const Vec<T, 3>& p) {
     return dot(a - p, cross(b - p, c - p));
 }
 
-template <class T>
-bool is_degenerate(const Triangle<T>& t) {
-    const Vec<T, 3> n = cross(t.p1 - t.p0, t.p2 - t.p0);
-    return n[0] == T(0) && n[1] == T(0) && n[2] == T(0);
-}
-
 namespace detail {
 
-template <class T>
-int sign_of(T x) {
-    return (x > T(0)) - (x < T(0));
-}
-
-/// Where triangle (v0, v1, v2), with signed plane distances d, meets the plane: 1 or 2 points.
-template <class T>
-int plane_cut(const Vec<T, 3>* v, const T* d, Vec<T, 3>* out) {
-    int n = 0;
-    for (int i = 0; i < 3; ++i)
-        if (d[i] == T(0)) out[n++] = v[i];
-    for (int i = 0; i < 3 && n < 2; ++i) {
-        const int j = (i + 1) % 3;
-        if ((d[i] < T(0) && d[j] > T(0)) || (d[i] > T(0) && d[j] < T(0)))
-            out[n++] = v[i] + (v[j] - v[i]) * (d[i] / (d[i] - d[j]));
-    }
-    return n;
+/// The two axes kept when axis `drop` is dropped.
+inline void kept_axes(std::size_t drop, std::size_t& x, std::size_t& y) {
+    x = drop == 0 ? 1 : 0;
+    y = drop == 2 ? 1 : 2;
 }
 
 template <class T>
-T orient2d(T ax, T ay, T bx, T by, T cx, T cy) {
-    return (ax - cx) * (by - cy) - (ay - cy) * (bx - cx);
+int orient2d_in(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, std::size_t drop) {
+    std::size_t x, y;
+    kept_axes(drop, x, y);
+    return orient2d_sign(double(a[x]), double(a[y]), double(b[x]), double(b[y]), double(c[x]),
+                         double(c[y]));
 }
 
-/// Coplanar triangles, compared in the coordinate plane that drops axis `drop`.
-template <class T, bool WantSegment>
-bool coplanar_intersect(const Vec<T, 3>* u, const Vec<T, 3>* v, std::size_t drop,
-                        TriangleIntersection<T>* out) {
-    const std::size_t x = drop == 0 ? 1 : 0, y = drop == 2 ? 1 : 2;
-    Vec<T, 3> pts[16];
-    int npts = 0;
-    const auto add = [&](const Vec<T, 3>& p) {
-        if (npts < 16) pts[npts++] = p;
-    };
-    const auto inside = [&](const Vec<T, 3>* t, const Vec<T, 3>& p) {
-        const T a = orient2d(t[0][x], t[0][y], t[1][x], t[1][y], p[x], p[y]);
-        const T b = orient2d(t[1][x], t[1][y], t[2][x], t[2][y], p[x], p[y]);
-        const T c = orient2d(t[2][x], t[2][y], t[0][x], t[0][y], p[x], p[y]);
-        return (a >= T(0) && b >= T(0) && c >= T(0)) || (a <= T(0) && b <= T(0) && c <= T(0));
-    };
-    bool hit = false;
-    for (int i = 0; i < 3; ++i) {
-        if (inside(v, u[i])) {
-            hit = true;
-            if constexpr (!WantSegment) return true;
-            add(u[i]);
-        }
-        if (inside(u, v[i])) {
-            hit = true;
-            if constexpr (!WantSegment) return true;
-            add(v[i]);
-        }
-    }
-    for (int i = 0; i < 3; ++i) {
-        const Vec<T, 3>&a = u[i], &b = u[(i + 1) % 3];
-        for (int j = 0; j < 3; ++j) {
-            const Vec<T, 3>&c = v[j], &d = v[(j + 1) % 3];
-            const T o1 = orient2d(a[x], a[y], b[x], b[y], c[x], c[y]);
-            const T o2 = orient2d(a[x], a[y], b[x], b[y], d[x], d[y]);
-            const T o3 = orient2d(c[x], c[y], d[x], d[y], a[x], a[y]);
-            const T o4 = orient2d(c[x], c[y], d[x], d[y], b[x], b[y]);
-            if (o1 == T(0) && o2 == T(0)) continue;  // collinear: endpoints were tested above
-            if (sign_of(o1) * sign_of(o2) > 0 || sign_of(o3) * sign_of(o4) > 0) continue;
-            hit = true;
-            if constexpr (!WantSegment) return true;
-            add(c + (d - c) * (o1 / (o1 - o2)));
-        }
-    }
-    if constexpr (WantSegment) {
-        if (hit) {
-            int far = 0;
-            T best = -1;
-            for (int k = 0; k < npts; ++k) {
-                const T d2 = length_squared(pts[k] - pts[0]);
-                if (d2 > best) best = d2, far = k;
-            }
-            *out = {true, true, pts[0], pts[far]};
-        }
-    }
-    return hit;
+/// An axis whose dropping keeps triangle t's area (its normal's component on it is non-zero),
+/// or 3 when t has zero area. Exact.
+template <class T>
+std::size_t projection_axis(const Vec<T, 3>* t) {
+    for (std::size_t k = 0; k < 3; ++k)
+        if (orient2d_in(t[0], t[1], t[2], k) != 0) return k;
+    return 3;
 }
 
-template <class T, bool WantSegment>
-bool intersect_impl(const Triangle<T>& a, const Triangle<T>& b, TriangleIntersection<T>* out) {
-    const Vec<T, 3> u[3] = {a.p0, a.p1, a.p2}, v[3] = {b.p0, b.p1, b.p2};
-    const Vec<T, 3> nu = cross(u[1] - u[0], u[2] - u[0]), nv = cross(v[1] - v[0], v[2] - v[0]);
-    if ((nu[0] == T(0) && nu[1] == T(0) && nu[2] == T(0)) ||
-        (nv[0] == T(0) && nv[1] == T(0) && nv[2] == T(0)))
-        return false;
-    // Sides of b's corners against a's plane; a quick plane-equation pre-test first would be
-    // cheaper, but its rounding could disagree with the exact-zero rule above.
-    T dv[3];
-    for (int i = 0; i < 3; ++i) dv[i] = orient3d(u[0], u[1], u[2], v[i]);
-    if ((dv[0] > T(0) && dv[1] > T(0) && dv[2] > T(0)) ||
-        (dv[0] < T(0) && dv[1] < T(0) && dv[2] < T(0)))
-        return false;
-    T du[3];
-    for (int i = 0; i < 3; ++i) du[i] = orient3d(v[0], v[1], v[2], u[i]);
-    if ((du[0] > T(0) && du[1] > T(0) && du[2] > T(0)) ||
-        (du[0] < T(0) && du[1] < T(0) && du[2] < T(0)))
-        return false;
-    if ((dv[0] == T(0) && dv[1] == T(0) && dv[2] == T(0)) ||
-        (du[0] == T(0) && du[1] == T(0) && du[2] == T(0)))
-        return coplanar_intersect<T, WantSegment>(u, v, largest_axis(max(nu, -nu)), out);
-
-    Vec<T, 3> su[2], sv[2];
-    const int nsu = plane_cut(u, du, su), nsv = plane_cut(v, dv, sv);
-    if (nsu == 1) su[1] = su[0];
-    if (nsv == 1) sv[1] = sv[0];
-    // Both cuts lie on the planes' common line: compare them along its largest coordinate.
-    const Vec<T, 3> line = cross(nu, nv);
-    const std::size_t k = largest_axis(max(line, -line));
-    if (su[0][k] > su[1][k]) std::swap(su[0], su[1]);
-    if (sv[0][k] > sv[1][k]) std::swap(sv[0], sv[1]);
-    const Vec<T, 3>& lo = su[0][k] >= sv[0][k] ? su[0] : sv[0];
-    const Vec<T, 3>& hi = su[1][k] <= sv[1][k] ? su[1] : sv[1];
-    if (lo[k] > hi[k]) return false;
-    if constexpr (WantSegment) *out = {true, false, lo, hi};
+/// p within the box of a and b in the plane that drops `drop` (for collinear points: on [a, b]).
+template <class T>
+bool in_box_2d(const Vec<T, 3>& p, const Vec<T, 3>& a, const Vec<T, 3>& b, std::size_t drop) {
+    for (std::size_t k = 0; k < 3; ++k)
+        if (k != drop && (p[k] < std::min(a[k], b[k]) || p[k] > std::max(a[k], b[k]))) return false;
     return true;
+}
+
+/// Whether closed segments [a, b] and [c, d] (either may be a point) meet in the plane dropping
+/// axis `drop`.
+template <class T>
+bool segments_meet_2d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c,
+                      const Vec<T, 3>& d, std::size_t drop) {
+    const int o1 = orient2d_in(a, b, c, drop), o2 = orient2d_in(a, b, d, drop);
+    const int o3 = orient2d_in(c, d, a, drop), o4 = orient2d_in(c, d, b, drop);
+    if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+    return (o1 == 0 && in_box_2d(c, a, b, drop)) || (o2 == 0 && in_box_2d(d, a, b, drop)) ||
+           (o3 == 0 && in_box_2d(a, c, d, drop)) || (o4 == 0 && in_box_2d(b, c, d, drop));
+}
+
+/// Whether closed segments [a, b] and [c, d] (either may be a point) meet in space: they must be
+/// coplanar, and then they meet exactly when they meet in all three coordinate projections (one
+/// of them is one-to-one on a plane holding all four points).
+template <class T>
+bool segments_meet_3d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c,
+                      const Vec<T, 3>& d) {
+    if (orient3d_sign(a, b, c, d) != 0) return false;
+    for (std::size_t k = 0; k < 3; ++k)
+        if (!segments_meet_2d(a, b, c, d, k)) return false;
+    return true;
+}
+
+/// p in closed triangle t, in the plane dropping `drop`, where t has non-zero area.
+template <class T>
+bool point_in_triangle_2d(const Vec<T, 3>* t, const Vec<T, 3>& p, std::size_t drop) {
+    const int a = orient2d_in(t[0], t[1], p, drop), b = orient2d_in(t[1], t[2], p, drop),
+              c = orient2d_in(t[2], t[0], p, drop);
+    return (a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0);
+}
+
+/// Whether closed segment [s, e] (maybe a point) meets closed triangle t (maybe of zero area;
+/// `axis` is projection_axis(t)).
+template <class T>
+bool segment_meets_triangle(const Vec<T, 3>& s, const Vec<T, 3>& e, const Vec<T, 3>* t,
+                            std::size_t axis) {
+    if (axis == 3) {  // t is its corners' hull: the union of its edges
+        for (int i = 0; i < 3; ++i)
+            if (segments_meet_3d(s, e, t[i], t[(i + 1) % 3])) return true;
+        return false;
+    }
+    const int os = orient3d_sign(t[0], t[1], t[2], s), oe = orient3d_sign(t[0], t[1], t[2], e);
+    if (os * oe > 0) return false;
+    if (os == 0 && oe == 0) {  // in t's plane: the projection keeping t's area is one-to-one
+        if (point_in_triangle_2d(t, s, axis) || point_in_triangle_2d(t, e, axis)) return true;
+        for (int i = 0; i < 3; ++i)
+            if (segments_meet_2d(s, e, t[i], t[(i + 1) % 3], axis)) return true;
+        return false;
+    }
+    // The segment crosses the plane at one point: inside t when the line through s and e passes
+    // on the same side of (or through) each of t's edges.
+    const int a = orient3d_sign(s, e, t[0], t[1]), b = orient3d_sign(s, e, t[1], t[2]),
+              c = orient3d_sign(s, e, t[2], t[0]);
+    return (a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0);
+}
+
+/// The general rule: an edge of one triangle meets the other.
+template <class T>
+bool edges_meet(const Vec<T, 3>* u, const Vec<T, 3>* v) {
+    const std::size_t au = projection_axis(u), av = projection_axis(v);
+    for (int i = 0; i < 3; ++i)
+        if (segment_meets_triangle(u[i], u[(i + 1) % 3], v, av)) return true;
+    for (int i = 0; i < 3; ++i)
+        if (segment_meets_triangle(v[i], v[(i + 1) % 3], u, au)) return true;
+    return false;
+}
+
+/// The corner of a triangle alone on its side of a plane, from the corners' sides d (not all
+/// zero, not all strictly on one side): a corner i with the others on the opposite side or on the
+/// plane (side s = d[i]), else the corner on the plane with the others strictly on one side
+/// (s = the opposite of theirs). The plane then cuts edges (i, i+1) and (i, i+2).
+inline int apex(const int* d, int& s) {
+    for (int i = 0; i < 3; ++i) {
+        const int j = d[(i + 1) % 3], k = d[(i + 2) % 3];
+        if (d[i] != 0 && j != d[i] && k != d[i]) {
+            s = d[i];
+            return i;
+        }
+    }
+    for (int i = 0; i < 3; ++i)
+        if (d[i] == 0) {
+            s = -d[(i + 1) % 3];
+            return i;
+        }
+    s = 0;
+    return 0;  // not reached for the inputs described
+}
+
+enum class Meet { None, Crossing, General };
+
+/// The exact decision. On Crossing, a[0..2] and b[0..2] are the triangles reordered so that
+/// a[0] is alone on the positive side of b's plane and b[0] on the positive side of a's (see
+/// apex()), for the segment construction.
+template <class T>
+Meet decide(const Vec<T, 3>* u, const Vec<T, 3>* v, Vec<T, 3>* a, Vec<T, 3>* b) {
+    int dv[3], du[3];
+    for (int i = 0; i < 3; ++i) dv[i] = orient3d_sign(u[0], u[1], u[2], v[i]);
+    if (dv[0] == dv[1] && dv[1] == dv[2]) return dv[0] == 0 ? Meet::General : Meet::None;
+    for (int i = 0; i < 3; ++i) du[i] = orient3d_sign(v[0], v[1], v[2], u[i]);
+    if (du[0] == du[1] && du[1] == du[2]) return du[0] == 0 ? Meet::General : Meet::None;
+    // Both have non-zero area (a zero-area triangle puts every point on its "plane") and they
+    // are not coplanar. Guigue-Devillers: rotate each so its apex comes first, flip the other's
+    // orientation so that the apex is on the positive side; the cuts overlap exactly when
+    // orient(a0, a1, b0, b1) <= 0 and orient(a0, a2, b2, b0) <= 0.
+    int su = 0, sv = 0;
+    const int iu = apex(du, su), iv = apex(dv, sv);
+    for (int k = 0; k < 3; ++k) {
+        a[k] = u[(iu + k) % 3];
+        b[k] = v[(iv + k) % 3];
+    }
+    if (su < 0) std::swap(b[1], b[2]);
+    if (sv < 0) std::swap(a[1], a[2]);
+    if (orient3d_sign(a[0], a[1], b[0], b[1]) > 0) return Meet::None;
+    if (orient3d_sign(a[0], a[2], b[2], b[0]) > 0) return Meet::None;
+    return Meet::Crossing;
 }
 
 }  // namespace detail
 
-/// Whether the closed triangles meet (the rules above).
+/// Whether the triangle has zero area (its corners are collinear or equal). Exact.
 template <class T>
-bool triangles_intersect(const Triangle<T>& a, const Triangle<T>& b) {
-    return detail::intersect_impl<T, false>(a, b, nullptr);
+bool is_degenerate(const Triangle<T>& t) {
+    const Vec<T, 3> c[3] = {t.p0, t.p1, t.p2};
+    return detail::projection_axis(c) == 3;
 }
 
-/// Whether the closed triangles meet, and where (the rules above).
+/// Whether the closed triangles meet (the rules above). Exact.
 template <class T>
-TriangleIntersection<T> intersect_triangles(const Triangle<T>& a, const Triangle<T>& b) {
-    TriangleIntersection<T> r;
-    detail::intersect_impl<T, true>(a, b, &r);
-    return r;
+bool triangles_intersect(const Triangle<T>& a, const Triangle<T>& b) {
+    const Vec<T, 3> u[3] = {a.p0, a.p1, a.p2}, v[3] = {b.p0, b.p1, b.p2};
+    Vec<T, 3> ra[3], rb[3];
+    switch (detail::decide(u, v, ra, rb)) {
+        case detail::Meet::None:
+            return false;
+        case detail::Meet::Crossing:
+            return true;
+        case detail::Meet::General:
+            return detail::edges_meet(u, v);
+    }
+    return false;
 }
 
 }  // namespace bvhkit
+
+#include "bvhkit/primitives/triangle_contact.hpp"

@@ -10,8 +10,9 @@
 // is within max(a, r * best) of the best, so the answer is at most that much above the true
 // distance. Both are 0 by default: the exact minimum (up to rounding).
 //
-// Zero-area triangles are ignored (triangle_triangle.hpp's rule). Models that intersect are at
-// distance 0 (the points then lie on an intersection segment). An empty model gives +infinity.
+// A zero-area triangle counts as the segment or point it is (triangle_triangle.hpp's rule).
+// Models that intersect are at distance 0 (the points then lie on an intersection segment). An
+// empty model gives +infinity.
 #include <algorithm>
 #include <limits>
 #include <vector>
@@ -59,6 +60,7 @@ DistanceResult<typename V::Scalar> distance(
     const DistanceOptions<typename V::Scalar>& options = {}) {
     using T = typename V::Scalar;
     using Traits = VolumeTraits<V>;
+    check_rigid_pose(pose_of_b_in_a, "distance", "pose_of_b_in_a");
     DistanceResult<T> result;
     if (a.bvh().empty() || b.bvh().empty()) return result;
     const auto& na_ = a.bvh().nodes;
@@ -123,12 +125,10 @@ DistanceResult<typename V::Scalar> distance(
         if (na.is_leaf() && nb.is_leaf()) {
             // B's triangle outside: carried into A's frame once for all of A's.
             for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
-                if (is_degenerate(tb[sb])) continue;
                 const Triangle<T> tri_b = transformed(tb[sb], pose_of_b_in_a);
                 const T rb = std::sqrt(std::max(length_squared(tri_b.p1 - tri_b.p0),
                                                 length_squared(tri_b.p2 - tri_b.p0)));
                 for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
-                    if (is_degenerate(ta[sa])) continue;
                     // Cheap rejection by the triangles' spheres about their first corners.
                     const T ra = std::sqrt(std::max(length_squared(ta[sa].p1 - ta[sa].p0),
                                                     length_squared(ta[sa].p2 - ta[sa].p0)));

@@ -138,12 +138,17 @@ struct CollideResult {
     PairStats stats;
 };
 
-/// Whether A and B (B placed in A's frame by pose_of_b_in_a) intersect, and where.
+/// Whether A and B (B placed in A's frame by pose_of_b_in_a) intersect, and where. The pose must
+/// be finite and rigid (check_rigid_pose, math/transform.hpp: Error otherwise). What is decided:
+/// each of B's corners is carried into A's frame in T (R x + t, each product and sum rounded to
+/// T, transformed() below), and the triangle pairs are then decided exactly on those rounded
+/// coordinates (triangle_triangle.hpp).
 template <BoundingVolume V>
 bool collide(const CollisionModel<V>& a, const CollisionModel<V>& b,
              const Transform<typename V::Scalar>& pose_of_b_in_a, const CollideOptions& options,
              CollideResult<typename V::Scalar>& result) {
     using T = typename V::Scalar;
+    check_rigid_pose(pose_of_b_in_a, "collide", "pose_of_b_in_a");
     result.colliding = false;
     result.contacts.clear();
     result.stats = {};
@@ -177,6 +182,7 @@ template <BoundingVolume V>
 bool collides(const CollisionModel<V>& a, const CollisionModel<V>& b,
               const Transform<typename V::Scalar>& pose_of_b_in_a,
               DescentRule rule = DescentRule::Larger) {
+    check_rigid_pose(pose_of_b_in_a, "collides", "pose_of_b_in_a");
     const auto ta = a.slot_triangles();
     const auto tb = b.slot_triangles();
     return !for_each_overlapping_pair(

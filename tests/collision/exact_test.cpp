@@ -1,0 +1,126 @@
+// The exact triangle-triangle decision against an exact integer reference that shares no method
+// with it (exact_reference.hpp), on hard pairs (hard_pairs.hpp); and the orientation predicate
+// against the integer determinant.
+#include <gtest/gtest.h>
+
+#include "bvhkit/math/predicates.hpp"
+#include "bvhkit/primitives/triangle_triangle.hpp"
+#include "exact_reference.hpp"
+#include "hard_pairs.hpp"
+#include "test_support.hpp"
+
+namespace bvhkit::test {
+namespace {
+
+template <class T>
+void check_orientations(std::size_t count) {
+    SplitMix64 rng(71);
+    std::size_t zeros = 0;
+    for (std::size_t n = 0; n < count; ++n) {
+        const double scale = std::pow(10.0, rng.uniform(-6, 6));
+        const Vec3d off =
+            rng.unit_vector() * (rng.below(2) ? std::pow(10.0, rng.uniform(4, 6)) : 0);
+        const Vec3d a = rng.unit_vector(), b = rng.unit_vector(), c = rng.unit_vector();
+        // d near the plane of a, b, c (on it before rounding), or on a line, or a copy.
+        Vec3d d = a + (b - a) * rng.uniform(-2, 2) + (c - a) * rng.uniform(-2, 2);
+        if (rng.below(4) == 0) d = a + (b - a) * rng.uniform(-2, 2);
+        const Vec<T, 3> p[4] = {Vec<T, 3>(a * scale + off), Vec<T, 3>(b * scale + off),
+                                Vec<T, 3>(c * scale + off), Vec<T, 3>(d * scale + off)};
+        const Vec<T, 3> q = rng.below(8) == 0 ? p[int(rng.below(3))] : p[3];
+        const int want = exact_orient3d(p[0], p[1], p[2], q);
+        zeros += want == 0;
+        ASSERT_EQ(orient3d_sign(p[0], p[1], p[2], q), want) << n;
+        ASSERT_EQ(orient3d_sign(p[1], p[2], p[0], q), want) << n;
+        ASSERT_EQ(orient3d_sign(p[0], p[2], p[1], q), -want) << n;
+    }
+    EXPECT_GT(zeros, count / 20);  // the generator does reach the exact zeros
+}
+
+TEST(ExactPredicates, Orient3dMatchesIntegerDeterminant) {
+    check_orientations<float>(scaled(20000));
+    check_orientations<double>(scaled(20000));
+}
+
+TEST(ExactPredicates, Orient3dExactOnTinyDeterminants) {
+    // Differences of floats far apart in exponent are not exact in double: the filter must
+    // leave these to the exact stage.
+    const Vec3f a{1e30f, 0, 0}, b{1e-30f, 1, 0}, c{0, 0, 1};
+    const Vec3f d{1e30f, 1e-30f, 1e-30f};
+    EXPECT_EQ(orient3d_sign(a, b, c, d), exact_orient3d(a, b, c, d));
+    EXPECT_EQ(orient2d_sign(0.0, 0.0, 1e-300, 1e-300, 1.0, 1.0), 0);
+    EXPECT_EQ(orient2d_sign(0.1, 0.1, 0.2, 0.2, 0.3, 0.3), 0);  // on y = x
+    EXPECT_EQ(orient2d_sign(0.1, 0.1, 0.2, 0.2, 0.3, std::nextafter(0.3, 1.0)), 1);
+}
+
+template <class T>
+void check_hard_pairs(std::size_t count, std::uint64_t seed) {
+    SplitMix64 rng(seed);
+    constexpr int kinds = 5;
+    std::size_t hits[kinds] = {}, misses[kinds] = {};
+    for (std::size_t n = 0; n < count; ++n) {
+        const int kind = int(n % kinds);
+        const auto [a, b] = hard_pair<T>(rng, kind);
+        const bool want = exact_triangles_meet(a, b);
+        (want ? hits : misses)[kind]++;
+        ASSERT_EQ(triangles_intersect(a, b), want) << "pair " << n << " kind " << kind;
+        ASSERT_EQ(triangles_intersect(b, a), want) << "pair " << n << " kind " << kind;
+        ASSERT_EQ(intersect_triangles(a, b).hit, want) << "pair " << n << " kind " << kind;
+    }
+    // Every kind yields both answers in good number (the generators are near the boundary).
+    for (int k = 0; k < kinds; ++k) {
+        EXPECT_GT(hits[k], count / kinds / 20) << "kind " << k;
+        EXPECT_GT(misses[k], count / kinds / 20) << "kind " << k;
+    }
+}
+
+TEST(ExactTriangleTriangle, FloatHardPairsMatchExactReference) {
+    check_hard_pairs<float>(scaled(100000, 50), 11);
+}
+
+TEST(ExactTriangleTriangle, DoubleHardPairsMatchExactReference) {
+    check_hard_pairs<double>(scaled(20000, 50), 12);
+}
+
+TEST(ExactTriangleTriangle, ZeroAreaTrianglesAreSegmentsAndPoints) {
+    using Tri = Triangle<double>;
+    const Tri a{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const Tri needle{{0.2, 0.2, -1}, {0.2, 0.2, 1}, {0.2, 0.2, 0}};  // collinear, through a
+    const Tri point{{0.2, 0.2, 0}, {0.2, 0.2, 0}, {0.2, 0.2, 0}};    // on a
+    const Tri above{{0.2, 0.2, 1e-9}, {0.2, 0.2, 1e-9}, {0.2, 0.2, 1e-9}};
+    EXPECT_TRUE(is_degenerate(needle));
+    EXPECT_TRUE(is_degenerate(point));
+    EXPECT_FALSE(is_degenerate(a));
+    EXPECT_TRUE(triangles_intersect(a, needle));
+    EXPECT_TRUE(triangles_intersect(needle, a));
+    const auto x = intersect_triangles(needle, a);
+    EXPECT_TRUE(x.hit);
+    EXPECT_EQ(x.p, (Vec3d{0.2, 0.2, 0}));
+    EXPECT_TRUE(triangles_intersect(point, a));
+    EXPECT_TRUE(triangles_intersect(point, point));
+    EXPECT_TRUE(triangles_intersect(point, needle));
+    EXPECT_FALSE(triangles_intersect(above, a));
+    EXPECT_FALSE(triangles_intersect(above, point));
+}
+
+TEST(ExactTriangleTriangle, SegmentLiesOnBothTriangles) {
+    // The reported segment of crossing needles: both ends within rounding of both triangles'
+    // planes (the decision is exact; the segment is interpolated in double).
+    SplitMix64 rng(5);
+    for (int n = 0; n < int(scaled(2000)); ++n) {
+        const auto [a, b] = hard_pair<double>(rng, 0);
+        const auto x = intersect_triangles(a, b);
+        if (!x.hit || x.coplanar) continue;
+        double size = 0;
+        for (const Vec3d& v : {a.p0, a.p1, a.p2, b.p0, b.p1, b.p2})
+            size = std::max(size, length(v));
+        for (const Triangle<double>& t : {a, b}) {
+            const Vec3d nrm = normalize(cross(t.p1 - t.p0, t.p2 - t.p0));
+            const double reach = 1e-13 * size;
+            EXPECT_LE(std::fabs(dot(nrm, x.p - t.p0)), reach);
+            EXPECT_LE(std::fabs(dot(nrm, x.q - t.p0)), reach);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace bvhkit::test
