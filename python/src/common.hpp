@@ -7,6 +7,7 @@
 // (no copy) and only read or fill them. Everything that does work releases the GIL.
 #include <nanobind/nanobind.h>
 #include <nanobind/ndarray.h>
+#include <nanobind/stl/string.h>
 
 #include <algorithm>
 #include <atomic>
