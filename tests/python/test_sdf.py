@@ -62,3 +62,16 @@ def test_open_mesh_winding_number_sign():
     assert len(p) > 20
     assert np.all(scene.signed_distance(p, sign="winding_number") < 0)
     assert np.all(scene.contains(p))
+
+
+def test_open_mesh_outside_above_the_hole():
+    # Above the missing face the pseudonormal of the rim says "inside" (the sign it gives is only
+    # right for closed meshes); the winding number says outside.
+    v, f = box_mesh([-1, -1, -1], [1, 1, 1])
+    top = np.flatnonzero(np.all(v[f][:, :, 2] == 1, axis=1))
+    scene = bvhkit.TriangleMesh(v, np.delete(f, top, axis=0))
+    g = np.linspace(-0.3, 0.3, 5)
+    p = np.array([[x, y, z] for x in g for y in g for z in (1.4, 1.7, 2.0)])
+    assert np.all(scene.signed_distance(p, sign="winding_number") > 0)
+    assert np.all(scene.signed_distance(p, sign="pseudonormal") < 0)
+    assert not np.any(scene.contains(p))
