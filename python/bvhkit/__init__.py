@@ -276,6 +276,7 @@ class TriangleMesh:
         return int(self._impl.triangle_count)
 
     def __repr__(self) -> str:
+        """Face count and dtype."""
         return f"TriangleMesh(faces={self.face_count}, dtype={self.dtype})"
 
 

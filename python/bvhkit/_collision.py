@@ -56,6 +56,7 @@ class CollisionModel:
         return int(self._impl.triangle_count)
 
     def __repr__(self) -> str:
+        """Face count and dtype."""
         return f"CollisionModel(faces={self.face_count}, volume={self.volume!r}, dtype={self.dtype})"
 
 

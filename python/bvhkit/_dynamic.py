@@ -124,9 +124,11 @@ class _DynamicTree:
         self._impl.rebuild()
 
     def __len__(self) -> int:
+        """Number of live proxies."""
         return len(self._impl)
 
     def __repr__(self) -> str:
+        """Class, proxy count and dtype."""
         return f"{type(self).__name__}(proxies={len(self)}, dtype={self.dtype})"
 
 

@@ -79,7 +79,8 @@ BasicTriangleMesh<T> make_mesh(const Rows<T, 3>& vertices, const Faces& faces) {
 /// per chunk.
 inline unsigned batch_threads(unsigned threads, std::size_t chunks) {
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-    const unsigned want = threads == 0 ? cores : threads;
+    // A request beyond any real machine's core count only adds start-up cost.
+    const unsigned want = threads == 0 ? cores : std::min(threads, 1024u);
     return unsigned(std::min<std::size_t>(want, std::max<std::size_t>(chunks, 1)));
 }
 

@@ -145,3 +145,26 @@ def test_cpp_errors_become_value_errors(tmp_path):
         bvhkit.load_mesh(str(bad))
     with pytest.raises(ValueError, match="sphere"):
         bvhkit.load_mesh("sphere:subdiv=99")
+
+
+def test_empty_batches_and_read_only_arrays(mesh):
+    v, f = mesh
+    v = v.copy()
+    v.setflags(write=False)
+    f32 = f.astype(np.int32)
+    f32.setflags(write=False)
+    scene = bvhkit.TriangleMesh(v, f32)
+    none = np.zeros((0, 3))
+    assert scene.closest_point(none).distance.shape == (0,)
+    assert scene.intersect(none, none).t.shape == (0,)
+    assert scene.winding_number(none).shape == (0,)
+    m = bvhkit.CollisionModel(v, f32)
+    assert bvhkit.collide(m, m, np.zeros((0, 3, 3)), none).shape == (0,)
+    assert bvhkit.collide(m, m, None, none, contacts=True) == []
+    assert bvhkit.distance(m, m, None, none).distance.shape == (0,)
+    t = bvhkit.DynamicTree2D()
+    assert t.create(np.zeros((0, 2)), np.zeros((0, 2))).shape == (0,)
+    assert t.find_pairs().shape == (0, 2)
+    assert t.query(np.zeros((0, 2)), np.zeros((0, 2))).shape == (0, 2)
+    # An absurd thread count is capped, not an error.
+    assert scene.closest_point(v[:5], threads=100000).face.shape == (5,)
