@@ -1,0 +1,290 @@
+"""bvhkit: bounding volume hierarchies on numpy arrays.
+
+- :func:`load_mesh` reads OBJ, PLY and STL files, or generates a mesh from a spec.
+- :class:`TriangleMesh`: rays (closest hit, occlusion, hit counts), closest points, signed distance,
+  winding numbers and inside/outside on one triangle mesh.
+- :class:`CollisionModel` with :func:`collide`, :func:`distance` and :func:`self_intersections`:
+  mesh against mesh over batches of rigid poses.
+- :class:`DynamicTree2D` and :class:`DynamicTree3D`: a dynamic AABB tree for moving boxes.
+
+Arrays go in and come out as numpy arrays. Inputs that are C-contiguous and of the object's scalar
+type are used in place; anything else is converted once. Every batch query releases the GIL and
+runs on ``threads`` threads (0 = every core), with the same answers for every thread count.
+Objects may be queried from several Python threads at once.
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from . import _arrays as _a
+from . import _bvhkit
+
+__version__: str = _bvhkit.version
+
+__all__ = [
+    "load_mesh",
+    "TriangleMesh",
+    "RayHits",
+    "ClosestPoints",
+    "CollisionModel",
+    "collide",
+    "distance",
+    "Distances",
+    "self_intersections",
+    "DynamicTree2D",
+    "DynamicTree3D",
+]
+
+
+def load_mesh(path_or_spec: str) -> tuple[np.ndarray, np.ndarray]:
+    """Reads a mesh file (.obj, .ply including triangle strips, .stl ascii or binary) or generates
+    one from a spec such as ``"sphere:subdiv=4"``, ``"torus"`` or ``"terrain:n=64"``.
+
+    Returns ``(vertices, faces)``: float32 (n, 3) and int64 (m, 3); polygons are split into fans.
+    Raises ValueError naming the file and line for a malformed file, or when the argument is
+    neither an existing file nor a valid spec.
+    """
+    if not isinstance(path_or_spec, (str,)) and not hasattr(path_or_spec, "__fspath__"):
+        raise TypeError(f"path_or_spec: must be a str or path, not {type(path_or_spec).__name__}")
+    import os
+
+    return _bvhkit.load_mesh(os.fspath(path_or_spec))
+
+
+class RayHits(NamedTuple):
+    """What :meth:`TriangleMesh.intersect` returns, one entry per ray."""
+
+    t: np.ndarray
+    """(k,) distance along the ray in units of its direction's length; inf on a miss."""
+    face: np.ndarray
+    """(k,) int64 index of the face hit; -1 on a miss."""
+    barycentric: np.ndarray
+    """(k, 3) weights of the face's three vertices at the hit point; zeros on a miss."""
+
+
+class ClosestPoints(NamedTuple):
+    """What :meth:`TriangleMesh.closest_point` returns, one entry per point."""
+
+    distance: np.ndarray
+    """(k,) distance to the mesh; inf where nothing is within max_distance (or the point is not
+    finite, or the mesh is empty)."""
+    closest: np.ndarray
+    """(k, 3) closest point on the mesh; NaN where there is none."""
+    face: np.ndarray
+    """(k,) int64 index of the face the closest point lies on; -1 where there is none."""
+    barycentric: np.ndarray
+    """(k, 3) weights of that face's three vertices at the closest point."""
+
+
+_SIGNS = ("pseudonormal", "winding_number")
+
+
+class TriangleMesh:
+    """A triangle mesh ready for rays and proximity queries.
+
+    ``vertices``: (n, 3) float32 or float64; ``faces``: (m, 3) int32 or int64 indices into
+    ``vertices``. ``dtype`` is the scalar type the scene computes in (float32 by default);
+    query arrays are converted to it. ``builder`` picks the tree builder (``"binned_sah"``,
+    ``"sweep_sah"``, ``"bottom_up"``, ``"lbvh"``, ``"insertion"``, ...; ``+opt`` adds the
+    reinsertion optimizer). ``ray_test`` is ``"fast"`` (Moller-Trumbore) or ``"watertight"``
+    (Woop et al. 2013: a ray through a shared edge never slips between the two faces).
+
+    Faces with a NaN or infinite coordinate are left out of every query (see :meth:`skipped`);
+    zero-area faces are never hit by rays. The ray tree is built at once; the closest point and
+    winding number structures on first use.
+    """
+
+    def __init__(
+        self,
+        vertices: Any,
+        faces: Any,
+        builder: str = "binned_sah",
+        dtype: Any = np.float32,
+        ray_test: str = "fast",
+        threads: int = 0,
+    ) -> None:
+        self.dtype: np.dtype = _a.scalar_type(dtype)
+        if not isinstance(builder, str):
+            raise TypeError(f"builder: must be a str, not {type(builder).__name__}")
+        if not isinstance(ray_test, str):
+            raise TypeError(f"ray_test: must be a str, not {type(ray_test).__name__}")
+        v = _a.vertices("vertices", vertices, self.dtype)
+        f = _a.faces(faces, len(v))
+        impl = _bvhkit.Scene32 if self.dtype == np.float32 else _bvhkit.Scene64
+        try:
+            self._impl = impl(v, f, builder.replace("_", "-"), ray_test, _a.threads(threads))
+        except ValueError as e:
+            raise ValueError(f"builder or ray_test: {e}") from None
+        self._vertex_count = len(v)
+
+    # ------------------------------------------------------------------ rays
+
+    def _rays(self, origins: Any, directions: Any, tmin: Any, tmax: Any):
+        o = _a.rows("origins", origins, 3, self.dtype)
+        d = _a.rows("directions", directions, 3, self.dtype)
+        if d.shape[0] != o.shape[0]:
+            raise ValueError(f"directions: {d.shape[0]} rows, origins has {o.shape[0]}")
+        t0 = _a.column("tmin", tmin, len(o), self.dtype)
+        t1 = _a.column("tmax", tmax, len(o), self.dtype)
+        return o, d, t0, t1
+
+    def intersect(
+        self,
+        origins: Any,
+        directions: Any,
+        tmin: Any = 0.0,
+        tmax: Any = np.inf,
+        threads: int = 0,
+    ) -> RayHits:
+        """The closest hit of each ray ``origin + t * direction``, t in [tmin, tmax].
+
+        ``origins`` and ``directions``: (k, 3); ``tmin``/``tmax``: scalars or (k,) arrays.
+        Returns :class:`RayHits` ``(t, face, barycentric)``: t = inf and face = -1 on a miss.
+        Directions need not be unit length (t is in units of the direction given).
+        """
+        o, d, t0, t1 = self._rays(origins, directions, tmin, tmax)
+        k = len(o)
+        t = np.empty(k, self.dtype)
+        face = np.empty(k, np.int64)
+        bary = np.empty((k, 3), self.dtype)
+        self._impl.intersect(o, d, t0, t1, t, face, bary, _a.threads(threads))
+        return RayHits(t, face, bary)
+
+    def occluded(
+        self,
+        origins: Any,
+        directions: Any,
+        tmin: Any = 0.0,
+        tmax: Any = np.inf,
+        threads: int = 0,
+    ) -> np.ndarray:
+        """Whether each ray hits any face within [tmin, tmax]: (k,) bool (any-hit, shadow rays)."""
+        o, d, t0, t1 = self._rays(origins, directions, tmin, tmax)
+        out = np.empty(len(o), np.bool_)
+        self._impl.occluded(o, d, t0, t1, out, _a.threads(threads))
+        return out
+
+    def count_intersections(
+        self,
+        origins: Any,
+        directions: Any,
+        tmin: Any = 0.0,
+        tmax: Any = np.inf,
+        threads: int = 0,
+    ) -> np.ndarray:
+        """How many faces each ray hits within [tmin, tmax]: (k,) int64.
+
+        A ray through an edge or vertex shared by several faces may count each of them (use
+        ``ray_test="watertight"`` for the exact edge rule).
+        """
+        o, d, t0, t1 = self._rays(origins, directions, tmin, tmax)
+        out = np.empty(len(o), np.int64)
+        self._impl.count_intersections(o, d, t0, t1, out, _a.threads(threads))
+        return out
+
+    # ------------------------------------------------------------------ proximity
+
+    def _points(self, points: Any) -> np.ndarray:
+        return _a.rows("points", points, 3, self.dtype)
+
+    def closest_point(
+        self, points: Any, max_distance: float = np.inf, threads: int = 0
+    ) -> ClosestPoints:
+        """The closest point of the mesh to each point, within ``max_distance``.
+
+        ``points``: (k, 3). Returns :class:`ClosestPoints` ``(distance, closest, face,
+        barycentric)``; where no face is within max_distance (or the point has a NaN or
+        infinite coordinate): distance = inf, closest = NaN, face = -1.
+        """
+        p = self._points(points)
+        md = float(max_distance)
+        if not md >= 0:
+            raise ValueError(f"max_distance: must be >= 0 (inf for no limit), not {max_distance}")
+        k = len(p)
+        dist = np.empty(k, self.dtype)
+        closest = np.empty((k, 3), self.dtype)
+        face = np.empty(k, np.int64)
+        bary = np.empty((k, 3), self.dtype)
+        self._impl.closest_point(p, md, dist, closest, face, bary, _a.threads(threads))
+        return ClosestPoints(dist, closest, face, bary)
+
+    def signed_distance(
+        self, points: Any, sign: str = "pseudonormal", threads: int = 0
+    ) -> np.ndarray:
+        """Distance to the mesh, negative inside: (k,).
+
+        ``sign="pseudonormal"`` takes the sign from the angle-weighted pseudonormal at the
+        closest point (Baerentzen and Aanaes 2005): exact for closed, consistently oriented
+        meshes. ``sign="winding_number"`` takes it from the generalized winding number
+        (inside where it exceeds 1/2; Jacobson et al. 2013): robust for meshes with holes or
+        self-intersections. Points with a non-finite coordinate, or an empty mesh, give inf.
+        """
+        if sign not in _SIGNS:
+            raise ValueError(f"sign: {sign!r} is not one of {', '.join(map(repr, _SIGNS))}")
+        p = self._points(points)
+        out = np.empty(len(p), self.dtype)
+        self._impl.signed_distance(p, sign, out, _a.threads(threads))
+        return out
+
+    def winding_number(
+        self, points: Any, exact: bool = False, beta: float = 2.0, threads: int = 0
+    ) -> np.ndarray:
+        """The generalized winding number of the mesh at each point: (k,).
+
+        About 1 inside a closed outward-oriented mesh, 0 outside. ``exact=True`` sums every
+        face's solid angle (cost: faces x points); otherwise the tree's dipole approximation
+        (Barill et al. 2018) is used, accurate where nodes are more than ``beta`` times their
+        radius away.
+        """
+        p = self._points(points)
+        b = float(beta)
+        if not b > 0 or not np.isfinite(b):
+            raise ValueError(f"beta: must be a positive finite number, not {beta}")
+        out = np.empty(len(p), self.dtype)
+        self._impl.winding_number(p, bool(exact), b, out, _a.threads(threads))
+        return out
+
+    def contains(self, points: Any, threads: int = 0) -> np.ndarray:
+        """Whether each point is inside the mesh (winding number above 1/2): (k,) bool."""
+        return self.winding_number(points, threads=threads) > 0.5
+
+    # ------------------------------------------------------------------ changes and measures
+
+    def refit(self, vertices: Any) -> None:
+        """New positions for the same vertices (same faces): the trees are refitted, not rebuilt
+        (fast, for deforming meshes; their quality degrades if the motion is large)."""
+        v = _a.vertices("vertices", vertices, self.dtype)
+        if len(v) != self._vertex_count:
+            raise ValueError(f"vertices: {len(v)} rows, the mesh has {self._vertex_count}")
+        self._impl.refit(v)
+
+    def stats(self) -> dict:
+        """Measures of the ray tree: triangles, skipped, nodes, leaves, depth, average leaf size,
+        SAH cost and builder."""
+        return dict(self._impl.stats())
+
+    def skipped(self) -> np.ndarray:
+        """Indices (int64) of faces left out for a NaN or infinite coordinate."""
+        return self._impl.skipped()
+
+    @property
+    def face_count(self) -> int:
+        """Number of faces."""
+        return int(self._impl.triangle_count)
+
+    def __repr__(self) -> str:
+        """Face count and dtype."""
+        return f"TriangleMesh(faces={self.face_count}, dtype={self.dtype})"
+
+
+from ._collision import (  # noqa: E402
+    CollisionModel,
+    Distances,
+    collide,
+    distance,
+    self_intersections,
+)
+from ._dynamic import DynamicTree2D, DynamicTree3D  # noqa: E402

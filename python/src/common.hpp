@@ -1,0 +1,138 @@
+#pragma once
+// What every part of the extension shares: the array types it accepts and returns, the mesh built
+// from numpy arrays, and run_batch, which spreads a batch over threads.
+//
+// The Python layer (python/bvhkit/) checks shapes and dtypes, names the argument at fault and hands
+// over C-contiguous arrays of the scene's scalar type, so the functions here take them as they are
+// (no copy) and only read or fill them. Everything that does work releases the GIL.
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/string.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bvhkit/error.hpp"
+#include "bvhkit/primitives/triangle_mesh.hpp"
+
+namespace bvhkit::python {
+
+namespace nb = nanobind;
+
+using Cpu = nb::device::cpu;
+/// (k, D) rows of T, read only.
+template <class T, std::size_t D>
+using Rows = nb::ndarray<const T, nb::shape<-1, D>, nb::c_contig, Cpu>;
+/// (k, D) rows of T, written by the call.
+template <class T, std::size_t D>
+using OutRows = nb::ndarray<T, nb::shape<-1, D>, nb::c_contig, Cpu>;
+/// (k,) values, read only / written.
+template <class T>
+using Column = nb::ndarray<const T, nb::shape<-1>, nb::c_contig, Cpu>;
+template <class T>
+using OutColumn = nb::ndarray<T, nb::shape<-1>, nb::c_contig, Cpu>;
+/// Faces: (m, 3) int32 or int64, chosen at run time.
+using Faces = nb::ndarray<nb::ro, nb::shape<-1, 3>, nb::c_contig, Cpu>;
+
+/// Throws bvhkit::Error (ValueError in Python) unless `a` has `rows` rows.
+template <class A>
+void expect_rows(const A& a, std::size_t rows, const char* name) {
+    if (a.shape(0) != rows)
+        throw Error(std::string(name) + ": " + std::to_string(a.shape(0)) + " rows, expected " +
+                    std::to_string(rows));
+}
+
+/// The vertices and faces as the library's mesh (one copy: the library keeps its own).
+template <class T>
+BasicTriangleMesh<T> make_mesh(const Rows<T, 3>& vertices, const Faces& faces) {
+    BasicTriangleMesh<T> mesh;
+    const std::size_t nv = vertices.shape(0), nf = faces.shape(0);
+    mesh.vertices.resize(nv);
+    const T* v = vertices.data();
+    for (std::size_t i = 0; i < nv; ++i) mesh.vertices[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+    mesh.triangles.resize(nf);
+    const auto copy = [&](const auto* f) {
+        for (std::size_t i = 0; i < 3 * nf; ++i) {
+            const auto k = f[i];
+            if (k < 0 || std::uint64_t(k) >= nv)
+                throw Error("faces: face " + std::to_string(i / 3) + " names vertex " +
+                            std::to_string(k) + " of " + std::to_string(nv));
+            mesh.triangles[i / 3][i % 3] = std::uint32_t(k);
+        }
+    };
+    if (faces.dtype() == nb::dtype<std::int32_t>())
+        copy(static_cast<const std::int32_t*>(faces.data()));
+    else if (faces.dtype() == nb::dtype<std::int64_t>())
+        copy(static_cast<const std::int64_t*>(faces.data()));
+    else
+        throw Error("faces: dtype must be int32 or int64");
+    return mesh;
+}
+
+/// The number of threads a batch of `count` items uses: `threads` (0 = every core), at most one
+/// per chunk.
+inline unsigned batch_threads(unsigned threads, std::size_t chunks) {
+    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+    // A request beyond any real machine's core count only adds start-up cost.
+    const unsigned want = threads == 0 ? cores : std::min(threads, 1024u);
+    return unsigned(std::min<std::size_t>(want, std::max<std::size_t>(chunks, 1)));
+}
+
+/// Calls body(begin, end) on consecutive chunks of `grain` items of [0, count), on `threads`
+/// threads (0 = every core; the calling thread is one of them). Each item is handled by exactly
+/// one call, so a body that writes only its own items gives the same answers for every thread
+/// count. The first exception thrown by a body stops the batch and is rethrown here.
+template <class Body>
+void run_batch(std::size_t count, std::size_t grain, unsigned threads, Body&& body) {
+    if (count == 0) return;
+    grain = std::max<std::size_t>(grain, 1);
+    const std::size_t chunks = (count + grain - 1) / grain;
+    const unsigned n = batch_threads(threads, chunks);
+    if (n <= 1) {
+        body(std::size_t(0), count);
+        return;
+    }
+    std::atomic<std::size_t> next{0};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    const auto work = [&] {
+        try {
+            for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
+                body(c * grain, std::min(count, (c + 1) * grain));
+        } catch (...) {
+            const std::lock_guard<std::mutex> lock(error_mutex);
+            if (!error) error = std::current_exception();
+            next.store(chunks);
+        }
+    };
+    std::vector<std::thread> pool;
+    pool.reserve(n - 1);
+    for (unsigned i = 1; i < n; ++i) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+}
+
+/// A (rows, cols) numpy array that owns `values` (rows * cols of them).
+template <class X>
+nb::ndarray<nb::numpy, X> owned_array(std::vector<X>&& values, std::size_t rows,
+                                      std::size_t cols) {
+    auto* heap = new std::vector<X>(std::move(values));
+    heap->reserve(1);  // a valid data pointer for an empty array
+    nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<X>*>(p); });
+    if (cols == 0) return nb::ndarray<nb::numpy, X>(heap->data(), {rows}, owner);
+    return nb::ndarray<nb::numpy, X>(heap->data(), {rows, cols}, owner);
+}
+
+void bind_scene(nb::module_& m);
+void bind_collision32(nb::module_& m);
+void bind_collision64(nb::module_& m);
+void bind_dynamic(nb::module_& m);
+
+}  // namespace bvhkit::python

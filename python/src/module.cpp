@@ -1,0 +1,48 @@
+// The extension module bvhkit._bvhkit: bvhkit::Error becomes ValueError, load_mesh, and the scene,
+// collision and dynamic tree classes (scene.cpp, collision.cpp, dynamic.cpp). The public API with
+// argument checks and defaults is the Python package around it (python/bvhkit/).
+#include <string>
+
+#include "bvhkit/mesh/load_mesh.hpp"
+#include "bvhkit/version.hpp"
+#include "common.hpp"
+
+namespace nb = nanobind;
+using namespace bvhkit::python;
+
+NB_MODULE(_bvhkit, m) {
+    m.doc() = "bvhkit's compiled core; use the bvhkit package, which checks arguments.";
+    nb::register_exception_translator([](const std::exception_ptr& p, void*) {
+        try {
+            std::rethrow_exception(p);
+        } catch (const bvhkit::Error& e) {
+            PyErr_SetString(PyExc_ValueError, e.what());
+        }
+    });
+    m.def(
+        "load_mesh",
+        [](const std::string& file_or_spec) {
+            bvhkit::TriangleMesh mesh;
+            {
+                nb::gil_scoped_release release;
+                mesh = bvhkit::load_mesh(file_or_spec);
+            }
+            std::vector<float> v(3 * mesh.vertices.size());
+            for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+                for (int a = 0; a < 3; ++a) v[3 * i + a] = mesh.vertices[i][a];
+            std::vector<std::int64_t> f(3 * mesh.triangles.size());
+            for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+                for (int a = 0; a < 3; ++a) f[3 * i + a] = mesh.triangles[i][a];
+            const std::size_t nv = mesh.vertices.size(), nf = mesh.triangles.size();
+            return nb::make_tuple(owned_array(std::move(v), nv, 3),
+                                  owned_array(std::move(f), nf, 3));
+        },
+        nb::arg("file_or_spec"),
+        "Reads an OBJ, PLY or STL file, or generates a mesh from a spec such as "
+        "'sphere:subdiv=6'; returns (vertices float32 (n, 3), faces int64 (m, 3)).");
+    m.attr("version") = bvhkit::version_string;
+    bind_scene(m);
+    bind_collision32(m);
+    bind_collision64(m);
+    bind_dynamic(m);
+}

@@ -1,0 +1,254 @@
+// Scene<T>: one triangle mesh with every query on it. Rays go to a TriangleBvh built at once; the
+// proximity structures (SignedDistanceMesh, which holds the ClosestPointMesh, and
+// WindingNumberMesh) are built on first use, so a user of rays alone never pays for them.
+//
+// Thread safety: queries hold a shared lock, refit an exclusive one, so Python threads may call
+// anything at any time (the GIL is released during the work).
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+
+#include "bvhkit/build/options.hpp"
+#include "bvhkit/bvh/statistics.hpp"
+#include "bvhkit/query/signed_distance.hpp"
+#include "bvhkit/query/winding_number.hpp"
+#include "bvhkit/triangle_bvh.hpp"
+#include "common.hpp"
+
+namespace bvhkit::python {
+namespace {
+
+template <class T>
+Vec<T, 3> row(const T* p, std::size_t i) {
+    return {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
+}
+
+template <class T>
+class Scene {
+  public:
+    Scene(const Rows<T, 3>& vertices, const Faces& faces, const std::string& builder,
+          const std::string& ray_test, unsigned threads)
+        : mesh_(make_mesh<T>(vertices, faces)), options_(parse_builder(builder)) {
+        if (ray_test != "fast" && ray_test != "watertight")
+            throw Error("ray_test: '" + ray_test + "' is not one of 'fast', 'watertight'");
+        options_.threads = threads;
+        nb::gil_scoped_release release;
+        rays_ = TriangleBvh<T>(mesh_, options_,
+                               ray_test == "fast" ? TriangleTest::Fast : TriangleTest::Watertight);
+    }
+
+    using Ray3 = Ray<T, 3>;
+    /// Calls per_ray(i, ray) for each ray of the batch, on `threads` threads, without the GIL.
+    template <class PerRay>
+    void rays(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
+              const Column<T>& tmax, unsigned threads, PerRay&& per_ray) const {
+        const std::size_t k = origins.shape(0);
+        expect_rows(directions, k, "directions");
+        expect_rows(tmin, k, "tmin");
+        expect_rows(tmax, k, "tmax");
+        const T *o = origins.data(), *d = directions.data(), *t0 = tmin.data(), *t1 = tmax.data();
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        run_batch(k, 1024, threads, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) per_ray(i, Ray3(row(o, i), row(d, i), t0[i], t1[i]));
+        });
+    }
+
+    void intersect(const Rows<T, 3>& origins, const Rows<T, 3>& directions,
+                   const Column<T>& tmin, const Column<T>& tmax, OutColumn<T> t,
+                   OutColumn<std::int64_t> face, OutRows<T, 3> barycentric,
+                   unsigned threads) const {
+        expect_rows(t, origins.shape(0), "t");
+        expect_rows(face, origins.shape(0), "face");
+        expect_rows(barycentric, origins.shape(0), "barycentric");
+        T *tp = t.data(), *bp = barycentric.data();
+        std::int64_t* fp = face.data();
+        rays(origins, directions, tmin, tmax, threads, [&](std::size_t i, const Ray3& ray) {
+            const Hit<T> h = rays_.closest_hit(ray);
+            tp[i] = h ? h.t : std::numeric_limits<T>::infinity();
+            fp[i] = h ? std::int64_t(h.primitive) : -1;
+            bp[3 * i] = h ? T(1) - h.u - h.v : T(0);
+            bp[3 * i + 1] = h.u;
+            bp[3 * i + 2] = h.v;
+        });
+    }
+    void occluded(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
+                  const Column<T>& tmax, OutColumn<bool> out, unsigned threads) const {
+        expect_rows(out, origins.shape(0), "out");
+        bool* op = out.data();
+        rays(origins, directions, tmin, tmax, threads,
+             [&](std::size_t i, const Ray3& ray) { op[i] = rays_.any_hit(ray); });
+    }
+    void count_intersections(const Rows<T, 3>& origins, const Rows<T, 3>& directions,
+                             const Column<T>& tmin, const Column<T>& tmax,
+                             OutColumn<std::int64_t> out, unsigned threads) const {
+        expect_rows(out, origins.shape(0), "out");
+        std::int64_t* op = out.data();
+        rays(origins, directions, tmin, tmax, threads, [&](std::size_t i, const Ray3& ray) {
+            std::int64_t n = 0;
+            rays_.all_hits(ray, [&](const Hit<T>&) { return ++n, true; });
+            op[i] = n;
+        });
+    }
+
+    /// Calls per_point(i, p, scratch) for each point, on `threads` threads, without the GIL.
+    template <class PerPoint>
+    void points(const Rows<T, 3>& pts, unsigned threads, bool need_sdf, bool need_winding,
+                PerPoint&& per_point) const {
+        const T* p = pts.data();
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        prepare(need_sdf, need_winding);
+        run_batch(pts.shape(0), 256, threads, [&](std::size_t b, std::size_t e) {
+            NearestScratch<T> scratch;
+            for (std::size_t i = b; i < e; ++i) per_point(i, row(p, i), scratch);
+        });
+    }
+
+    void closest_point(const Rows<T, 3>& pts, T max_distance, OutColumn<T> distance,
+                       OutRows<T, 3> closest, OutColumn<std::int64_t> face,
+                       OutRows<T, 3> barycentric, unsigned threads) const {
+        const std::size_t k = pts.shape(0);
+        expect_rows(distance, k, "distance");
+        expect_rows(closest, k, "closest");
+        expect_rows(face, k, "face");
+        expect_rows(barycentric, k, "barycentric");
+        const T max2 = std::isinf(max_distance) ? max_distance : max_distance * max_distance;
+        T *dp = distance.data(), *cp = closest.data(), *bp = barycentric.data();
+        std::int64_t* fp = face.data();
+        points(pts, threads, true, false, [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
+            const MeshPoint<T> c = sdf_->closest_point_mesh().closest_point(p, scratch, max2);
+            const T nan = std::numeric_limits<T>::quiet_NaN();
+            dp[i] = c ? std::sqrt(c.distance_squared) : std::numeric_limits<T>::infinity();
+            for (int a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;
+            fp[i] = c ? std::int64_t(c.triangle) : -1;
+            bp[3 * i] = c ? T(1) - c.u - c.v : T(0);
+            bp[3 * i + 1] = c.u;
+            bp[3 * i + 2] = c.v;
+        });
+    }
+    void signed_distance(const Rows<T, 3>& pts, const std::string& sign, OutColumn<T> out,
+                         unsigned threads) const {
+        expect_rows(out, pts.shape(0), "out");
+        T* op = out.data();
+        if (sign == "pseudonormal") {
+            points(pts, threads, true, false,
+                   [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
+                       op[i] = sdf_->signed_distance(p, scratch).distance;
+                   });
+        } else if (sign == "winding_number") {
+            points(pts, threads, true, true,
+                   [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
+                       const MeshPoint<T> c = sdf_->closest_point_mesh().closest_point(p, scratch);
+                       const T d = c ? std::sqrt(c.distance_squared)
+                                     : std::numeric_limits<T>::infinity();
+                       op[i] = winding_->inside(p) ? -d : d;
+                   });
+        } else {
+            throw Error("sign: '" + sign + "' is not one of 'pseudonormal', 'winding_number'");
+        }
+    }
+    void winding_number(const Rows<T, 3>& pts, bool exact, T beta, OutColumn<T> out,
+                        unsigned threads) const {
+        expect_rows(out, pts.shape(0), "out");
+        T* op = out.data();
+        points(pts, threads, false, true, [&](std::size_t i, const Vec<T, 3>& p, auto&) {
+            op[i] = exact ? winding_->exact(p) : winding_->fast(p, beta);
+        });
+    }
+
+    void refit(const Rows<T, 3>& vertices) {
+        if (vertices.shape(0) != mesh_.vertices.size())
+            throw Error("vertices: " + std::to_string(vertices.shape(0)) +
+                        " rows, the scene has " + std::to_string(mesh_.vertices.size()));
+        const T* v = vertices.data();
+        nb::gil_scoped_release release;
+        const std::unique_lock<std::shared_mutex> lock(mutex_);
+        for (std::size_t i = 0; i < mesh_.vertices.size(); ++i) mesh_.vertices[i] = row(v, i);
+        rays_.refit(mesh_);
+        // The proximity structures are rebuilt when next asked for.
+        sdf_.reset();
+        winding_.reset();
+    }
+
+    nb::dict stats() const {
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        const BvhStatistics s = statistics(rays_.bvh());
+        nb::dict d;
+        d["triangles"] = rays_.triangle_count();
+        d["skipped"] = rays_.skipped().size();
+        d["nodes"] = s.node_count;
+        d["leaves"] = s.leaf_count;
+        d["depth"] = s.depth;
+        d["average_leaf_size"] = s.average_leaf_size();
+        d["sah_cost"] = s.sah_cost;
+        d["builder"] = to_string(options_.builder);
+        return d;
+    }
+    nb::ndarray<nb::numpy, std::int64_t> skipped() const {
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        std::vector<std::int64_t> s(rays_.skipped().begin(), rays_.skipped().end());
+        const std::size_t n = s.size();
+        return owned_array(std::move(s), n, 0);
+    }
+    std::size_t triangle_count() const { return mesh_.triangles.size(); }
+
+  private:
+    /// Builds what a query needs, once (the caller holds the shared lock; builders take this one).
+    void prepare(bool need_sdf, bool need_winding) const {
+        const std::lock_guard<std::mutex> lock(build_mutex_);
+        if (need_sdf && !sdf_) sdf_ = std::make_unique<SignedDistanceMesh<T>>(mesh_, options_);
+        if (need_winding && !winding_)
+            winding_ = std::make_unique<WindingNumberMesh<T>>(mesh_, options_);
+    }
+
+    BasicTriangleMesh<T> mesh_;
+    BuildOptions options_;
+    TriangleBvh<T> rays_;
+    mutable std::unique_ptr<SignedDistanceMesh<T>> sdf_;
+    mutable std::unique_ptr<WindingNumberMesh<T>> winding_;
+    mutable std::shared_mutex mutex_;
+    mutable std::mutex build_mutex_;
+};
+
+template <class T>
+void bind_scene_type(nb::module_& m, const char* name) {
+    using S = Scene<T>;
+    nb::class_<S>(m, name, "A triangle mesh ready for ray and proximity queries (see bvhkit.TriangleMesh).")
+        .def(nb::init<const Rows<T, 3>&, const Faces&, const std::string&, const std::string&,
+                      unsigned>(),
+             nb::arg("vertices"), nb::arg("faces"), nb::arg("builder"), nb::arg("ray_test"),
+             nb::arg("threads"), "Builds the ray tree over the mesh.")
+        .def("intersect", &S::intersect, nb::arg("origins"), nb::arg("directions"),
+             nb::arg("tmin"), nb::arg("tmax"), nb::arg("t"), nb::arg("face"),
+             nb::arg("barycentric"), nb::arg("threads"),
+             "Closest hit of each ray into the output arrays.")
+        .def("occluded", &S::occluded, nb::arg("origins"), nb::arg("directions"),
+             nb::arg("tmin"), nb::arg("tmax"), nb::arg("out"), nb::arg("threads"),
+             "Whether each ray hits anything within [tmin, tmax].")
+        .def("count_intersections", &S::count_intersections, nb::arg("origins"),
+             nb::arg("directions"), nb::arg("tmin"), nb::arg("tmax"), nb::arg("out"),
+             nb::arg("threads"), "The number of triangles each ray hits within [tmin, tmax].")
+        .def("closest_point", &S::closest_point, nb::arg("points"), nb::arg("max_distance"),
+             nb::arg("distance"), nb::arg("closest"), nb::arg("face"), nb::arg("barycentric"),
+             nb::arg("threads"), "Closest point of the mesh to each point.")
+        .def("signed_distance", &S::signed_distance, nb::arg("points"), nb::arg("sign"),
+             nb::arg("out"), nb::arg("threads"), "Signed distance of each point (negative inside).")
+        .def("winding_number", &S::winding_number, nb::arg("points"), nb::arg("exact"),
+             nb::arg("beta"), nb::arg("out"), nb::arg("threads"),
+             "Generalized winding number of each point.")
+        .def("refit", &S::refit, nb::arg("vertices"), "New vertex positions, same faces.")
+        .def("stats", &S::stats, "Tree statistics of the ray tree.")
+        .def("skipped", &S::skipped, "Faces left out for non-finite coordinates.")
+        .def_prop_ro("triangle_count", &S::triangle_count, "Number of faces.");
+}
+
+}  // namespace
+
+void bind_scene(nb::module_& m) {
+    bind_scene_type<float>(m, "Scene32");
+    bind_scene_type<double>(m, "Scene64");
+}
+
+}  // namespace bvhkit::python

@@ -1,0 +1,124 @@
+"""Rays against a numpy Moller-Trumbore brute force in float64."""
+
+import numpy as np
+import pytest
+
+import bvhkit
+from reference import random_soup, ray_hits
+
+DTYPES = [np.float32, np.float64]
+# Rays closer than this (relative barycentric / t margin) to an edge or an interval end may go
+# either way in float32 and are left out of the comparison.
+MARGIN = {np.float32: 1e-3, np.float64: 1e-9}
+RTOL = {np.float32: 1e-4, np.float64: 1e-10}
+
+
+def random_rays(rng, k, spread=2.0):
+    o = rng.uniform(-spread, spread, (k, 3))
+    target = rng.uniform(-1, 1, (k, 3))
+    return o, target - o
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+@pytest.mark.parametrize("case", ["unit", "far", "tiny", "huge"])
+def test_intersect_matches_brute_force(dtype, case):
+    rng = np.random.default_rng(11)
+    offset, scale = {"unit": (0, 1), "far": (1e4, 1), "tiny": (0, 1e-6), "huge": (0, 1e6)}[case]
+    if case == "far" and dtype == np.float32:
+        scale = 100.0  # keep float32 relative precision sensible at 1e4
+    v, f = random_soup(rng, 60, scale=scale, offset=offset)
+    v = v.astype(dtype).astype(np.float64)  # the scene's own vertices, exactly
+    o, d = random_rays(rng, 800)
+    o, d = (o * scale + offset).astype(dtype), (d * scale).astype(dtype)
+    tmax = np.where(rng.uniform(size=len(o)) < 0.3, 1.0, np.inf)
+    scene = bvhkit.TriangleMesh(v, f, dtype=dtype)
+    hits = scene.intersect(o, d, tmax=tmax)
+    t_ref, margin = ray_hits(v, f, o, d, tmax=tmax)
+    robust = (margin >= MARGIN[dtype]) | ~np.isfinite(margin)
+    clean = robust.all(axis=1)  # no triangle is near-grazed by this ray
+    assert clean.sum() > 400
+    best = t_ref.min(axis=1)
+    hit = np.isfinite(best)
+    np.testing.assert_array_equal(np.isfinite(hits.t[clean]), hit[clean])
+    np.testing.assert_array_equal(hits.face[clean] >= 0, hit[clean])
+    both = clean & hit
+    np.testing.assert_allclose(hits.t[both], best[both], rtol=RTOL[dtype] * 100)
+    # The face found is one at the least t (ties only between coplanar duplicates).
+    t_of_face = t_ref[np.flatnonzero(both), hits.face[both]]
+    np.testing.assert_allclose(t_of_face, best[both], rtol=RTOL[dtype] * 100)
+    # Misses report inf and -1.
+    assert np.all(hits.t[~np.isfinite(hits.t)] == np.inf)
+    assert np.all(hits.face[np.isinf(hits.t)] == -1)
+    # The barycentrics rebuild the hit point.
+    idx = np.flatnonzero(both)
+    tri = v[f[hits.face[idx]]]
+    p = np.einsum("ki,kij->kj", hits.barycentric[idx].astype(np.float64), tri)
+    q = o[idx].astype(np.float64) + hits.t[idx, None] * d[idx].astype(np.float64)
+    extent = np.abs(v).max() + scale
+    np.testing.assert_allclose(p, q, atol=extent * RTOL[dtype] * 100)
+    # occluded and count_intersections agree with the same reference.
+    occ = scene.occluded(o, d, tmax=tmax)
+    np.testing.assert_array_equal(occ[clean], hit[clean])
+    counts = scene.count_intersections(o, d, tmax=tmax)
+    np.testing.assert_array_equal(counts[clean], np.isfinite(t_ref).sum(axis=1)[clean])
+
+
+def test_tmin_per_ray_and_duplicates_and_degenerates():
+    rng = np.random.default_rng(5)
+    v, f = random_soup(rng, 30)
+    # A duplicate of face 0, a zero-area face (three equal vertices), a needle.
+    v = np.vstack([v, v[f[0]], [[0.1, 0.1, 0.1]] * 3, [[0, 0, 0], [1, 0, 0], [2, 1e-9, 0]]])
+    n = len(f)
+    f = np.vstack([f, [[3 * n, 3 * n + 1, 3 * n + 2]], [[3 * n + 3] * 3],
+                   [[3 * n + 6, 3 * n + 7, 3 * n + 8]]])
+    o, d = random_rays(rng, 500)
+    tmin = rng.uniform(0, 0.5, len(o))
+    scene = bvhkit.TriangleMesh(v, f, dtype=np.float64)
+    hits = scene.intersect(o, d, tmin=tmin)
+    t_ref, margin = ray_hits(v, f, o, d, tmin=tmin)
+    clean = ((margin >= 1e-9) | ~np.isfinite(margin)).all(axis=1)
+    best = t_ref.min(axis=1)
+    np.testing.assert_array_equal(np.isfinite(hits.t[clean]), np.isfinite(best[clean]))
+    ok = clean & np.isfinite(best)
+    np.testing.assert_allclose(hits.t[ok], best[ok], rtol=1e-9)
+    assert not np.any(hits.face == len(f) - 2)  # the zero-area face is never hit
+
+
+def test_nan_vertices_are_skipped_and_nan_rays_miss():
+    rng = np.random.default_rng(3)
+    v, f = random_soup(rng, 20)
+    v[1, 2] = np.nan  # face 0 has a NaN corner
+    scene = bvhkit.TriangleMesh(v, f)
+    assert list(scene.skipped()) == [0]
+    assert scene.stats()["skipped"] == 1
+    o, d = random_rays(rng, 200)
+    hits = scene.intersect(o, d)
+    assert not np.any(hits.face == 0)
+    nan_rays = scene.intersect([[np.nan, 0, 0]], [[1, 0, 0]])
+    assert nan_rays.face[0] == -1 and nan_rays.t[0] == np.inf
+
+
+def test_watertight_ray_through_shared_edge():
+    # Two triangles sharing the edge x = 0.5 of a unit square; rays straight down through it.
+    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0, 0], [0.5, 1, 0]], float)
+    f = np.array([[0, 4, 5], [0, 5, 3], [4, 1, 2], [4, 2, 5]])
+    y = np.linspace(0.01, 0.99, 97)
+    o = np.stack([np.full_like(y, 0.5), y, np.ones_like(y)], axis=1)
+    d = np.tile([0.0, 0.0, -1.0], (len(y), 1))
+    for dtype in DTYPES:
+        scene = bvhkit.TriangleMesh(v, f, dtype=dtype, ray_test="watertight")
+        assert np.all(scene.intersect(o, d).face >= 0)
+        assert np.all(scene.occluded(o, d))
+
+
+def test_refit_moves_the_hits():
+    v, f = bvhkit.load_mesh("sphere:subdiv=2")
+    scene = bvhkit.TriangleMesh(v, f)
+    o = np.array([[0, 0, -5.0]])
+    d = np.array([[0, 0, 1.0]])
+    t0 = scene.intersect(o, d).t[0]
+    scene.refit(v * 2)
+    t1 = scene.intersect(o, d).t[0]
+    assert abs(t0 - 4) < 1e-5 and abs(t1 - 3) < 1e-5
+    # The proximity structures follow the refit too.
+    assert abs(scene.closest_point([[0, 0, 0]]).distance[0] - 2) < 0.05
