@@ -2,8 +2,8 @@
 # The test suite, as CI runs it: installs dependencies if missing, builds Release and the
 # AddressSanitizer + UndefinedBehaviorSanitizer build and runs every test in both, runs the
 # concurrency tests under ThreadSanitizer, builds the plain configuration a user without any optional
-# package gets, checks that a separate CMake project can find_package(bvhkit) from an install, and
-# fuzzes each mesh reader briefly. Tests that cannot run here (a mesh or a peer library not found)
+# package gets, checks that a separate CMake project can find_package(bvhkit) from an install, builds
+# the Python package and runs its tests, and fuzzes each mesh reader briefly. Tests that cannot run here (a mesh or a peer library not found)
 # are reported as skipped, with the reason.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -35,7 +35,8 @@ disabled=()
 for package in embree box2d PkgConfig CGAL TBB PNG GTest benchmark; do
     disabled+=("-DCMAKE_DISABLE_FIND_PACKAGE_${package}=ON")
 done
-cmake -S . -B build/bare -G Ninja "${disabled[@]}" > "$logs/bare-configure.log"
+# Debug: this run checks what compiles and runs without the optional packages, and -O0 compiles faster.
+cmake -S . -B build/bare -G Ninja -DCMAKE_BUILD_TYPE=Debug "${disabled[@]}" > "$logs/bare-configure.log"
 grep -E "not found|skipped|not used" "$logs/bare-configure.log" || true
 cmake --build build/bare -j "$jobs"
 build/bare/tools/bvhkit info sphere:subdiv=5
@@ -48,6 +49,9 @@ cmake --install build/release --prefix build/install >/dev/null
 cmake -S tests/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$PWD/build/install" >/dev/null
 cmake --build build/consumer
 build/consumer/consumer
+
+echo "== Python package (pip install into build/python-venv) and its tests"
+scripts/test-python.sh
 
 echo "== Fuzzing the mesh readers"
 scripts/fuzz.sh "${BVHKIT_FUZZ_SECONDS:-15}"
