@@ -89,7 +89,9 @@ class DynamicTree {
         remove_leaf(p.node);
         free_node(p.node);
         p.node = dynamic_detail::kNullNode;
-        p.moved = false;  // a stale entry may stay in the move buffer; find_pairs() skips it
+        p.moved = false;  // find_pairs() skips its buffer entry
+        p.ended = true;   // update_pairs() ends its pairs
+        if (!p.buffered) p.buffered = true, move_buffer_.push_back(id);
         p.next_free = free_proxy_;
         free_proxy_ = id;
         --proxy_count_;
@@ -210,14 +212,45 @@ class DynamicTree {
         return static_cast<int>(k);
     }
 
-    /// Removes every proxy (keeps the memory).
+    /// Removes every proxy and returns all memory (memory_bytes() is 0 afterwards).
     void clear() {
         check_not_walking("DynamicTree::clear");
-        nodes_.clear();
-        proxies_.clear();
-        move_buffer_.clear();
+        release(nodes_);
+        release(proxies_);
+        release(move_buffer_);
+        release_scratch();
         root_ = free_node_ = free_proxy_ = dynamic_detail::kNullNode;
         node_count_ = proxy_count_ = 0;
+    }
+
+    /// Returns unused memory: the node pool is repacked (depth first) to exactly the nodes in use,
+    /// free proxy slots past the largest live id are dropped, and the scratch
+    /// storage is freed. Live proxy ids do not change. O(nodes).
+    void shrink_to_fit() {
+        check_not_walking("DynamicTree::shrink_to_fit");
+        std::size_t keep = proxies_.size();
+        while (keep > 0 && proxies_[keep - 1].node == dynamic_detail::kNullNode) --keep;
+        if (keep < proxies_.size()) {
+            // Destroyed ids past the end leave the move buffer (find_pairs skips them anyway).
+            move_buffer_.erase(
+                std::remove_if(move_buffer_.begin(), move_buffer_.end(),
+                               [keep](ProxyId id) { return std::size_t(id) >= keep; }),
+                move_buffer_.end());
+            proxies_.resize(keep);
+            free_proxy_ = dynamic_detail::kNullNode;  // relist the free slots, smallest id first
+            for (std::size_t id = keep; id-- > 0;)
+                if (proxies_[id].node == dynamic_detail::kNullNode)
+                    proxies_[id].next_free = free_proxy_, free_proxy_ = std::int32_t(id);
+        }
+        proxies_.shrink_to_fit();
+        std::vector<Node> packed;
+        packed.reserve(node_count_);
+        root_ = dynamic_detail::compact_nodes(
+            nodes_, root_, packed, [this](ProxyId p, int leaf) { proxies_[p].node = leaf; });
+        nodes_.swap(packed);
+        free_node_ = dynamic_detail::kNullNode;
+        move_buffer_.shrink_to_fit();
+        release_scratch();
     }
 
     bool contains(ProxyId id) const {
@@ -315,8 +348,7 @@ class DynamicTree {
         const Guard guard(walks_);
         out.clear();
         auto& buf = move_buffer_;
-        std::sort(buf.begin(), buf.end());
-        buf.erase(std::unique(buf.begin(), buf.end()), buf.end());
+        std::sort(buf.begin(), buf.end());  // each id is there once (Proxy::buffered)
         const auto v = view();
         for (const ProxyId q : buf) {
             if (!proxies_[q].moved) continue;  // destroyed since it was buffered
@@ -330,7 +362,10 @@ class DynamicTree {
                 },
                 nullptr);
         }
-        for (const ProxyId q : buf) proxies_[q].moved = false;
+        for (const ProxyId q : buf) {
+            Proxy& p = proxies_[q];
+            p.moved = p.buffered = p.ended = false;
+        }
         buf.clear();
         std::sort(out.begin(), out.end());
     }
@@ -341,7 +376,8 @@ class DynamicTree {
         const Guard guard(walks_);  // the callback must not change pair_scratch_ either
         for (const ProxyPair& p : pair_scratch_) callback(p.a, p.b);
     }
-    /// Proxies waiting in the move buffer (may hold duplicates and destroyed ids).
+    /// Ids waiting in the move buffer: each at most once (moved, created, or destroyed since the
+    /// last pair step), so never more than id_bound(), however many moves come between pair steps.
     std::size_t move_buffer_size() const { return move_buffer_.size(); }
 
     // ---------------------------------------------------------------- checks and measures
@@ -349,7 +385,8 @@ class DynamicTree {
     /// Checks every invariant; throws bvhkit::Error naming the first one broken.
     void validate() const {
         dynamic_detail::validate_tree(dynamic_detail::TreeParts<T, N, UserData>{
-            nodes_, proxies_, root_, free_node_, free_proxy_, node_count_, proxy_count_});
+            nodes_, proxies_, move_buffer_, root_, free_node_, free_proxy_, node_count_,
+            proxy_count_});
     }
     int height() const { return root_ == dynamic_detail::kNullNode ? 0 : nodes_[root_].height; }
     /// Sum of the areas (perimeters in 2D) of the internal nodes.
@@ -520,10 +557,24 @@ class DynamicTree {
         return id;
     }
 
+    template <class V>
+    static void release(V& v) {
+        V().swap(v);
+    }
+    void release_scratch() {
+        release(heap_);
+        release(pair_scratch_);
+        release(build_.items);
+        release(build_.tasks);
+        release(build_.created);
+        release(optimize_scratch_);
+    }
+
     void buffer_move(ProxyId id) {
         Proxy& p = proxies_[id];
-        if (p.moved) return;
         p.moved = true;
+        if (p.buffered) return;  // a reused id may still be there from before its destroy
+        p.buffered = true;
         move_buffer_.push_back(id);
     }
 
@@ -565,7 +616,7 @@ class DynamicTree {
             free_proxy_ = proxies_[id].next_free;
         }
         proxies_[id].next_free = dynamic_detail::kNullNode;
-        proxies_[id].moved = false;
+        proxies_[id].moved = false;  // `buffered` and `ended` stay: the id may wait in the buffer
         ++proxy_count_;
         return id;
     }

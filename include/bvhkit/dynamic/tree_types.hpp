@@ -97,7 +97,9 @@ struct Proxy {
     UserData user_data{};
     std::int32_t node = kNullNode;
     std::int32_t next_free = kNullNode;
-    bool moved = false;  // in the move buffer
+    bool moved = false;     // live and created or moved since the last pair step
+    bool buffered = false;  // its id is in the move buffer (once at most: bounds the buffer)
+    bool ended = false;     // destroyed since the last pair step: its pairs have ended
 };
 
 /// How many walks (queries, find_pairs, for_each_node) are running over a tree right now. The
