@@ -46,6 +46,18 @@ struct QueryStats {
     std::uint64_t leaves_tested = 0;  // leaves whose proxy box was tested
 };
 
+/// The cast a ray_cast or box_cast callback may ask for (callback(const CastInput&, ProxyId) -> T,
+/// as physics engines hand their ray input): the segment origin + s * translation, s in
+/// [0, max_fraction], with max_fraction as clipped so far, and the cast box's half extents (zero
+/// for a ray cast; origin is then the box's centre). Enough to clip the proxy's own shape exactly.
+template <class T, std::size_t N>
+struct CastInput {
+    Vec<T, N> origin;
+    Vec<T, N> translation;
+    Vec<T, N> half_extent;
+    T max_fraction = T(1);
+};
+
 /// A pair of overlapping proxies, a < b.
 struct ProxyPair {
     ProxyId a = kNullProxy;
