@@ -35,6 +35,7 @@
 
 #include "bvhkit/dynamic/small_stack.hpp"
 #include "bvhkit/dynamic/tree_insertion.hpp"
+#include "bvhkit/dynamic/tree_pairs.hpp"
 #include "bvhkit/dynamic/tree_queries.hpp"
 #include "bvhkit/dynamic/tree_rebuild.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
@@ -89,7 +90,9 @@ class DynamicTree {
         remove_leaf(p.node);
         free_node(p.node);
         p.node = dynamic_detail::kNullNode;
-        p.moved = false;  // a stale entry may stay in the move buffer; find_pairs() skips it
+        p.moved = false;  // find_pairs() skips its buffer entry
+        p.ended = true;   // update_pairs() ends its pairs
+        if (!p.buffered) p.buffered = true, move_buffer_.push_back(id);
         p.next_free = free_proxy_;
         free_proxy_ = id;
         --proxy_count_;
@@ -210,14 +213,57 @@ class DynamicTree {
         return static_cast<int>(k);
     }
 
-    /// Removes every proxy (keeps the memory).
+    /// Removes every proxy and returns all memory (memory_bytes() is 0 afterwards).
     void clear() {
         check_not_walking("DynamicTree::clear");
-        nodes_.clear();
-        proxies_.clear();
-        move_buffer_.clear();
+        release(nodes_);
+        release(proxies_);
+        release(move_buffer_);
+        release(pairs_);
+        release(pending_ends_);
+        pairs_valid_ = true;
+        release_scratch();
         root_ = free_node_ = free_proxy_ = dynamic_detail::kNullNode;
         node_count_ = proxy_count_ = 0;
+    }
+
+    /// Returns unused memory: the node pool is repacked (depth first) to exactly the nodes in use,
+    /// free proxy slots past the largest live id are dropped, and the scratch
+    /// storage is freed. Live proxy ids do not change. O(nodes).
+    void shrink_to_fit() {
+        check_not_walking("DynamicTree::shrink_to_fit");
+        std::size_t keep = proxies_.size();
+        while (keep > 0 && proxies_[keep - 1].node == dynamic_detail::kNullNode) --keep;
+        if (keep < proxies_.size()) {
+            // Pairs naming a dropped id end at the next update_pairs().
+            std::size_t kept = 0;
+            for (const ProxyPair& p : pairs_)
+                if (std::size_t(p.b) >= keep)
+                    pending_ends_.push_back(p);
+                else
+                    pairs_[kept++] = p;
+            pairs_.resize(kept);
+            // Destroyed ids past the end leave the move buffer (find_pairs skips them anyway).
+            move_buffer_.erase(
+                std::remove_if(move_buffer_.begin(), move_buffer_.end(),
+                               [keep](ProxyId id) { return std::size_t(id) >= keep; }),
+                move_buffer_.end());
+            proxies_.resize(keep);
+            free_proxy_ = dynamic_detail::kNullNode;  // relist the free slots, smallest id first
+            for (std::size_t id = keep; id-- > 0;)
+                if (proxies_[id].node == dynamic_detail::kNullNode)
+                    proxies_[id].next_free = free_proxy_, free_proxy_ = std::int32_t(id);
+        }
+        proxies_.shrink_to_fit();
+        std::vector<Node> packed;
+        packed.reserve(node_count_);
+        root_ = dynamic_detail::compact_nodes(
+            nodes_, root_, packed, [this](ProxyId p, int leaf) { proxies_[p].node = leaf; });
+        nodes_.swap(packed);
+        free_node_ = dynamic_detail::kNullNode;
+        move_buffer_.shrink_to_fit();
+        pairs_.shrink_to_fit();
+        release_scratch();
     }
 
     bool contains(ProxyId id) const {
@@ -272,8 +318,9 @@ class DynamicTree {
         dynamic_detail::query_point(view(), p, callback, stats);
     }
     /// The segment origin + s * direction, s in [0, max_fraction], against the proxies' boxes.
-    /// callback(ProxyId, T max_fraction) -> T: < 0 ignore and go on, 0 stop, > 0 clip to that
-    /// fraction.
+    /// callback(ProxyId, T max_fraction) -> T, or callback(const CastInput<T, N>&, ProxyId) -> T to
+    /// get the ray (origin, translation = direction, current max_fraction) for exact clipping:
+    /// < 0 ignore and go on, 0 stop, > 0 clip to that fraction.
     template <class F>
     void ray_cast(const VecT& origin, const VecT& direction, T max_fraction, F&& callback,
                   QueryStats* stats = nullptr) const {
@@ -281,8 +328,9 @@ class DynamicTree {
         dynamic_detail::check_vector(direction, "direction", "DynamicTree::ray_cast");
         check_fraction(max_fraction, "DynamicTree::ray_cast");
         const Guard guard(walks_);
-        dynamic_detail::cast(view(), dynamic_detail::Segment<T, N>(origin, direction), VecT{},
-                             max_fraction, callback, stats);
+        dynamic_detail::cast(view(), dynamic_detail::Segment<T, N>(origin, direction),
+                             CastInput<T, N>{origin, direction, VecT{}, max_fraction}, callback,
+                             stats);
     }
     /// `box` swept by s * translation, s in [0, max_fraction]: a ray cast from the box's centre
     /// against every box grown by the cast box's half extents. Same callback as ray_cast().
@@ -293,9 +341,11 @@ class DynamicTree {
         dynamic_detail::check_vector(translation, "translation", "DynamicTree::box_cast");
         check_fraction(max_fraction, "DynamicTree::box_cast");
         const Guard guard(walks_);
+        const VecT centre = dynamic_detail::safe_centroid(box);
         dynamic_detail::cast(
-            view(), dynamic_detail::Segment<T, N>(dynamic_detail::safe_centroid(box), translation),
-            box.max * T(0.5) - box.min * T(0.5), max_fraction, callback, stats);
+            view(), dynamic_detail::Segment<T, N>(centre, translation),
+            CastInput<T, N>{centre, translation, box.max * T(0.5) - box.min * T(0.5), max_fraction},
+            callback, stats);
     }
     /// Every pair (proxy of this tree, proxy of `other`) whose boxes overlap.
     /// callback(ProxyId mine, ProxyId theirs) -> bool, false stops.
@@ -309,30 +359,14 @@ class DynamicTree {
     // ---------------------------------------------------------------- pair finding
 
     /// The overlapping pairs (of the tight boxes) that involve a proxy moved or created since the
-    /// last call, each once, as (a, b) with a < b, sorted. Clears the move buffer.
+    /// last call, each once, as (a, b) with a < b, sorted. Clears the move buffer. (It leaves
+    /// update_pairs()'s persistent set stale: its next call compares against all pairs.)
     void find_pairs(std::vector<ProxyPair>& out) {
         check_not_walking("DynamicTree::find_pairs");
         const Guard guard(walks_);
-        out.clear();
-        auto& buf = move_buffer_;
-        std::sort(buf.begin(), buf.end());
-        buf.erase(std::unique(buf.begin(), buf.end()), buf.end());
-        const auto v = view();
-        for (const ProxyId q : buf) {
-            if (!proxies_[q].moved) continue;  // destroyed since it was buffered
-            dynamic_detail::query_box(
-                v, proxies_[q].box,
-                [&](ProxyId o) {
-                    // Skip itself; when both moved, only the query from the smaller id reports.
-                    if (o != q && !(proxies_[o].moved && o < q))
-                        out.push_back(o < q ? ProxyPair{o, q} : ProxyPair{q, o});
-                    return true;
-                },
-                nullptr);
-        }
-        for (const ProxyId q : buf) proxies_[q].moved = false;
-        buf.clear();
-        std::sort(out.begin(), out.end());
+        dynamic_detail::collect_moved_pairs(view(), move_buffer_, out);
+        end_pair_step();
+        pairs_valid_ = false;
     }
     /// Same pairs, handed to callback(ProxyId a, ProxyId b) in order.
     template <class F>
@@ -341,7 +375,43 @@ class DynamicTree {
         const Guard guard(walks_);  // the callback must not change pair_scratch_ either
         for (const ProxyPair& p : pair_scratch_) callback(p.a, p.b);
     }
-    /// Proxies waiting in the move buffer (may hold duplicates and destroyed ids).
+    /// Pair events: calls on_end(a, b) for every pair (a < b) of tight boxes that overlapped at the
+    /// last call and no longer does (or whose proxy was destroyed), then on_begin(a, b) for every
+    /// pair that overlaps now and did not, each sorted by (a, b). Pairs that persist are not
+    /// reported. Keeps a sorted persistent pair set; the work is one query per moved proxy plus a
+    /// linear merge. An id destroyed and created again in one step gives an end and a begin. The
+    /// ids in an end event may name proxies destroyed since. clear() forgets the set silently.
+    template <class Begin, class End>
+    void update_pairs(Begin&& on_begin, End&& on_end) {
+        check_not_walking("DynamicTree::update_pairs");
+        const Guard guard(walks_);
+        const bool stale = !pairs_valid_;
+        if (stale) {  // after find_pairs(): every pair of the set is checked again
+            for (std::size_t id = 0; id < proxies_.size(); ++id)
+                if (proxies_[id].node != dynamic_detail::kNullNode) buffer_move(ProxyId(id));
+            pairs_valid_ = true;
+        }
+        dynamic_detail::collect_moved_pairs(view(), move_buffer_, pair_scratch_);
+        auto& ends = pair_ends_;
+        auto& begins = pair_begins_;
+        ends.swap(pending_ends_);  // pairs of ids dropped by shrink_to_fit()
+        pending_ends_.clear();
+        begins.clear();
+        const auto touched = [this, stale](ProxyId id) { return stale || proxies_[id].buffered; };
+        const auto ended = [this](ProxyId id) { return proxies_[id].ended; };
+        dynamic_detail::step_pair_set(pairs_, pair_scratch_, touched, ended, pair_next_, ends,
+                                      begins);
+        pairs_.swap(pair_next_);
+        end_pair_step();
+        std::sort(ends.begin(), ends.end());
+        for (const ProxyPair& p : ends) on_end(p.a, p.b);
+        for (const ProxyPair& p : begins) on_begin(p.a, p.b);
+    }
+    /// The pairs overlapping as of the last update_pairs() (sorted).
+    const std::vector<ProxyPair>& current_pairs() const { return pairs_; }
+
+    /// Ids waiting in the move buffer: each at most once (moved, created, or destroyed since the
+    /// last pair step), so never more than id_bound(), however many moves come between pair steps.
     std::size_t move_buffer_size() const { return move_buffer_.size(); }
 
     // ---------------------------------------------------------------- checks and measures
@@ -349,7 +419,8 @@ class DynamicTree {
     /// Checks every invariant; throws bvhkit::Error naming the first one broken.
     void validate() const {
         dynamic_detail::validate_tree(dynamic_detail::TreeParts<T, N, UserData>{
-            nodes_, proxies_, root_, free_node_, free_proxy_, node_count_, proxy_count_});
+            nodes_, proxies_, move_buffer_, root_, free_node_, free_proxy_, node_count_,
+            proxy_count_});
     }
     int height() const { return root_ == dynamic_detail::kNullNode ? 0 : nodes_[root_].height; }
     /// Sum of the areas (perimeters in 2D) of the internal nodes.
@@ -373,7 +444,10 @@ class DynamicTree {
                build_.items.capacity() * sizeof(build_.items[0]) +
                build_.tasks.capacity() * sizeof(build_.tasks[0]) +
                build_.created.capacity() * sizeof(std::int32_t) +
-               optimize_scratch_.capacity() * sizeof(optimize_scratch_[0]);
+               optimize_scratch_.capacity() * sizeof(optimize_scratch_[0]) +
+               (pairs_.capacity() + pending_ends_.capacity() + pair_next_.capacity() +
+                pair_ends_.capacity() + pair_begins_.capacity()) *
+                   sizeof(ProxyPair);
     }
     TreeStats stats() const {
         TreeStats s;
@@ -520,10 +594,36 @@ class DynamicTree {
         return id;
     }
 
+    template <class V>
+    static void release(V& v) {
+        V().swap(v);
+    }
+    void release_scratch() {
+        release(heap_);
+        release(pair_scratch_);
+        release(build_.items);
+        release(build_.tasks);
+        release(build_.created);
+        release(optimize_scratch_);
+        release(pair_next_);
+        release(pair_ends_);
+        release(pair_begins_);
+    }
+
+    /// Clears the move buffer and its flags after a pair step.
+    void end_pair_step() {
+        for (const ProxyId q : move_buffer_) {
+            Proxy& p = proxies_[q];
+            p.moved = p.buffered = p.ended = false;
+        }
+        move_buffer_.clear();
+    }
+
     void buffer_move(ProxyId id) {
         Proxy& p = proxies_[id];
-        if (p.moved) return;
         p.moved = true;
+        if (p.buffered) return;  // a reused id may still be there from before its destroy
+        p.buffered = true;
         move_buffer_.push_back(id);
     }
 
@@ -565,7 +665,7 @@ class DynamicTree {
             free_proxy_ = proxies_[id].next_free;
         }
         proxies_[id].next_free = dynamic_detail::kNullNode;
-        proxies_[id].moved = false;
+        proxies_[id].moved = false;  // `buffered` and `ended` stay: the id may wait in the buffer
         ++proxy_count_;
         return id;
     }
@@ -650,6 +750,10 @@ class DynamicTree {
     std::vector<ProxyPair> pair_scratch_;
     dynamic_detail::BuildScratch<T, N> build_;
     std::vector<std::pair<double, std::int32_t>> optimize_scratch_;
+    // update_pairs(): the persistent pair set, whether it is current (find_pairs() makes it
+    // stale), ends owed for ids shrink_to_fit() dropped, and scratch.
+    std::vector<ProxyPair> pairs_, pending_ends_, pair_next_, pair_ends_, pair_begins_;
+    bool pairs_valid_ = true;
     dynamic_detail::WalkCounter walks_;
 };
 

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
+#include <utility>
 
 #include "bvhkit/dynamic/small_stack.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
@@ -89,15 +91,19 @@ struct Segment {
     }
 };
 
-/// Ray (or box) cast along segment `seg` with every box grown by `pad` (zero for a ray, the cast
-/// box's half extents for a box cast). callback(ProxyId, T max_fraction) -> T, as games expect:
+/// Ray (or box) cast of `in` (every box grown by in.half_extent: zero for a ray, the cast box's
+/// half extents for a box cast) along `seg`, its slab form. The callback is either
+/// callback(ProxyId, T max_fraction) or callback(const CastInput&, ProxyId), returning T, as games
+/// expect:
 ///   < 0  ignore this proxy, go on with the same max fraction
 ///   == 0 stop the query
 ///   > 0  go on, clipping the segment to this new max fraction
 template <class T, std::size_t N, class U, class F>
-void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, const Vec<T, N>& pad,
-          T max_fraction, F&& callback, QueryStats* stats) {
+void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, CastInput<T, N> in, F&& callback,
+          QueryStats* stats) {
     if (t.root == kNullNode) return;
+    const Vec<T, N> pad = in.half_extent;
+    T& max_fraction = in.max_fraction;
     std::uint64_t visited = 0, tested = 0;
     SmallStack<std::int32_t> stack;
     stack.push(t.root);
@@ -108,7 +114,11 @@ void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, const Vec<T, N>&
         if (n.is_leaf()) {
             ++tested;
             if (seg.entry(t.proxies[n.proxy()].box, pad, max_fraction) < T(0)) continue;
-            const T value = callback(n.proxy(), max_fraction);
+            T value;
+            if constexpr (std::is_invocable_v<F&, const CastInput<T, N>&, ProxyId>)
+                value = callback(std::as_const(in), n.proxy());
+            else
+                value = callback(n.proxy(), max_fraction);
             if (value == T(0)) break;
             if (value > T(0)) max_fraction = value;
         } else {

@@ -155,4 +155,33 @@ std::int32_t build_binned_sah(Node<T, N>* nodes, BuildScratch<T, N>& s, Alloc&& 
     return root;
 }
 
+/// Copies the tree under `root` into `out` (cleared), depth first, so that the pool holds exactly
+/// the nodes in use; calls relink(proxy, new leaf index) for every leaf. Returns the new root.
+template <class T, std::size_t N, class Relink>
+std::int32_t compact_nodes(const std::vector<Node<T, N>>& nodes, std::int32_t root,
+                           std::vector<Node<T, N>>& out, Relink&& relink) {
+    out.clear();
+    if (root == kNullNode) return kNullNode;
+    struct Item {
+        std::int32_t old, parent, slot;
+    };
+    std::vector<Item> stack{{root, kNullNode, 0}};
+    while (!stack.empty()) {
+        const Item it = stack.back();
+        stack.pop_back();
+        const auto i = static_cast<std::int32_t>(out.size());
+        out.push_back(nodes[it.old]);
+        out[i].parent = it.parent;
+        if (it.slot == 1) out[it.parent].child1 = i;
+        if (it.slot == 2) out[it.parent].child2 = i;
+        if (out[i].is_leaf()) {
+            relink(out[i].proxy(), i);
+        } else {
+            stack.push_back({nodes[it.old].child2, i, 2});
+            stack.push_back({nodes[it.old].child1, i, 1});
+        }
+    }
+    return 0;
+}
+
 }  // namespace bvhkit::dynamic_detail

@@ -46,6 +46,18 @@ struct QueryStats {
     std::uint64_t leaves_tested = 0;  // leaves whose proxy box was tested
 };
 
+/// The cast a ray_cast or box_cast callback may ask for (callback(const CastInput&, ProxyId) -> T,
+/// as physics engines hand their ray input): the segment origin + s * translation, s in
+/// [0, max_fraction], with max_fraction as clipped so far, and the cast box's half extents (zero
+/// for a ray cast; origin is then the box's centre). Enough to clip the proxy's own shape exactly.
+template <class T, std::size_t N>
+struct CastInput {
+    Vec<T, N> origin;
+    Vec<T, N> translation;
+    Vec<T, N> half_extent;
+    T max_fraction = T(1);
+};
+
 /// A pair of overlapping proxies, a < b.
 struct ProxyPair {
     ProxyId a = kNullProxy;
@@ -97,7 +109,9 @@ struct Proxy {
     UserData user_data{};
     std::int32_t node = kNullNode;
     std::int32_t next_free = kNullNode;
-    bool moved = false;  // in the move buffer
+    bool moved = false;     // live and created or moved since the last pair step
+    bool buffered = false;  // its id is in the move buffer (once at most: bounds the buffer)
+    bool ended = false;     // destroyed since the last pair step: its pairs have ended
 };
 
 /// How many walks (queries, find_pairs, for_each_node) are running over a tree right now. The

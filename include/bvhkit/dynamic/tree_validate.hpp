@@ -60,6 +60,7 @@ template <class T, std::size_t N, class U>
 struct TreeParts {
     const std::vector<Node<T, N>>& nodes;
     const std::vector<Proxy<T, N, U>>& proxies;
+    const std::vector<ProxyId>& move_buffer;
     std::int32_t root;
     std::int32_t free_node;
     std::int32_t free_proxy;
@@ -162,7 +163,7 @@ void validate_tree(const TreeParts<T, N, U>& t) {
         const auto& px = t.proxies[p];
         if (px.node == kNullNode) {
             if (px.moved)
-                broken("proxy table: free proxy " + std::to_string(p) + " is in the move buffer");
+                broken("proxy table: free proxy " + std::to_string(p) + " is marked moved");
             continue;
         }
         ++live;
@@ -182,6 +183,18 @@ void validate_tree(const TreeParts<T, N, U>& t) {
             broken("proxy free list: proxy " + std::to_string(p) + " is live");
         if (++free_proxies > t.proxies.size()) broken("proxy free list has a cycle");
     }
+    // Move buffer: each id in range, flagged, and there once; every moved proxy is in it.
+    std::size_t flagged = 0;
+    for (const auto& px : t.proxies) {
+        flagged += px.buffered;
+        if (px.moved && !px.buffered) broken("move buffer: a moved proxy is not in it");
+    }
+    for (const ProxyId id : t.move_buffer)
+        if (id < 0 || id >= pcap || !t.proxies[id].buffered)
+            broken("move buffer: id " + std::to_string(id) + " is out of range or not flagged");
+    if (flagged != t.move_buffer.size())
+        broken("move buffer: " + std::to_string(t.move_buffer.size()) + " entries, " +
+               std::to_string(flagged) + " proxies flagged (an id is listed twice)");
     if (free_proxies + t.proxy_count != t.proxies.size())
         broken("proxy free list: " + std::to_string(free_proxies) + " free + " +
                std::to_string(t.proxy_count) + " live != table size " +
