@@ -8,11 +8,17 @@
 //
 // Exact: every triangle's solid angle (Van Oosterom and Strackee 1983), linear in the mesh size.
 // Fast: the hierarchical approximation of Barill et al. 2018 ("Fast winding numbers for soups and
-// clouds"), first order: a node whose triangles all lie within radius r of their area-weighted
-// centre c, seen from a point farther than beta * r from c, counts as one dipole,
-//     w_node = (c - q) . sum(a_i n_i) / (4 pi |c - q|^3),
-// and nearer nodes are opened (leaves summed exactly). beta = 2 gives errors around 1e-2 near the
-// surface and far less away from it; a larger beta is more exact and slower.
+// clouds"): a node whose triangles all lie within radius r of their area-weighted centre c, seen
+// from a point farther than beta * r from c, counts as its Taylor expansion; nearer nodes are
+// opened (leaves summed exactly). Order 1 is the dipole,
+//     w_node = (c - q) . sum(a_i n_i) / (4 pi |c - q|^3);
+// order 2 (the default) adds the first moment M = sum(a_i (centroid_i - c) (x) n_i) against the
+// Jacobian of r / |r|^3: (tr M / |r|^3 - 3 r.M.r / |r|^5) / (4 pi), r = c - q.
+// Measured against exact() on spot for 3,000 points within 1% of the diagonal from the surface,
+// beta = 2 (tests/proximity/winding_accuracy_test.cpp): order 1 mean error 0.027, max 0.065,
+// 92% of points off by more than 1e-2; order 2 mean 0.010, max 0.036, 46%. Far from the surface
+// the error falls off fast. A larger beta is more exact and slower; beta must be at least 1.
+
 #include <array>
 #include <cmath>
 #include <numbers>
