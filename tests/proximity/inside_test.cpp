@@ -187,5 +187,35 @@ TEST(Overlap, BoxSphereAndPointEqualBruteForce) {
     }
 }
 
+// The batch signed distance: the same answers as one at a time, on 1 thread and on all, in float
+// and double; an output too small is an error.
+template <class T>
+void check_signed_distance_batch(const TriangleMesh& mesh, std::uint64_t seed) {
+    const SignedDistanceMesh<T> sdf(mesh);
+    test::Random rng(seed);
+    std::vector<Vec<T, 3>> points(test::scaled(5000, 10));
+    for (auto& p : points) p = rng.point_in(Aabb<T, 3>(Vec<T, 3>(T(-1.3)), Vec<T, 3>(T(1.3))));
+    std::vector<SignedDistance<T>> one(points.size()), all(points.size());
+    sdf.signed_distances(points, one, 1);
+    sdf.signed_distances(points, all, 0);
+    std::size_t inside = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const SignedDistance<T> single = sdf.signed_distance(points[i]);
+        ASSERT_EQ(one[i].distance, single.distance) << i;
+        ASSERT_EQ(one[i].closest.triangle, single.closest.triangle) << i;
+        ASSERT_EQ(all[i].distance, single.distance) << i;
+        ASSERT_EQ(all[i].closest.point, single.closest.point) << i;
+        inside += single.distance < 0;
+    }
+    EXPECT_GT(inside, points.size() / 20);  // the premise: both signs occur
+    std::vector<SignedDistance<T>> small(points.size() - 1);
+    EXPECT_THROW(sdf.signed_distances(points, small), Error);
+}
+
+TEST(SignedDistanceBatch, EqualsOneAtATimeOnAnyThreads) {
+    check_signed_distance_batch<float>(make_sphere(4), 1);
+    check_signed_distance_batch<double>(make_torus(48, 24), 2);
+}
+
 }  // namespace
 }  // namespace bvhkit

@@ -14,9 +14,12 @@
 namespace bvhkit {
 namespace {
 
+/// The brute force's distance: the accurate point-triangle distance ClosestPointMesh measures its
+/// candidates with (itself judged against exact arithmetic in closest_point_accuracy_test.cpp), so
+/// that these tests check the search: the same answer as every triangle measured alike.
 template <class T>
 T distance2(const Triangle<T>& t, const Vec<T, 3>& p) {
-    return length_squared(closest_point(t, p).point - p);
+    return T(distance_squared_accurate(t, p));
 }
 
 /// Points near the surface (a random surface point pushed off by up to 1% of the diagonal) and
@@ -62,6 +65,20 @@ void check_against_brute_force(const std::vector<Triangle<T>>& tris, std::size_t
         ASSERT_TRUE(got) << "point " << q;
         const T want = all[0].first;
         ASSERT_NEAR(got.distance_squared, want, T(1e-6) * want + std::numeric_limits<T>::min())
+            << "point " << q;
+        // And within 1e-6 (relative, in distance) of a brute force by another method: Ericson's
+        // closest point in double on the same triangles, moved so that p is the origin (its
+        // rounding is then relative to the distance and the triangle's size).
+        double ericson = std::numeric_limits<double>::infinity();
+        const Vec3d pd(p);
+        for (const auto& t : tris) {
+            const Triangle<double> w{Vec3d(t.p0) - pd, Vec3d(t.p1) - pd, Vec3d(t.p2) - pd};
+            ericson = std::min(ericson, length_squared(closest_point(w, Vec3d(0.0)).point));
+        }
+        // (Plus 2^-40 of p's magnitude: points on the surface are at distance ~0, and either
+        // brute force is off by the rounding of the coordinates there.)
+        ASSERT_NEAR(std::sqrt(double(got.distance_squared)), std::sqrt(ericson),
+                    1e-6 * std::sqrt(ericson) + 0x1p-40 * double(max_component(abs(p))))
             << "point " << q;
         if (got.triangle != all[0].second) {
             // Allowed for a tie only: the triangle we got is as close as the best.
@@ -417,18 +434,19 @@ TEST(NearestWide, EricsonsPointOutsideTheBox) {
                       {-0x1.82e3eap-1f, -0x1.7ebba4p+0f, -0x1.8047d8p+0f},
                       {-0x1.eeb6c8p-1f, 0x1.ecd2f8p-3f, 0x1.11ef44p-2f}};
     const Vec3f p{-0x1.eeb6c8p-1f, 0x1.ecd3p-3f, 0x1.11ef3ep-2f};
-    const float ericson = distance2(t, p);
+    const float ericson = length_squared(closest_point(t, p).point - p);
     ASSERT_LT(ericson, t.bounds().distance_squared(p));  // the premise
+    const float want = distance2(t, p);
     const ClosestPointMesh<float> one(std::vector<Trianglef>{t});
     NearestScratch<float> scratch;
-    const auto got = one.closest_point(p, scratch, 0x1p-49f);
+    const auto got = one.closest_point(p, scratch, want);
     ASSERT_TRUE(got);
-    EXPECT_EQ(got.distance_squared, ericson);
+    EXPECT_EQ(got.distance_squared, want);
     std::vector<MeshPoint<float>> out;
     one.k_nearest(p, 1, out, scratch);
     ASSERT_EQ(out.size(), 1u);
-    EXPECT_EQ(out[0].distance_squared, ericson);
-    one.within_radius(p, std::sqrt(0x1p-49f), out);
+    EXPECT_EQ(out[0].distance_squared, want);
+    one.within_radius(p, std::sqrt(want) * 1.0001f, out);
     EXPECT_EQ(out.size(), 1u);
 }
 

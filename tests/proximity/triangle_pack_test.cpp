@@ -446,15 +446,15 @@ TEST(TrianglePack, ReviewedThinTriangle) {
                       {-0x1.247606p-1f, -0x1.b43016p-2f, -0x1.2a507ep-3f},
                       {-0x1.2b9154p-1f, -0x1.91c544p-2f, -0x1.0e9a3ep-3f}};
     const Vec3f p{-0x1.2a893cp-1f, -0x1.9645f8p-2f, -0x1.129becp-3f};
-    const float ericson = length_squared(closest_point(t, p).point - p);
+    const float accurate = float(distance_squared_accurate(t, p));
     const ClosestPointMesh<float> one(std::vector<Trianglef>{t});
     NearestScratch<float> scratch;
-    const auto got = one.closest_point(p, scratch, ericson);
+    const auto got = one.closest_point(p, scratch, accurate);
     ASSERT_TRUE(got);
-    EXPECT_EQ(got.distance_squared, ericson);
+    EXPECT_EQ(got.distance_squared, accurate);
     // With a point triangle a little farther than it, and no search limit.
     Vec3f x = p;
-    x[2] += std::sqrt(ericson) * 1.0001f;
+    x[2] += std::sqrt(accurate) * 1.5f;  // (1.5: x is rounded to ~7e-9, a fifth of it)
     const ClosestPointMesh<float> two(std::vector<Trianglef>{t, {x, x, x}});
     EXPECT_EQ(two.closest_point(p, scratch).triangle, 0u);
 }

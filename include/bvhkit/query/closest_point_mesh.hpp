@@ -6,16 +6,21 @@
 // radius, and a batch of points (in parallel with oneTBB, the same answers as serial).
 //
 // It owns a Bvh (binned SAH by default) and a copy of the triangles in leaf order, so a leaf's
-// triangles are contiguous; the distance to a triangle is Ericson's closest point
-// (primitives/closest_point.hpp). Triangles with a NaN or infinite coordinate are left out.
+// triangles are contiguous. A triangle's distance is closest_point_accurate's
+// (primitives/closest_point.hpp): computed in double for float meshes, long double for double
+// ones, without cancellation, so the distance returned is the true distance from the point to the
+// mesh within |d - d_true| <= 2 eps_T d + 96 eps_W (d + L) (L the longest edge; docs/accuracy.md),
+// on slivers and far from the origin alike. The float boxes and packs only cull, against the
+// search radius widened by their rounding. Triangles with a NaN or infinite coordinate are left
+// out. Candidates are ranked in the wider type, so a point whose squared distance is past T's
+// range (1e19 from a float mesh) still gets its closest triangle (distance_squared is then inf).
 //
 // closest_point walks a second form of the same tree, built from it: the binary tree collapsed
 // to four children a node (bvh/wide_bvh.hpp), its leaves' triangles four abreast
 // (primitives/triangle_pack.hpp). A pack's SIMD distances only pick which triangles to measure
-// with Ericson's code, with a margin for rounding, so the answers are those of testing every
-// triangle with it; against the binary walk this took ~40% less time per N1 query and halved
-// its mispredicted branches (docs/proximity.md). k_nearest and within_radius walk the binary
-// tree.
+// accurately, with a margin for rounding, so the answers are those of measuring every triangle;
+// against the binary walk this took ~40% less time per N1 query (docs/proximity.md).
+// k_nearest and within_radius walk the binary tree.
 #include <span>
 
 #include "bvhkit/build/build.hpp"
@@ -62,23 +67,28 @@ class ClosestPointMesh {
                                T max_distance_squared = std::numeric_limits<T>::infinity(),
                                Stats&& stats = {}) const {
         if (!is_finite(p)) return {};
+        using W = AccurateScalar<T>;
         NearestSlot<T> best;
-        // radius2 accepts (Ericson's distance must be within it); search2, radius2 widened by
-        // what rounding can put between Ericson's distance and any bound on it, prunes boxes and
-        // packs. The packs hold the mesh scaled to unit magnitude (see build): p likewise.
-        T radius2 = max_distance_squared;
+        // Candidates are measured accurately, in W (closest_point_accurate), and compared there:
+        // a squared distance past T's range (a point 1e19 from a float mesh) still ranks.
+        // search2, the best distance widened by what rounding can put between the true distance
+        // and the float bounds on it, prunes boxes and packs. The packs hold the mesh scaled to
+        // unit magnitude (see build): p likewise.
+        W best2 = std::numeric_limits<W>::infinity();
         const T magnitude = max_component(abs(p));
-        T search2 = widened(radius2, magnitude);
+        T search2 = widened(max_distance_squared, magnitude);
         const Vec<T, 3> ps = p * pack_scale_;
-        const bool scaled_ok = is_finite(ps);
+        // The pack formula squares lengths twice over: beyond 2^(max_exponent / 4) from the
+        // (unit) mesh it would overflow, and every lane is measured.
+        const bool scaled_ok =
+            max_component(abs(ps)) < std::ldexp(T(1), std::numeric_limits<T>::max_exponent / 4);
         const T unscale = T(1) / pack_scale_;  // exact: a power of two
         const auto open_leaf = [&](std::uint32_t first, std::uint32_t groups) {
             for (std::uint32_t g = first; g < first + groups; ++g) {
                 const TrianglePack4<T>& pack = packs_[g];
                 for (int l = 0; l < 4; ++l)
                     if (pack.slot[l] != invalid_index) stats.primitive();
-                // The pack's distances decide which lanes to measure exactly, with Ericson's
-                // closest point, so the answer is the one testing every triangle with it gives.
+                // The pack's distances decide which lanes to measure accurately.
                 const unsigned lanes =
                     scaled_ok ? pack.lanes_within(ps, search2 * pack_scale_ * pack_scale_)
                               : pack.used_lanes();
@@ -88,11 +98,12 @@ class ClosestPointMesh {
                     // The pack's own copy, in cache already, when it unscales exactly.
                     const Triangle<T> t =
                         packs_unscale_exactly_ ? pack.triangle(l, unscale) : tris_[s];
-                    const T d2 = length_squared(bvhkit::closest_point(t, p).point - p);
-                    if (d2 < best.distance_squared && d2 <= radius2) {
-                        best = {s, d2};
-                        radius2 = d2;
-                        search2 = widened(radius2, magnitude);
+                    const W d2 = distance_squared_accurate(t, p);
+                    // The limit is judged on the distance as returned (rounded to T).
+                    if (d2 < best2 && T(d2) <= max_distance_squared) {
+                        best = {s, T(d2)};
+                        best2 = d2;
+                        search2 = widened(T(d2), magnitude);
                     }
                 }
             }
@@ -122,7 +133,8 @@ class ClosestPointMesh {
         for (const auto& [d2, s] : slots) out.push_back(point_of(s, p));
     }
 
-    /// Every triangle within `radius` of p (inclusive), in no particular order.
+    /// Every triangle within `radius` of p (inclusive, on the distances as rounded to T), in no
+    /// particular order. A negative or NaN radius finds nothing.
     void within_radius(const Vec<T, 3>& p, T radius, std::vector<MeshPoint<T>>& out) const {
         out.clear();
         bvhkit::within_radius(bvh_, p, radius, distance(), [&](std::uint32_t s, T) {
@@ -195,11 +207,11 @@ class ClosestPointMesh {
                 packs_unscale_exactly_ = false;
         }
     }
-    /// `radius2` widened by what rounding can put between Ericson's distance to a triangle and
-    /// any bound on it: the pack's distance, the triangle's box, a node's box (Ericson's point can
-    /// land an ulp outside the triangle's box). 1024 ulps of the lengths involved: the largest
-    /// gap measured between a pack's distance and Ericson's was ~150 ulps on triangles that are
-    /// not flagged as slivers. `point_magnitude` is the query point's largest |coordinate|.
+    /// `radius2` widened by what rounding can put between a triangle's true distance and the
+    /// float bounds on it: the pack's distance, the triangle's box, a node's box. 1024 ulps of the
+    /// lengths involved: the largest gap measured between a pack's distance and the true one was
+    /// ~150 ulps on triangles that are not flagged as slivers (slivers are always measured).
+    /// `point_magnitude` is the query point's largest |coordinate|.
     T widened(T radius2, T point_magnitude) const {
         if (!(radius2 >= T(0) && radius2 < std::numeric_limits<T>::infinity())) return radius2;
         const T r = std::sqrt(radius2);
@@ -216,7 +228,7 @@ class ClosestPointMesh {
             // The triangle's box is a cheap lower bound: most triangles of a leaf fail it.
             const T box_d2 = box_distance_squared(t, p);
             if (box_d2 > widen(p, bound)) return box_d2;
-            return length_squared(bvhkit::closest_point(t, p).point - p);
+            return T(distance_squared_accurate(t, p));
         }
         /// The bound the walks prune boxes with: see widened().
         T widen(const Vec<T, 3>& p, T bound) const {
@@ -257,8 +269,9 @@ class ClosestPointMesh {
         return d2;
     }
     MeshPoint<T> point_of(std::uint32_t slot, const Vec<T, 3>& p) const {
-        const ClosestPoint<T> c = bvhkit::closest_point(tris_[slot], p);
-        return {c.point, length_squared(c.point - p), bvh_.primitive_indices[slot], c.u, c.v};
+        const AccurateClosestPoint<T> c = closest_point_accurate(tris_[slot], p);
+        return {Vec<T, 3>(c.point), T(c.distance_squared), bvh_.primitive_indices[slot], T(c.u),
+                T(c.v)};
     }
 
     AabbBvh<T, 3> bvh_;

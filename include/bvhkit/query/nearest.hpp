@@ -183,10 +183,11 @@ void k_nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, std::size_t k, Di
 
 /// Every primitive within `radius` of `p` (inclusive): on_found(slot, squared distance) returns
 /// true to go on, false to stop. Depth first with a fixed stack (the order does not matter here).
+/// A negative or NaN radius holds nothing (no ball has it): no primitive is reported.
 template <class T, std::size_t N, class Distance, class OnFound, class Stats = NoStats>
 bool within_radius(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, T radius, Distance&& distance,
                    OnFound&& on_found, Stats&& stats = {}) {
-    if (bvh.empty()) return true;
+    if (bvh.empty() || !(radius >= T(0))) return true;
     const T r2 = radius * radius;
     const T prune2 = nearest_detail::prune_radius2(distance, p, r2);
     const auto* nodes = bvh.nodes.data();
