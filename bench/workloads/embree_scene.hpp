@@ -46,6 +46,7 @@ class EmbreeScene {
             h.primitive = rh.hit.primID;
             h.u = rh.hit.u;
             h.v = rh.hit.v;
+            h.normal = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
         }
         return h;
     }

@@ -3,9 +3,14 @@
 // ask closest_hit, any_hit or all_hits. It owns a Bvh and a copy of the triangles laid out in leaf
 // order (edges and normal precomputed), so a leaf's triangles are contiguous in memory.
 //
-// Hit::primitive is the triangle's index in the mesh. Triangles with a NaN or infinite coordinate
-// are left out (see BuildReport / skipped()); degenerate (zero-area) triangles stay in the tree and
-// are never hit.
+// Hit::primitive is the triangle's index in the mesh, Hit::normal its geometric normal (p1 - p0) x
+// (p2 - p0), not normalized. Triangles with a NaN or infinite coordinate are left out (see
+// BuildReport / skipped()); degenerate (zero-area) triangles stay in the tree and are never hit.
+// A ray with a NaN or infinite component or a zero direction misses without walking the tree.
+//
+// The triangle test is TriangleBvhOptions::triangle_test: watertight by default (no ray slips
+// through a shared edge or vertex of a closed mesh), or the fast Moller-Trumbore test, which can
+// (see primitives/triangle.hpp).
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/refit.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
@@ -14,8 +19,17 @@
 namespace bvhkit {
 
 enum class TriangleTest {
-    Fast,        // Moller-Trumbore on precomputed edges (default)
-    Watertight,  // Woop, Benthin, Wald 2013: never misses through a shared edge
+    Watertight,  // Woop, Benthin, Wald 2013: never misses through a shared edge (default)
+    Fast,        // Moller-Trumbore on precomputed edges: a ray can slip through a shared edge
+};
+
+/// How a TriangleBvh is built (every BuildOptions member) and which triangle test its queries run.
+/// Converts from BuildOptions, so `TriangleBvh<float>(mesh, build_options)` keeps working.
+struct TriangleBvhOptions : BuildOptions {
+    TriangleTest triangle_test = TriangleTest::Watertight;
+
+    TriangleBvhOptions() = default;
+    TriangleBvhOptions(const BuildOptions& build) : BuildOptions(build) {}  // NOLINT: implicit
 };
 
 template <class T>
@@ -24,17 +38,16 @@ class TriangleBvh {
     TriangleBvh() = default;
 
     template <class U>
-    explicit TriangleBvh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {},
-                         TriangleTest test = TriangleTest::Fast)
-        : triangle_test_(test) {
+    explicit TriangleBvh(const BasicTriangleMesh<U>& mesh, const TriangleBvhOptions& options = {})
+        : triangle_test_(options.triangle_test) {
         check_triangle_indices(mesh);
         build([&](std::size_t i) { return triangle_at<T>(mesh, i); }, mesh.triangles.size(),
               options);
     }
 
     explicit TriangleBvh(const std::vector<Triangle<T>>& triangles,
-                         const BuildOptions& options = {}, TriangleTest test = TriangleTest::Fast)
-        : triangle_test_(test) {
+                         const TriangleBvhOptions& options = {})
+        : triangle_test_(options.triangle_test) {
         build([&](std::size_t i) { return triangles[i]; }, triangles.size(), options);
     }
 
@@ -42,26 +55,28 @@ class TriangleBvh {
     template <class Stats>
     Hit<T> closest_hit(const Ray<T, 3>& ray, Stats&& stats) const {
         if (triangle_test_ == TriangleTest::Watertight)
-            return bvhkit::closest_hit(bvh_, ray, watertight_test(), stats);
-        return bvhkit::closest_hit(bvh_, ray, fast_test(), stats);
+            return bvhkit::closest_hit(bvh_, ray, WatertightTest{exact_.data(), ray}, stats);
+        return bvhkit::closest_hit(bvh_, ray, FastTest{fast_.data()}, stats);
     }
 
     bool any_hit(const Ray<T, 3>& ray) const { return any_hit(ray, NoStats{}); }
     template <class Stats>
     bool any_hit(const Ray<T, 3>& ray, Stats&& stats) const {
         if (triangle_test_ == TriangleTest::Watertight)
-            return bvhkit::any_hit(bvh_, ray, watertight_test(), stats);
-        return bvhkit::any_hit(bvh_, ray, fast_test(), stats);
+            return bvhkit::any_hit(bvh_, ray, WatertightTest{exact_.data(), ray}, stats);
+        return bvhkit::any_hit(bvh_, ray, FastTest{fast_.data()}, stats);
     }
 
     /// on_hit(const Hit<T>&) -> bool (true to go on); hits come in no particular order.
     template <class OnHit, class Stats = NoStats>
     void all_hits(const Ray<T, 3>& ray, OnHit&& on_hit, Stats&& stats = {}) const {
         if (triangle_test_ == TriangleTest::Watertight)
-            bvhkit::all_hits(bvh_, ray, watertight_test(), on_hit, stats);
+            bvhkit::all_hits(bvh_, ray, WatertightTest{exact_.data(), ray}, on_hit, stats);
         else
-            bvhkit::all_hits(bvh_, ray, fast_test(), on_hit, stats);
+            bvhkit::all_hits(bvh_, ray, FastTest{fast_.data()}, on_hit, stats);
     }
+
+    TriangleTest triangle_test() const { return triangle_test_; }
 
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
     template <class U>
@@ -97,37 +112,48 @@ class TriangleBvh {
         lay_out(triangle);
     }
 
+    // Only the chosen test's layout is kept.
     template <class TriangleAt>
     void lay_out(TriangleAt&& triangle) {
         const auto& order = bvh_.primitive_indices;
         fast_.clear();
-        fast_.reserve(order.size());
-        for (std::uint32_t i : order) fast_.emplace_back(triangle(i));
         exact_.clear();
         if (triangle_test_ == TriangleTest::Watertight) {
             exact_.reserve(order.size());
             for (std::uint32_t i : order) exact_.push_back(triangle(i));
+        } else {
+            fast_.reserve(order.size());
+            for (std::uint32_t i : order) fast_.emplace_back(triangle(i));
         }
     }
-    auto fast_test() const {
-        return [tris = fast_.data()](std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) {
+
+    // The leaf tests (query/ray.hpp): the watertight one carries its per-ray constants, made once
+    // per query.
+    struct WatertightTest {
+        const Triangle<T>* tris;
+        WatertightRay<T> prepared;
+        WatertightTest(const Triangle<T>* t, const Ray<T, 3>& ray) : tris(t), prepared(ray) {}
+        bool operator()(std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) const {
+            const Triangle<T>& tri = tris[slot];
+            return intersect_watertight(prepared, tri.p0, tri.p1, tri.p2, ray.tmin, ray.tmax, h);
+        }
+        Vec<T, 3> normal(std::uint32_t slot) const { return tris[slot].normal(); }
+    };
+    struct FastTest {
+        const PrecomputedTriangle<T>* tris;
+        bool operator()(std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) const {
             return tris[slot].intersect(ray, ray.tmax, h);
-        };
-    }
-    auto watertight_test() const {
-        return [tris = exact_.data()](std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) {
-            const auto r = tris[slot].intersect_watertight(ray);
-            if (r) h = *r;
-            return r.has_value();
-        };
-    }
+        }
+        // n = (p0 - p1) x (p2 - p0) = -(p1 - p0) x (p2 - p0).
+        Vec<T, 3> normal(std::uint32_t slot) const { return tris[slot].n * T(-1); }
+    };
 
     AabbBvh<T, 3> bvh_;
-    std::vector<PrecomputedTriangle<T>> fast_;  // leaf-slot order
+    std::vector<PrecomputedTriangle<T>> fast_;  // leaf-slot order, only for the fast test
     std::vector<Triangle<T>> exact_;            // leaf-slot order, only for the watertight test
     BuildReport report_;
     std::size_t triangle_count_ = 0;
-    TriangleTest triangle_test_ = TriangleTest::Fast;
+    TriangleTest triangle_test_ = TriangleTest::Watertight;
 };
 
 }  // namespace bvhkit

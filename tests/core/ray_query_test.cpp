@@ -30,13 +30,15 @@ TYPED_TEST(RayQueries, EveryBuilderMatchesBruteForceOnRandomSoups) {
     }
 }
 
-TYPED_TEST(RayQueries, WatertightModeAgreesWithItsBruteForce) {
+TYPED_TEST(RayQueries, FastModeAgreesWithItsBruteForce) {
     using T = TypeParam;
     const auto tris = test::random_soup<T>(2000, 99);
     const auto rays =
         test::random_rays<T>(test::scaled(10000), Aabb<T, 3>({0, 0, 0}, {1, 1, 1}), 5);
-    const test::BruteForce<T> reference(tris, rays, TriangleTest::Watertight);
-    reference.check(TriangleBvh<T>(tris, {}, TriangleTest::Watertight), rays);
+    TriangleBvhOptions fast;
+    fast.triangle_test = TriangleTest::Fast;
+    const test::BruteForce<T> reference(tris, rays, TriangleTest::Fast);
+    reference.check(TriangleBvh<T>(tris, fast), rays);
 }
 
 TYPED_TEST(RayQueries, AllHitsEqualsTheBruteForceSet) {
@@ -52,8 +54,7 @@ TYPED_TEST(RayQueries, AllHitsEqualsTheBruteForceSet) {
             return true;
         });
         for (std::uint32_t i = 0; i < tris.size(); ++i) {
-            TriangleHit<T> h;
-            if (PrecomputedTriangle<T>(tris[i]).intersect(ray, ray.tmax, h)) want.push_back(i);
+            if (tris[i].intersect_watertight(ray)) want.push_back(i);
         }
         std::sort(got.begin(), got.end());
         ASSERT_EQ(got, want);
@@ -130,6 +131,63 @@ TYPED_TEST(RayQueries, NanTrianglesAreSkippedAndTheRestStillHit) {
     test::BruteForce<T>(tris, rays).check(bvh, rays);
 }
 
+TYPED_TEST(RayQueries, UntraceableRaysMissWithoutVisitingANode) {
+    using T = TypeParam;
+    constexpr T nan = std::numeric_limits<T>::quiet_NaN(), inf = std::numeric_limits<T>::infinity();
+    const auto tris = test::random_soup<T>(2000, 12);
+    const std::vector<Ray<T, 3>> bad{Ray<T, 3>({nan, 0.5, 0.5}, {1, 0, 0}),
+                                     Ray<T, 3>({0.5, 0.5, inf}, {0, 0, -1}),
+                                     Ray<T, 3>({0.5, 0.5, -1}, {0, nan, 1}),
+                                     Ray<T, 3>({0.5, 0.5, -1}, {0, 0, inf}),
+                                     Ray<T, 3>({0.5, 0.5, -1}, {-inf, 0, 1}),
+                                     Ray<T, 3>({0.5, 0.5, -1}, {0, 0, 0}),
+                                     Ray<T, 3>({0.5, 0.5, -1}, {-T(0), T(0), -T(0)}),
+                                     Ray<T, 3>({0.5, 0.5, -1}, {0, 0, 1}, nan),
+                                     Ray<T, 3>({0.5, 0.5, -1}, {0, 0, 1}, 0, nan),
+                                     Ray<T, 3>({0.5, 0.5, -1}, {0, 0, 1}, 3, 2)};
+    for (const TriangleTest mode : {TriangleTest::Watertight, TriangleTest::Fast}) {
+        TriangleBvhOptions options;
+        options.triangle_test = mode;
+        const TriangleBvh<T> bvh(tris, options);
+        for (std::size_t i = 0; i < bad.size(); ++i) {
+            TraversalStats stats;
+            EXPECT_FALSE(bvh.closest_hit(bad[i], stats)) << i;
+            EXPECT_FALSE(bvh.any_hit(bad[i], stats)) << i;
+            bvh.all_hits(
+                bad[i], [](const Hit<T>&) { return true; }, stats);
+            EXPECT_EQ(stats.nodes_visited, 0u) << i;
+            EXPECT_EQ(stats.primitives_tested, 0u) << i;
+        }
+        // The same rays with the bad part mended do walk the tree and hit.
+        TraversalStats stats;
+        EXPECT_TRUE(bvh.closest_hit(Ray<T, 3>({0.5, 0.5, -1}, {0, 0, 1}), stats));
+        EXPECT_GT(stats.nodes_visited, 0u);
+    }
+}
+
+TYPED_TEST(RayQueries, HitNormalIsTheGeometricNormalInBothModes) {
+    using T = TypeParam;
+    const std::vector<Triangle<T>> tris{{{0, 0, 1}, {1, 0, 1}, {0, 1, 1}},
+                                        {{0, 0, 2}, {0, 1, 2}, {1, 0, 2}}};
+    for (const TriangleTest mode : {TriangleTest::Watertight, TriangleTest::Fast}) {
+        TriangleBvhOptions options;
+        options.triangle_test = mode;
+        const TriangleBvh<T> bvh(tris, options);
+        EXPECT_EQ(bvh.triangle_test(), mode);
+        // Counterclockwise seen from +z: the normal is +z, twice the area long, from either side.
+        const Hit<T> up = bvh.closest_hit(Ray<T, 3>({T(0.2), T(0.2), 0}, {0, 0, 1}));
+        EXPECT_EQ(up.normal, (Vec<T, 3>{0, 0, 1}));
+        const Hit<T> down = bvh.closest_hit(Ray<T, 3>({T(0.2), T(0.2), 3}, {0, 0, -1}));
+        EXPECT_EQ(down.primitive, 1u);
+        EXPECT_EQ(down.normal, (Vec<T, 3>{0, 0, -1}));
+        bvh.all_hits(Ray<T, 3>({T(0.2), T(0.2), 0}, {0, 0, 1}), [&](const Hit<T>& h) {
+            EXPECT_EQ(h.normal, tris[h.primitive].normal());
+            return true;
+        });
+        EXPECT_EQ(bvh.closest_hit(Ray<T, 3>({5, 5, 0}, {0, 0, 1})).normal, (Vec<T, 3>{}));
+    }
+}
+
 TEST(RayQueries2d, SegmentsMatchBruteForce) {
     test::Random rng(101);
     std::vector<Segment<float>> segs(3000);
@@ -148,7 +206,7 @@ TEST(RayQueries2d, SegmentsMatchBruteForce) {
             Vec2f d{float(std::cos(angle)), float(std::sin(angle))};
             if (i % 7 == 0) d[i % 2] = 0;
             const Ray2f ray(o, d);
-            const Hit<float> got = closest_hit(bvh, ray, test_segment);
+            const Hit<float, 2> got = closest_hit(bvh, ray, test_segment);
             float best = std::numeric_limits<float>::infinity();
             std::uint32_t best_i = invalid_index;
             for (std::uint32_t k = 0; k < segs.size(); ++k)

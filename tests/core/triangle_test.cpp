@@ -121,3 +121,36 @@ TEST(Segment, RayHitsAgreeWithParametricSolve) {
     }
     EXPECT_GT(hits, 3000);
 }
+
+TYPED_TEST(TriangleTests, InfiniteDirectionsMissAndSubnormalOnesGiveTheTrueT) {
+    using T = TypeParam;
+    constexpr T inf = std::numeric_limits<T>::infinity();
+    constexpr T tiny = std::numeric_limits<T>::denorm_min();
+    // A subnormal plane z0, so that a subnormal direction reaches it at a finite t.
+    const T z0 = tiny * T(4096);
+    const Triangle<T> far{{-1, -1, 1}, {1, -1, 1}, {0, 1, 1}};
+    const Triangle<T> near{{-1, -1, z0}, {1, -1, z0}, {0, 1, z0}};
+    // An infinite component is invalid: a miss, never t = 0 or t = inf.
+    for (const Vec<T, 3> d : {Vec<T, 3>{0, 0, inf}, Vec<T, 3>{inf, 0, 1}, Vec<T, 3>{0, 0, -inf}}) {
+        EXPECT_FALSE(far.intersect_watertight(Ray<T, 3>({0, 0, 0}, d)));
+        EXPECT_FALSE(far.intersect(Ray<T, 3>({0, 0, 0}, d)));
+    }
+    // d = (0, 0, denorm_min): the plane z = 1 lies at t = 1 / denorm_min, beyond the largest T:
+    // a miss. The plane z = z0 lies at t = 4096 exactly.
+    const Ray<T, 3> slow({0, 0, 0}, {0, 0, tiny});
+    EXPECT_FALSE(far.intersect_watertight(slow));
+    const auto h = near.intersect_watertight(slow);
+    ASSERT_TRUE(h);
+    EXPECT_EQ(h->t, T(4096));
+    // Tilted, on a triangle of the same subnormal size: the hit is at t = 1024, x = 1024 tiny. For
+    // float the edge functions are evaluated in double and find it; in double they underflow to
+    // zero (det = 0), which gives a miss: also a defined answer.
+    const Triangle<T> small{{-z0, -z0, z0}, {z0, -z0, z0}, {0, z0, z0}};
+    const auto tilted = small.intersect_watertight(Ray<T, 3>({0, 0, 0}, {tiny, 0, 4 * tiny}));
+    if (std::is_same_v<T, float>) {
+        ASSERT_TRUE(tilted);
+    }
+    if (tilted) {
+        EXPECT_EQ(tilted->t, T(1024));
+    }
+}

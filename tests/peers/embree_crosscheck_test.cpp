@@ -1,6 +1,7 @@
 // bvhkit and Embree 3 trace workload R1 and R2 rays on every shared mesh and must agree on at least
 // 99.99% of rays: same hit or miss, and the same triangle or the same t within 1e-4 (relative).
-// They use different triangle tests, so rays grazing an edge may legitimately differ.
+// They use different triangle tests, so rays grazing an edge may legitimately differ. Where both
+// hit the same triangle, Hit::normal must be Embree's Ng (same vector, up to rounding).
 #include <gtest/gtest.h>
 
 #include "bvhkit/io/read_mesh.hpp"
@@ -34,6 +35,10 @@ TEST_P(EmbreeCrossCheck, R1AndR2AgreeOnAtLeast9999Percent) {
                               (!a || a.primitive == b.primitive ||
                                std::fabs(a.t - b.t) <= 1e-4f * std::max(1.0f, std::fabs(b.t)));
             agree += same;
+            if (a && a.primitive == b.primitive) {
+                const float scale = length(b.normal);
+                ASSERT_LE(length(a.normal - b.normal), 1e-4f * scale) << set.name;
+            }
             // any-hit must agree with closest-hit's verdict within bvhkit.
             ASSERT_EQ(ours.any_hit(ray), bool(a));
         }

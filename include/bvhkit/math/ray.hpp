@@ -43,6 +43,20 @@ struct Ray {
     constexpr VecT at(T t) const { return origin + direction * t; }
 };
 
+/// Whether a ray can be traced: a finite origin, a finite direction that is not zero, and an
+/// interval with tmin <= tmax (neither NaN). Every ray query gives any other ray a miss at once,
+/// without visiting a node: a NaN would otherwise pass every box test (see below) and walk the
+/// whole tree.
+template <class T, std::size_t N>
+bool is_traceable(const Ray<T, N>& ray) {
+    bool finite = ray.tmin <= ray.tmax, moves = false;
+    for (std::size_t i = 0; i < N; ++i) {
+        finite = finite && std::isfinite(ray.origin[i]) && std::isfinite(ray.direction[i]);
+        moves = moves || ray.direction[i] != T(0);
+    }
+    return finite && moves;
+}
+
 /// Per-ray values the slab test reuses for every box: reciprocal direction and the ray's octant,
 /// bit i set when the ray goes towards negative values on axis i (then the box's max is the near
 /// plane). -0 counts as negative, so that its -inf reciprocal meets the planes in the right order.
@@ -54,8 +68,15 @@ struct RaySlabData {
 
     explicit RaySlabData(const Ray<T, N>& ray) : origin(ray.origin) {
         for (std::size_t i = 0; i < N; ++i) {
-            inv_direction[i] = T(1) / ray.direction[i];
-            if (std::signbit(ray.direction[i])) octant |= 1u << i;
+            const T d = ray.direction[i];
+            inv_direction[i] = T(1) / d;
+            // A subnormal d has no finite reciprocal; as +-inf it would place the planes of this
+            // axis wrongly (a box reached at t = 7 would seem reached at inf). NaN makes every
+            // plane distance NaN, which the test drops: the axis then does not restrict the
+            // interval, which is conservative.
+            if (d != T(0) && !std::isfinite(inv_direction[i]))
+                inv_direction[i] = std::numeric_limits<T>::quiet_NaN();
+            if (std::signbit(d)) octant |= 1u << i;
         }
     }
 
