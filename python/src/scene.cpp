@@ -34,8 +34,9 @@ class Scene {
             throw Error("ray_test: '" + ray_test + "' is not one of 'fast', 'watertight'");
         options_.threads = threads;
         nb::gil_scoped_release release;
-        rays_ = TriangleBvh<T>(mesh_, options_,
-                               ray_test == "fast" ? TriangleTest::Fast : TriangleTest::Watertight);
+        TriangleBvhOptions ray_options(options_);
+        ray_options.triangle_test = ray_test == "fast" ? TriangleTest::Fast : TriangleTest::Watertight;
+        rays_ = TriangleBvh<T>(mesh_, ray_options);
     }
 
     using Ray3 = Ray<T, 3>;
