@@ -37,11 +37,11 @@ class TriangleBvh {
   public:
     TriangleBvh() = default;
 
-    template <class U>
-    explicit TriangleBvh(const BasicTriangleMesh<U>& mesh, const TriangleBvhOptions& options = {})
+    template <IndexedTriangleMesh M>
+    explicit TriangleBvh(const M& mesh, const TriangleBvhOptions& options = {})
         : triangle_test_(options.triangle_test) {
         check_triangle_indices(mesh);
-        build([&](std::size_t i) { return triangle_at<T>(mesh, i); }, mesh.triangles.size(),
+        build([&](std::size_t i) { return triangle_at<T>(mesh, i); }, mesh.triangle_count(),
               options);
     }
 
@@ -79,11 +79,11 @@ class TriangleBvh {
     TriangleTest triangle_test() const { return triangle_test_; }
 
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
-    template <class U>
-    void refit(const BasicTriangleMesh<U>& mesh) {
-        if (mesh.triangles.size() != triangle_count_)
+    template <IndexedTriangleMesh M>
+    void refit(const M& mesh) {
+        if (mesh.triangle_count() != triangle_count_)
             throw Error("TriangleBvh::refit: the mesh has " +
-                        std::to_string(mesh.triangles.size()) +
+                        std::to_string(mesh.triangle_count()) +
                         " triangles, the tree was built over " + std::to_string(triangle_count_));
         check_triangle_indices(mesh);
         const auto triangle = [&](std::size_t i) { return triangle_at<T>(mesh, i); };

@@ -50,8 +50,8 @@ class ClosestPointMesh {
   public:
     ClosestPointMesh() = default;
 
-    template <class U>
-    explicit ClosestPointMesh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {}) {
+    template <IndexedTriangleMesh M>
+    explicit ClosestPointMesh(const M& mesh, const BuildOptions& options = {}) {
         const std::vector<Triangle<T>> tris = mesh_triangles<T>(mesh);
         build(tris, options);
     }

@@ -34,29 +34,29 @@ class CollisionModel {
     using Volume = V;
 
     CollisionModel() = default;
-    template <class U>
-    explicit CollisionModel(const BasicTriangleMesh<U>& mesh,
+    template <IndexedTriangleMesh M>
+    explicit CollisionModel(const M& mesh,
                             const BuildOptions& options = collision_build_options()) {
         check_triangle_indices(mesh);
-        std::vector<Aabb<T, 3>> boxes(mesh.triangles.size());
-        std::vector<Vec<T, 3>> centroids(mesh.triangles.size());
+        std::vector<Aabb<T, 3>> boxes(mesh.triangle_count());
+        std::vector<Vec<T, 3>> centroids(mesh.triangle_count());
         for (std::size_t i = 0; i < boxes.size(); ++i) {
             boxes[i] = triangle_at<T>(mesh, i).bounds();
             centroids[i] = boxes[i].centroid();
         }
         const AabbBvh<T, 3> topology = build_bvh<T, 3>(boxes, centroids, options, &report_);
-        triangle_count_ = mesh.triangles.size();
+        triangle_count_ = mesh.triangle_count();
         lay_out(mesh, topology.primitive_indices);
         bvh_ = fit_volumes<V>(topology, std::span<const Triangle<T>>(slot_triangles_));
     }
 
     /// After the mesh's vertices moved (same triangles in the same order): new triangles, every
     /// volume refitted in one pass, same tree shape.
-    template <class U>
-    void refit(const BasicTriangleMesh<U>& mesh) {
-        if (mesh.triangles.size() != triangle_count_)
+    template <IndexedTriangleMesh M>
+    void refit(const M& mesh) {
+        if (mesh.triangle_count() != triangle_count_)
             throw Error("CollisionModel::refit: the mesh has " +
-                        std::to_string(mesh.triangles.size()) +
+                        std::to_string(mesh.triangle_count()) +
                         " triangles, the model was built over " + std::to_string(triangle_count_));
         check_triangle_indices(mesh);
         lay_out(mesh, bvh_.primitive_indices);
@@ -77,14 +77,14 @@ class CollisionModel {
     T scale() const { return scale_; }
 
   private:
-    template <class U>
-    void lay_out(const BasicTriangleMesh<U>& mesh, const std::vector<std::uint32_t>& order) {
+    template <IndexedTriangleMesh M>
+    void lay_out(const M& mesh, const std::vector<std::uint32_t>& order) {
         slot_triangles_.resize(order.size());
         slot_vertex_ids_.resize(order.size());
         Aabb<T, 3> box;
         for (std::size_t s = 0; s < order.size(); ++s) {
             slot_triangles_[s] = triangle_at<T>(mesh, order[s]);
-            slot_vertex_ids_[s] = mesh.triangles[order[s]];
+            slot_vertex_ids_[s] = mesh.triangle(order[s)];
             box.grow(slot_triangles_[s].p0).grow(slot_triangles_[s].p1).grow(slot_triangles_[s].p2);
         }
         scale_ = box.is_empty()

@@ -12,7 +12,10 @@
 // so the edges and vertices of the pseudonormals are the geometric ones.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 #include <span>
 #include <string>
@@ -30,26 +33,34 @@ struct SignedDistance {
 template <class T>
 class SignedDistanceMesh {
   public:
-    template <class U>
-    explicit SignedDistanceMesh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {})
+    template <IndexedTriangleMesh M>
+    explicit SignedDistanceMesh(const M& mesh, const BuildOptions& options = {})
         : closest_(mesh, options) {
-        const std::size_t nt = mesh.triangles.size();
+        const std::size_t nt = mesh.triangle_count();
         // Weld corners by exact position: sort vertex ids by coordinates, give equal ones one id.
-        std::vector<std::uint32_t> by_position(mesh.vertices.size());
+        std::vector<std::uint32_t> by_position(mesh.vertex_count());
         for (std::uint32_t i = 0; i < by_position.size(); ++i) by_position[i] = i;
+        // The key orders coordinates totally, NaN included (a NaN under operator< would make the
+        // sort undefined): IEEE bits made monotonic, -0 as +0, every NaN as one value.
+        const auto ordered = [](double x) {
+            if (std::isnan(x)) return std::numeric_limits<std::uint64_t>::max();
+            const auto b = std::bit_cast<std::uint64_t>(x == 0 ? 0.0 : x);
+            return (b >> 63) ? ~b : b | (std::uint64_t(1) << 63);
+        };
         const auto key = [&](std::uint32_t i) {
-            const auto& v = mesh.vertices[i];
-            return std::array<double, 3>{double(v[0]), double(v[1]), double(v[2])};
+            const auto v = mesh.vertex(i);
+            return std::array<std::uint64_t, 3>{ordered(double(v[0])), ordered(double(v[1])),
+                                                ordered(double(v[2]))};
         };
         std::sort(by_position.begin(), by_position.end(),
                   [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
-        std::vector<std::uint32_t> weld(mesh.vertices.size());
+        std::vector<std::uint32_t> weld(mesh.vertex_count());
         std::uint32_t ids = 0;
         for (std::size_t k = 0; k < by_position.size(); ++k) {
             if (k > 0 && key(by_position[k]) != key(by_position[k - 1])) ++ids;
             weld[by_position[k]] = ids;
         }
-        vertex_normals_.assign(mesh.vertices.empty() ? 0 : ids + 1, Vec<T, 3>{});
+        vertex_normals_.assign((mesh.vertex_count() == 0) ? 0 : ids + 1, Vec<T, 3>{});
         face_normals_.resize(nt);
         corners_.resize(nt);
         // Edge pseudonormals: the sum of the unit normals of the faces on each (welded) edge,
@@ -62,12 +73,12 @@ class SignedDistanceMesh {
         std::vector<EdgeRef> edges;
         edges.reserve(3 * nt);
         for (std::uint32_t f = 0; f < nt; ++f) {
-            const auto& t = mesh.triangles[f];
+            const auto t = mesh.triangle(f);
             const std::array<std::uint32_t, 3> c{weld[t[0]], weld[t[1]], weld[t[2]]};
             corners_[f] = c;
-            const Vec<double, 3> p[3] = {Vec<double, 3>(mesh.vertices[t[0]]),
-                                         Vec<double, 3>(mesh.vertices[t[1]]),
-                                         Vec<double, 3>(mesh.vertices[t[2]])};
+            const Vec<double, 3> p[3] = {Vec<double, 3>(mesh.vertex(t[0)]),
+                                         Vec<double, 3>(mesh.vertex(t[1)]),
+                                         Vec<double, 3>(mesh.vertex(t[2)])};
             const Vec<double, 3> n = cross(p[1] - p[0], p[2] - p[0]);
             const double len = length(n);
             const Vec<double, 3> unit = len > 0 ? n / len : Vec<double, 3>{};

@@ -46,11 +46,11 @@ T solid_angle(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, const 
 template <class T>
 class WindingNumberMesh {
   public:
-    template <class U>
-    explicit WindingNumberMesh(const BasicTriangleMesh<U>& mesh, const BuildOptions& options = {}) {
-        std::vector<Aabb<T, 3>> boxes(mesh.triangles.size());
-        std::vector<Vec<T, 3>> centroids(mesh.triangles.size());
-        std::vector<Triangle<T>> tris(mesh.triangles.size());
+    template <IndexedTriangleMesh M>
+    explicit WindingNumberMesh(const M& mesh, const BuildOptions& options = {}) {
+        std::vector<Aabb<T, 3>> boxes(mesh.triangle_count());
+        std::vector<Vec<T, 3>> centroids(mesh.triangle_count());
+        std::vector<Triangle<T>> tris(mesh.triangle_count());
         check_triangle_indices(mesh);
         for (std::size_t i = 0; i < tris.size(); ++i) {
             tris[i] = triangle_at<T>(mesh, i);
