@@ -84,7 +84,7 @@ class CollisionModel {
         Aabb<T, 3> box;
         for (std::size_t s = 0; s < order.size(); ++s) {
             slot_triangles_[s] = triangle_at<T>(mesh, order[s]);
-            slot_vertex_ids_[s] = mesh.triangle(order[s)];
+            slot_vertex_ids_[s] = mesh.triangle(order[s]);
             box.grow(slot_triangles_[s].p0).grow(slot_triangles_[s].p1).grow(slot_triangles_[s].p2);
         }
         scale_ = box.is_empty()

@@ -76,9 +76,9 @@ class SignedDistanceMesh {
             const auto t = mesh.triangle(f);
             const std::array<std::uint32_t, 3> c{weld[t[0]], weld[t[1]], weld[t[2]]};
             corners_[f] = c;
-            const Vec<double, 3> p[3] = {Vec<double, 3>(mesh.vertex(t[0)]),
-                                         Vec<double, 3>(mesh.vertex(t[1)]),
-                                         Vec<double, 3>(mesh.vertex(t[2)])};
+            const Vec<double, 3> p[3] = {Vec<double, 3>(mesh.vertex(t[0])),
+                                         Vec<double, 3>(mesh.vertex(t[1])),
+                                         Vec<double, 3>(mesh.vertex(t[2]))};
             const Vec<double, 3> n = cross(p[1] - p[0], p[2] - p[0]);
             const double len = length(n);
             const Vec<double, 3> unit = len > 0 ? n / len : Vec<double, 3>{};
