@@ -90,20 +90,21 @@ T brute_force_distance(const std::vector<Triangle<T>>& a, const std::vector<Tria
         bt[j] = transformed(b[j], pose);
         bb[j] = bt[j].bounds();
     }
-    T best2 = std::numeric_limits<T>::infinity();
+    double best2 = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < a.size(); ++i) {
         const Aabb<T, 3> ba = a[i].bounds();
         for (std::size_t j = 0; j < b.size(); ++j) {
-            T gap2 = 0;
+            double gap2 = 0;  // in double: float squares overflow for far-apart models
             for (int k = 0; k < 3; ++k) {
-                const T g = std::max({T(0), ba.min[k] - bb[j].max[k], bb[j].min[k] - ba.max[k]});
+                const double g = std::max({0.0, double(ba.min[k]) - double(bb[j].max[k]),
+                                           double(bb[j].min[k]) - double(ba.max[k])});
                 gap2 += g * g;
             }
             if (gap2 >= best2) continue;
             best2 = std::min(best2, triangle_distance(a[i], bt[j]).distance_squared);
         }
     }
-    return std::sqrt(best2);
+    return T(std::sqrt(best2));
 }
 
 /// A soup of `count` random triangles in the unit cube, sizes up to `size`.

@@ -5,6 +5,9 @@
 
 #include "bvhkit/math/predicates.hpp"
 #include "bvhkit/primitives/triangle_triangle.hpp"
+#include "bvhkit/query/self_collision.hpp"
+#include "bvhkit/volumes/obb.hpp"
+#include "collision_support.hpp"
 #include "exact_reference.hpp"
 #include "hard_pairs.hpp"
 #include "test_support.hpp"
@@ -120,6 +123,44 @@ TEST(ExactTriangleTriangle, SegmentLiesOnBothTriangles) {
             EXPECT_LE(std::fabs(dot(nrm, x.q - t.p0)), reach);
         }
     }
+}
+
+TEST(ExactTriangleTriangle, SelfCollisionMatchesExactReference) {
+    // One mesh of many hard pairs (corners not shared, so every meeting pair counts), plus pairs
+    // that share a corner index (neighbours: never reported).
+    SplitMix64 rng(31);
+    TriangleMesh m;
+    const auto add = [&](const Triangle<float>& t) {
+        const auto v = std::uint32_t(m.vertices.size());
+        m.vertices.insert(m.vertices.end(), {t.p0, t.p1, t.p2});
+        m.triangles.push_back({v, v + 1, v + 2});
+    };
+    for (std::size_t n = 0; n < scaled(400, 10); ++n) {
+        const auto [a, b] = hard_pair<float>(rng, int(n % 5));
+        add(a);
+        add(b);
+    }
+    const auto v = std::uint32_t(m.vertices.size());
+    m.vertices.insert(m.vertices.end(), {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.2f, 0.2f, -1}});
+    m.triangles.push_back({v, v + 1, v + 2});
+    m.triangles.push_back({v, v + 3, v + 3});  // zero-area, shares corner v: a neighbour
+    const auto tris = mesh_triangles(m);
+    std::vector<Aabb<float, 3>> boxes(tris.size());
+    for (std::size_t i = 0; i < tris.size(); ++i) boxes[i] = tris[i].bounds();
+    PairSet want;
+    for_each_box_pair(boxes, boxes, [&](std::uint32_t i, std::uint32_t j) {
+        if (i >= j) return;
+        for (auto x : m.triangles[i])
+            for (auto y : m.triangles[j])
+                if (x == y) return;
+        if (exact_triangles_meet(tris[i], tris[j])) want.insert({i, j});
+    });
+    std::vector<Contact<float>> contacts;
+    self_collide(CollisionModel<Obb<float>>(m), contacts);
+    PairSet got;
+    for (const auto& c : contacts) got.insert({c.triangle_a, c.triangle_b});
+    EXPECT_EQ(got, want);
+    EXPECT_GT(want.size(), scaled(400, 10) / 4);
 }
 
 }  // namespace

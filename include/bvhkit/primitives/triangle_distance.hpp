@@ -2,9 +2,14 @@
 // Distance between two triangles and a closest pair of points. Two triangles that do not meet have
 // a closest pair on an edge of one and an edge of the other, or at a corner of one and the face of
 // the other; so the distance is the least of 9 segment-segment distances (Ericson, Real-Time
-// Collision Detection, 2005, 5.1.9) and 6 point-triangle distances (5.1.5, closest_point.hpp).
-// Triangles that meet (triangle_triangle.hpp's rules) are at distance 0, the points at the start
-// of their intersection segment.
+// Collision Detection, 2005, 5.1.9) and 6 point-triangle distances (projection onto the plane, or
+// the nearest point of an edge).
+// Triangles that meet (triangle_triangle.hpp's rules, exact) are at distance 0, the points at the
+// start of their intersection segment. Everything is computed in double (float input converts
+// exactly): see docs/accuracy.md for the bound.
+#include <algorithm>
+#include <limits>
+
 #include "bvhkit/math/select.hpp"
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/primitives/triangle_triangle.hpp"
@@ -53,30 +58,68 @@ SegmentClosest<T> closest_points_segments(const Vec<T, 3>& p1, const Vec<T, 3>& 
 
 template <class T>
 struct TriangleDistanceResult {
-    T distance_squared = std::numeric_limits<T>::infinity();
-    Vec<T, 3> p{}, q{};  // on the first and on the second triangle
+    // In double for float and double triangles: finite for any finite float input (a float
+    // distance's square can overflow float), and free of float's cancellation on slivers.
+    double distance_squared = std::numeric_limits<double>::infinity();
+    Vec<T, 3> p{}, q{};  // on the first and on the second triangle (rounded to T)
 };
 
+namespace detail {
+
+/// The point of segment [a, b] nearest p (a when the segment is a point).
+inline Vec<double, 3> nearest_on_segment(const Vec<double, 3>& p, const Vec<double, 3>& a,
+                                         const Vec<double, 3>& b) {
+    const Vec<double, 3> ab = b - a;
+    const double l2 = dot(ab, ab);
+    if (!(l2 > 0)) return a;
+    return a + ab * std::clamp(dot(p - a, ab) / l2, 0.0, 1.0);
+}
+
+/// The point of triangle t nearest p, in double: the projection onto the plane when it falls
+/// inside (each edge's side tested against the normal), else the nearest point of an edge. No
+/// barycentric region tests, whose cancellation grows with the aspect ratio.
+inline Vec<double, 3> nearest_on_triangle(const Vec<double, 3>& p, const Vec<double, 3>* t) {
+    const Vec<double, 3> n = cross(t[1] - t[0], t[2] - t[0]);
+    const double nn = dot(n, n);
+    if (nn > 0 && dot(cross(t[1] - t[0], p - t[0]), n) >= 0 &&
+        dot(cross(t[2] - t[1], p - t[1]), n) >= 0 && dot(cross(t[0] - t[2], p - t[2]), n) >= 0)
+        return p - n * (dot(p - t[0], n) / nn);
+    Vec<double, 3> best = nearest_on_segment(p, t[0], t[1]);
+    double best2 = length_squared(best - p);
+    for (int i = 1; i < 3; ++i) {
+        const Vec<double, 3> q = nearest_on_segment(p, t[i], t[(i + 1) % 3]);
+        const double d2 = length_squared(q - p);
+        if (d2 < best2) best = q, best2 = d2;
+    }
+    return best;
+}
+
+}  // namespace detail
+
+/// Distance between triangles a and b (zero-area ones are their segment or point), computed in
+/// double on the input coordinates; the points are rounded to T.
 template <class T>
 TriangleDistanceResult<T> triangle_distance(const Triangle<T>& a, const Triangle<T>& b) {
-    TriangleDistanceResult<T> best;
+    using V = Vec<double, 3>;
     const TriangleIntersection<T> x = intersect_triangles(a, b);
-    if (x.hit) return {T(0), x.p, x.p};
-    const Vec<T, 3> u[3] = {a.p0, a.p1, a.p2}, v[3] = {b.p0, b.p1, b.p2};
+    if (x.hit) return {0.0, x.p, x.p};
+    const V u[3] = {V(a.p0), V(a.p1), V(a.p2)}, v[3] = {V(b.p0), V(b.p1), V(b.p2)};
+    double best2 = std::numeric_limits<double>::infinity();
+    V bp{}, bq{};
+    const auto take = [&](const V& p, const V& q) {
+        const double d2 = length_squared(p - q);
+        if (d2 < best2) best2 = d2, bp = p, bq = q;
+    };
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) {
             const auto s = closest_points_segments(u[i], u[(i + 1) % 3], v[j], v[(j + 1) % 3]);
-            if (s.distance_squared < best.distance_squared) best = {s.distance_squared, s.p, s.q};
+            take(s.p, s.q);
         }
     for (int i = 0; i < 3; ++i) {
-        const Vec<T, 3> qb = closest_point(b, u[i]).point;
-        const T db = length_squared(qb - u[i]);
-        if (db < best.distance_squared) best = {db, u[i], qb};
-        const Vec<T, 3> qa = closest_point(a, v[i]).point;
-        const T da = length_squared(qa - v[i]);
-        if (da < best.distance_squared) best = {da, qa, v[i]};
+        take(u[i], detail::nearest_on_triangle(u[i], v));
+        take(detail::nearest_on_triangle(v[i], u), v[i]);
     }
-    return best;
+    return {best2, Vec<T, 3>(bp), Vec<T, 3>(bq)};
 }
 
 }  // namespace bvhkit

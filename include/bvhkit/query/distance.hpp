@@ -41,14 +41,17 @@ struct DistanceResult {
 namespace detail {
 
 /// Whether triangle `u` lies wholly on one side of triangle t's plane, at least `gap` from it
-/// (then the triangles are at least `gap` apart).
+/// (then the triangles are at least `gap` apart). In double: float squares overflow past 1.8e19,
+/// which would reject pairs that are not beyond; an infinite gap rejects nothing.
 template <class T>
 bool beyond_plane(const Triangle<T>& t, const Triangle<T>& u, T gap) {
-    const Vec<T, 3> n = cross(t.p1 - t.p0, t.p2 - t.p0);
-    const T d0 = dot(n, u.p0 - t.p0), d1 = dot(n, u.p1 - t.p0), d2 = dot(n, u.p2 - t.p0);
-    const T reach = gap * gap * length_squared(n);
-    const T lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
-    return (lo > T(0) && lo * lo >= reach) || (hi < T(0) && hi * hi >= reach);
+    using V = Vec<double, 3>;
+    if (!(double(gap) < std::numeric_limits<double>::infinity())) return false;
+    const V t0(t.p0), n = cross(V(t.p1) - t0, V(t.p2) - t0);
+    const double d0 = dot(n, V(u.p0) - t0), d1 = dot(n, V(u.p1) - t0), d2 = dot(n, V(u.p2) - t0);
+    const double reach = double(gap) * double(gap) * length_squared(n);
+    const double lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
+    return (lo > 0 && lo * lo >= reach) || (hi < 0 && hi * hi >= reach);
 }
 
 }  // namespace detail
@@ -70,8 +73,12 @@ DistanceResult<typename V::Scalar> distance(
     const T slack = pose_slack(a.scale(), b.scale(), pose_of_b_in_a);
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
     const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
+    // The best squared distance is kept in double (finite for any finite float input: a float
+    // square overflows past 1.8e19); `best`, its root in T, feeds the volumes' bounds.
+    double best2 = std::numeric_limits<double>::infinity();
     T best = std::numeric_limits<T>::infinity();
     const auto hopeless = [&](T lb) {
+        if (!(best2 < std::numeric_limits<double>::infinity())) return false;
         const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
         return lb >= best - tol;
     };
@@ -141,8 +148,13 @@ DistanceResult<typename V::Scalar> distance(
                         continue;
                     result.stats.primitive();
                     const auto d = triangle_distance(ta[sa], tri_b);
-                    if (d.distance_squared < best * best) {
-                        best = std::sqrt(d.distance_squared);
+                    if (d.distance_squared < best2) {
+                        best2 = d.distance_squared;
+                        // Above T's range only for float corners near 3e38: +inf, not UB.
+                        const double root = std::sqrt(best2);
+                        best = root <= double(std::numeric_limits<T>::max())
+                                   ? T(root)
+                                   : std::numeric_limits<T>::infinity();
                         result.distance = best;
                         result.point_a = d.p;
                         result.point_b = d.q;
@@ -151,7 +163,7 @@ DistanceResult<typename V::Scalar> distance(
                     }
                 }
             }
-            if (best == T(0)) break;
+            if (best2 == 0) break;
             continue;
         }
         const DescentRule rule =
