@@ -194,6 +194,10 @@ def p4(v, f, k, reps, mods):
     return _rows("P4c", _time(runs, reps), k) + _rows("P4d", _time(dist_runs, reps), k)
 
 
+def _show(rows: List[str]) -> None:
+    print("\n".join(rows), flush=True)
+
+
 def main(argv=None) -> None:
     """Runs the workloads and prints one table."""
     ap = argparse.ArgumentParser(prog="python -m bvhkit.bench", description=__doc__,
@@ -212,22 +216,21 @@ def main(argv=None) -> None:
     v, f = _mesh(args.mesh)
     s = args.scale
     only = set(args.only.split(","))
-    lines: List[str] = []
+    print("work  library                                 median        rate    peer/bvhkit(1)")
+
     if "P1" in only:
-        lines += p1(v, f, int(1_000_000 * s), args.reps, mods)
+        _show(p1(v, f, int(1_000_000 * s), args.reps, mods))
     if "P2" in only:
-        lines += p2(v, f, int(1_000_000 * s), args.reps, mods)
+        _show(p2(v, f, int(1_000_000 * s), args.reps, mods))
     if "P3" in only:
         grid = max(8, int(round(128 * s ** (1 / 3))))
         sv, sf = _mesh(args.sdf_mesh)
-        lines += p3(sv, sf, grid, args.reps, mods, " closed")
+        _show(p3(sv, sf, grid, args.reps, mods, " closed"))
         holes = np.random.default_rng(5).random(len(sf)) > 0.01  # drop 1% of the faces
-        lines += p3(sv, sf[holes], grid, args.reps, mods, " holes")
+        _show(p3(sv, sf[holes], grid, args.reps, mods, " holes"))
     if "P4" in only:
         cv, cf = _mesh(args.collision_mesh)
-        lines += p4(cv, cf, max(10, int(1000 * s)), args.reps, mods)
-    print("work  library                                 median        rate    peer/bvhkit(1)")
-    print("\n".join(lines))
+        _show(p4(cv, cf, max(10, int(1000 * s)), args.reps, mods))
 
 
 if __name__ == "__main__":
