@@ -89,8 +89,8 @@ class TriangleMesh:
     ``vertices``. ``dtype`` is the scalar type the scene computes in (float32 by default);
     query arrays are converted to it. ``builder`` picks the tree builder (``"binned_sah"``,
     ``"sweep_sah"``, ``"bottom_up"``, ``"lbvh"``, ``"insertion"``, ...; ``+opt`` adds the
-    reinsertion optimizer). ``ray_test`` is ``"fast"`` (Moller-Trumbore) or ``"watertight"``
-    (Woop et al. 2013: a ray through a shared edge never slips between the two faces).
+    reinsertion optimizer). ``ray_test`` is ``"watertight"`` (the default; Woop et al. 2013: a ray through a shared edge
+    never slips between the two faces) or ``"fast"`` (Moller-Trumbore, which can).
 
     Faces with a NaN or infinite coordinate are left out of every query (see :meth:`skipped`);
     zero-area faces are never hit by rays. The ray tree is built at once; the closest point and
@@ -103,7 +103,7 @@ class TriangleMesh:
         faces: Any,
         builder: str = "binned_sah",
         dtype: Any = np.float32,
-        ray_test: str = "fast",
+        ray_test: str = "watertight",
         threads: int = 0,
     ) -> None:
         self.dtype: np.dtype = _a.scalar_type(dtype)
@@ -177,8 +177,9 @@ class TriangleMesh:
     ) -> np.ndarray:
         """How many faces each ray hits within [tmin, tmax]: (k,) int64.
 
-        A ray through an edge or vertex shared by several faces may count each of them (use
-        ``ray_test="watertight"`` for the exact edge rule).
+        With the default watertight test a ray through an edge or vertex shared by several faces
+        counts each face whose closed triangle it meets; ``ray_test="fast"`` may miss or double
+        count there.
         """
         o, d, t0, t1 = self._rays(origins, directions, tmin, tmax)
         out = np.empty(len(o), np.int64)

@@ -9,7 +9,7 @@ import numpy as np
 from . import _arrays as _a
 from . import _bvhkit
 
-VOLUMES = ("obb", "rss", "aabb", "sphere", "kdop18")
+VOLUMES = ("obb", "rss", "obbrss", "aabb", "sphere", "kdop18")
 
 
 class CollisionModel:
@@ -18,7 +18,8 @@ class CollisionModel:
     ``vertices``: (n, 3) float32 or float64; ``faces``: (m, 3) int32 or int64. ``volume`` is the
     bounding volume of the tree: ``"obb"`` (oriented boxes, Gottschalk et al. 1996: the fastest
     for collision), ``"rss"`` (rectangle swept spheres, Larsen et al. 1999: the fastest for
-    distance), ``"aabb"``, ``"sphere"`` or ``"kdop18"``. ``dtype``: float32 (default) or float64.
+    distance), ``"obbrss"`` (both in one model: boxes for collision, swept spheres for distance),
+    ``"aabb"``, ``"sphere"`` or ``"kdop18"``. ``dtype``: float32 (default) or float64.
     Both models of a query must have the same volume and dtype.
 
     Faces with a NaN or infinite coordinate are left out; zero-area faces never collide.
