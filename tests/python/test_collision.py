@@ -6,7 +6,7 @@ import pytest
 import bvhkit
 from reference import random_soup, triangle_distance, triangles_intersect
 
-VOLUMES = ["obb", "rss", "aabb", "sphere", "kdop18"]
+VOLUMES = ["obb", "rss", "obbrss", "aabb", "sphere", "kdop18"]
 
 
 def random_rotations(rng, k):
