@@ -57,14 +57,15 @@ TEST(ObbRss, CollisionEqualsTheBoxModelAndDistanceTheBruteForce) {
         colliding += r_box.colliding;
         if (r_box.colliding) continue;
         // Distance: the minimum over every pair of triangles, B's carried into A's frame.
-        float brute = std::numeric_limits<float>::infinity();
+        double brute = std::numeric_limits<double>::infinity();
         for (const auto& a : tris)
             for (const auto& b : tris)
                 brute = std::min(
-                    brute, std::sqrt(triangle_distance(a, transformed(b, pose)).distance_squared));
+                    brute,
+                    double(std::sqrt(triangle_distance(a, transformed(b, pose)).distance_squared)));
         const float d_both = distance(both, both, pose).distance;
         EXPECT_EQ(d_both, distance(swept, swept, pose).distance) << "pose " << i;
-        EXPECT_NEAR(d_both, brute, 1e-5f * (1 + brute)) << "pose " << i;
+        EXPECT_NEAR(d_both, brute, 1e-5 * (1 + brute)) << "pose " << i;
     }
     EXPECT_GT(colliding, 0u);
     EXPECT_LT(colliding, poses);

@@ -52,7 +52,7 @@ PairSet collide_pairs(const CollisionModel<V>& m, const Transform<float>& pose) 
 
 void check_c1_poses(const char* name) {
     const auto path = shared_mesh(name);
-    if (path.empty()) GTEST_SKIP() << name << " not found under " << data_dir();
+    if (path.empty()) GTEST_SKIP() << name << " not found in " << data_dirs_text();
     const TriangleMesh mesh = read_mesh(path);
     const auto tris = mesh_triangles(mesh);
     // C1's poses (bench/workloads/collide_bench.cpp): the same generator and seed; all 1,000
