@@ -7,6 +7,7 @@
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/refit.hpp"
 #include "bvhkit/bvh/validate.hpp"
+#include "bvhkit/triangle_bvh.hpp"
 #include "random_geometry.hpp"
 #include "test_support.hpp"
 
@@ -325,4 +326,83 @@ TEST(BuildOptions, HugeThreadCountsAreClampedToTheHardware) {
         EXPECT_NO_THROW(validate(build_bvh<float, 3>(in.boxes, in.centroids, huge), in.boxes));
     }
     EXPECT_GE(hardware_threads(), 1u);
+}
+
+TEST(Build, ValidateKnowsTheSkippedPrimitives) {
+    auto tris = test::random_soup<float>(300, 33);
+    tris[7].p1[0] = std::numeric_limits<float>::quiet_NaN();
+    for (const auto& [name, options] : configurations()) {
+        SCOPED_TRACE(name);
+        const TriangleBvh<float> tree(tris, options);
+        ASSERT_EQ(tree.skipped(), (std::vector<std::uint32_t>{7}));
+        // Boxes grown point by point with min/max that drop the NaN: primitive 7 gets a finite
+        // box, but the build skipped it. With the skipped list it is no error.
+        std::vector<Aabb3f> boxes;
+        for (const auto& t : tris) {
+            Aabb3f b;
+            for (const Vec3f& p : {t.p0, t.p1, t.p2})
+                for (std::size_t a = 0; a < 3; ++a)
+                    if (!std::isnan(p[a])) {
+                        b.min[a] = std::min(b.min[a], p[a]);
+                        b.max[a] = std::max(b.max[a], p[a]);
+                    }
+            boxes.push_back(b);
+        }
+        ASSERT_TRUE(boxes[7].is_finite());
+        EXPECT_THROW(validate(tree.bvh(), boxes), Error);
+        EXPECT_NO_THROW(validate(tree.bvh(), boxes, tree.skipped()));
+        // Still strict: a listed primitive must be absent, an unlisted usable one present.
+        const std::vector<std::uint32_t> wrong{8};
+        EXPECT_THROW(validate(tree.bvh(), boxes, wrong), Error);
+    }
+    // A finite but empty box (min > max) is skipped by the build and accepted absent.
+    std::vector<Aabb3f> boxes{Aabb3f({0, 0, 0}, {1, 1, 1}), Aabb3f({2, 2, 2}, {1, 1, 1}),
+                              Aabb3f({3, 3, 3}, {4, 4, 4})};
+    std::vector<Vec3f> centroids{{0.5f, 0.5f, 0.5f}, {1.5f, 1.5f, 1.5f}, {3.5f, 3.5f, 3.5f}};
+    BuildReport report;
+    const auto bvh = build_bvh<float, 3>(boxes, centroids, {}, &report);
+    EXPECT_EQ(report.skipped, (std::vector<std::uint32_t>{1}));
+    EXPECT_NO_THROW(validate(bvh, boxes));
+    EXPECT_NO_THROW(validate(bvh, boxes, report.skipped));
+}
+
+TEST(Build, ExtremeFiniteInputIsFreeOfUndefinedBehaviour) {
+    const float inf = std::numeric_limits<float>::infinity();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    // The bin of a coordinate is clamped before it is converted: inf and NaN (0 * inf) included.
+    EXPECT_EQ(bin_of(inf, 0.0f, 1.0f, 16), 15u);
+    EXPECT_EQ(bin_of(3e38f, -3e38f, 16.0f, 16), 15u);  // (c - origin) overflows to inf
+    EXPECT_EQ(bin_of(nan, 0.0f, 1.0f, 16), 0u);
+    EXPECT_EQ(bin_of(1e-40f, 1e-40f, inf, 16), 0u);  // 0 * inf
+    EXPECT_EQ(bin_of(-inf, 0.0f, 1.0f, 16), 0u);
+    EXPECT_EQ(bin_of(7.5f, 0.0f, 1.0f, 16), 7u);
+    // Morton codes of centroids in bounds of infinite or denormal extent.
+    const Aabb3f huge({-3e38f, -3e38f, -3e38f}, {3e38f, 3e38f, 3e38f});
+    EXPECT_EQ(morton_code(Vec3f(-3e38f), huge), 0u);
+    (void)morton_code(Vec3f(3e38f), Aabb3f(Vec3f(-inf), Vec3f(inf)));
+    const Aabb3f tiny(Vec3f(1e-45f), Vec3f(1e-40f));
+    EXPECT_EQ(morton_code(Vec3f(1e-40f), tiny), morton_code(Vec3f(1e-40f), tiny));
+
+    // Whole builds: extents near 3e38 (their float extent overflows), denormal extents, both.
+    std::vector<Trianglef> sets[3];
+    test::Random rng(34);
+    for (int k = 0; k < 600; ++k) {
+        const float s = float(rng.uniform(1e37, 3e38)) * (k % 2 ? 1.0f : -1.0f);
+        sets[0].push_back({{-s, s, 0}, {s, -s, s}, {0.5f * s, 0, -s}});
+        const float d = float(rng.uniform(1e-45, 1e-40));
+        sets[1].push_back({{d, 0, 0}, {0, d, 2 * d}, {d, d, 0}});
+        sets[2].push_back(k % 2 ? sets[0].back() : sets[1].back());
+    }
+    for (const auto& tris : sets)
+        for (const auto& [name, options] : configurations()) {
+            SCOPED_TRACE(name);
+            const Boxes<float> in(tris);
+            const auto bvh = build_bvh<float, 3>(in.boxes, in.centroids, options);
+            ASSERT_NO_THROW(validate(bvh, in.boxes));
+            EXPECT_EQ(bvh.primitive_indices.size(), tris.size());
+            std::uint32_t largest_leaf = 0;
+            for (const auto& node : bvh.nodes)
+                largest_leaf = std::max(largest_leaf, node.is_leaf() ? node.count : 0u);
+            EXPECT_LE(largest_leaf, options.max_leaf_size);
+        }
 }

@@ -36,8 +36,11 @@ class BinnedSahRule {
         const Aabb<T, N>& cb = task.centroid_bounds;
         T scale[N];
         for (std::size_t a = 0; a < N; ++a) {
+            // A finite scale even for denormal extents (bin_count / 1e-44 overflows float).
             const T extent = cb.max[a] - cb.min[a];
-            scale[a] = extent > T(0) ? T(bin_count) / extent : T(0);
+            scale[a] = extent > T(0)
+                           ? std::min(T(bin_count) / extent, std::numeric_limits<T>::max())
+                           : T(0);
         }
         const BinMapping mapping(cb.min, scale, bin_count);
         const std::size_t row = N * bin_count;

@@ -9,8 +9,10 @@
 //     against C_trav + the children's best costs, all weighted by area) and it holds no more than
 //     max_leaf_size primitives; the usual post-pass of bottom-up builders (Karras 2012, Meister and
 //     Bittner 2018);
-//   - depth: a node at max_depth becomes a leaf holding everything below it, so no tree is deeper
-//     than the fixed traversal stack (max_bvh_depth), whatever the builder did.
+//   - depth: no tree is deeper than max_depth (at most the fixed traversal stack, max_bvh_depth),
+//     whatever the builder did: a subtree too tall for the depth left is laid out balanced from the
+//     depth where halving its primitives down to max_leaf_size just fits (so leaves stay within
+//     max_leaf_size unless max_depth is too small even for that).
 // Boxes are recomputed from the leaves, so the builders need not keep internal boxes exact.
 #include <algorithm>
 #include <span>
@@ -77,7 +79,7 @@ Bvh<Aabb<T, N>> flatten(const BinaryTree& tree, std::span<const Aabb<T, N>> boxe
         }
     }
     std::vector<Aabb<T, N>> box(n);
-    std::vector<std::uint32_t> prims(n);
+    std::vector<std::uint32_t> prims(n), height(n, 0);
     std::vector<double> cost(n);  // best SAH cost of the subtree, in area units
     std::vector<std::uint8_t> collapse(n, 0);
     for (std::size_t k = preorder.size(); k-- > 0;) {
@@ -93,6 +95,7 @@ Bvh<Aabb<T, N>> flatten(const BinaryTree& tree, std::span<const Aabb<T, N>> boxe
             continue;
         }
         const std::uint32_t l = tree.left[v], r = tree.right[v];
+        height[v] = 1 + std::max(height[l], height[r]);
         box[v] = unite(box[l], box[r]);
         prims[v] = prims[l] + prims[r];
         const double area = double(box[v].area());
@@ -107,34 +110,77 @@ Bvh<Aabb<T, N>> flatten(const BinaryTree& tree, std::span<const Aabb<T, N>> boxe
     }
 
     const std::uint32_t max_depth = std::min(options.max_depth, max_bvh_depth);
+    const std::uint32_t max_leaf = std::max<std::uint32_t>(1, options.max_leaf_size);
     bvh.nodes.reserve(2 * std::size_t(prims[tree.root]));
     bvh.primitive_indices.reserve(prims[tree.root]);
     std::vector<std::uint32_t> gather;  // reused stack for collecting a collapsed subtree's leaves
+    // Appends the primitives of the subtree of `v` to `out`, left to right.
+    const auto collect = [&](std::uint32_t v, std::vector<std::uint32_t>& out) {
+        gather.assign(1, v);
+        while (!gather.empty()) {
+            const std::uint32_t u = gather.back();
+            gather.pop_back();
+            if (tree.left[u] == no_child) {
+                for (std::uint32_t s = tree.first[u]; s < tree.first[u] + tree.count[u]; ++s)
+                    out.push_back(tree.order[s]);
+            } else {
+                gather.push_back(tree.right[u]);
+                gather.push_back(tree.left[u]);
+            }
+        }
+    };
+    // A subtree too tall for the depth left is laid out balanced instead, halving the run of its
+    // primitives (left to right, so still grouped as the builder grouped them) from the depth where
+    // halving just fits: a leaf of more than max_leaf_size only when even halving cannot fit.
+    std::vector<std::uint32_t> runs;  // the primitives of such subtrees; Work::source = no_child
     struct Work {
-        std::uint32_t source, target, depth;
+        std::uint32_t source, target, depth, begin = 0, end = 0;
     };
     std::vector<Work> stack{{tree.root, 0, 0}};
     bvh.nodes.emplace_back();
     while (!stack.empty()) {
         const Work w = stack.back();
         stack.pop_back();
+        if (w.source == no_child) {
+            auto& node = bvh.nodes[w.target];
+            Aabb<T, N> b;
+            for (std::uint32_t k = w.begin; k < w.end; ++k) b.grow(boxes[runs[k]]);
+            node.bounds = b;
+            if (w.end - w.begin <= max_leaf || w.depth >= max_depth) {
+                node.first = static_cast<std::uint32_t>(bvh.primitive_indices.size());
+                node.count = w.end - w.begin;
+                bvh.primitive_indices.insert(bvh.primitive_indices.end(), runs.begin() + w.begin,
+                                             runs.begin() + w.end);
+                continue;
+            }
+            const auto child = static_cast<std::uint32_t>(bvh.nodes.size());
+            node.first = child;
+            node.count = 0;
+            bvh.nodes.emplace_back();
+            bvh.nodes.emplace_back();
+            const std::uint32_t mid = w.begin + (w.end - w.begin) / 2;
+            stack.push_back({no_child, child + 1, w.depth + 1, mid, w.end});
+            stack.push_back({no_child, child, w.depth + 1, w.begin, mid});
+            continue;
+        }
         auto& node = bvh.nodes[w.target];
         node.bounds = box[w.source];
+        const std::uint32_t left_depth = max_depth - std::min(max_depth, w.depth);
+        if (!collapse[w.source] && height[w.source] > left_depth && prims[w.source] > max_leaf) {
+            std::uint32_t levels = 0;  // halvings down to max_leaf
+            for (std::uint32_t c = prims[w.source]; c > max_leaf; c = (c + 1) / 2) ++levels;
+            if (levels + 1 >= left_depth) {
+                const auto begin = static_cast<std::uint32_t>(runs.size());
+                collect(w.source, runs);
+                stack.push_back(
+                    {no_child, w.target, w.depth, begin, static_cast<std::uint32_t>(runs.size())});
+                continue;
+            }
+        }
         if (collapse[w.source] || w.depth >= max_depth) {
             node.first = static_cast<std::uint32_t>(bvh.primitive_indices.size());
             node.count = prims[w.source];
-            gather.assign(1, w.source);
-            while (!gather.empty()) {
-                const std::uint32_t v = gather.back();
-                gather.pop_back();
-                if (tree.left[v] == no_child) {
-                    for (std::uint32_t s = tree.first[v]; s < tree.first[v] + tree.count[v]; ++s)
-                        bvh.primitive_indices.push_back(tree.order[s]);
-                } else {
-                    gather.push_back(tree.right[v]);
-                    gather.push_back(tree.left[v]);
-                }
-            }
+            collect(w.source, bvh.primitive_indices);
             continue;
         }
         const auto child = static_cast<std::uint32_t>(bvh.nodes.size());

@@ -15,6 +15,12 @@
 
 namespace bvhkit {
 
+/// Nodes the sibling search of the insertion builder and the reinsertion optimizer expands at most
+/// per insertion. Ordinary input needs far fewer (the bound prunes early); heavily overlapping
+/// boxes (coincident centroids) weaken the bound until the exact search visits most of the tree,
+/// a quadratic build. Beyond this the best sibling found so far is taken.
+inline constexpr std::size_t insertion_max_expansions = 64;
+
 template <class T, std::size_t N>
 Bvh<Aabb<T, N>> build_insertion(std::span<const Aabb<T, N>> boxes,
                                 std::span<const std::uint32_t> indices,
@@ -42,8 +48,8 @@ Bvh<Aabb<T, N>> build_insertion(std::span<const Aabb<T, N>> boxes,
             root = leaf;
             continue;
         }
-        const std::int32_t sibling =
-            dynamic_detail::find_sibling_branch_and_bound(nodes.data(), root, ln.box, heap);
+        const std::int32_t sibling = dynamic_detail::find_sibling_branch_and_bound(
+            nodes.data(), root, ln.box, heap, insertion_max_expansions);
         const std::int32_t parent = next++;
         const std::int32_t old_parent = nodes[std::size_t(sibling)].parent;
         Node& p = nodes[std::size_t(parent)];
@@ -59,9 +65,16 @@ Bvh<Aabb<T, N>> build_insertion(std::span<const Aabb<T, N>> boxes,
         }
         Node& op = nodes[std::size_t(old_parent)];
         (op.child1 == sibling ? op.child1 : op.child2) = parent;
+        // Up to the root, or to the first node whose box and height stay and that does not
+        // rotate: nothing above it changes then.
         for (std::int32_t i = old_parent; i != null; i = nodes[std::size_t(i)].parent) {
+            Node& v = nodes[std::size_t(i)];
+            const Aabb<T, N> before = v.box;
+            const std::int32_t c1 = v.child1;
+            const auto height = v.height;  // ties descend by height: keep heights exact
             dynamic_detail::refit(nodes.data(), i);
             dynamic_detail::rotate(nodes.data(), i);
+            if (i != old_parent && v.box == before && v.child1 == c1 && v.height == height) break;
         }
     }
     BinaryTree tree;

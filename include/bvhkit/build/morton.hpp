@@ -51,7 +51,9 @@ std::uint64_t morton_code(const Vec<T, N>& c, const Aabb<T, N>& bounds) {
     for (std::size_t a = 0; a < N; ++a) {
         const double extent = double(bounds.max[a]) - double(bounds.min[a]);
         const double t = extent > 0 ? (double(c[a]) - double(bounds.min[a])) / extent : 0.0;
-        q[a] = static_cast<std::uint64_t>(std::clamp(t * cells, 0.0, cells - 1.0));
+        // Clamped with comparisons that send NaN (an infinite extent) to 0, before converting.
+        const double x = t * cells;
+        q[a] = x > 0.0 ? static_cast<std::uint64_t>(x < cells - 1.0 ? x : cells - 1.0) : 0u;
     }
     if constexpr (N == 3) {
         return morton_spread3(q[0]) << 2 | morton_spread3(q[1]) << 1 | morton_spread3(q[2]);

@@ -18,6 +18,7 @@
 #include <algorithm>
 
 #include "bvhkit/build/flatten.hpp"
+#include "bvhkit/build/insertion.hpp"
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/dynamic/tree_insertion.hpp"
 
@@ -88,8 +89,8 @@ ReinsertionReport optimize_reinsertion(Bvh<Aabb<T, N>>& bvh, std::span<const Aab
     std::vector<std::pair<double, std::int32_t>> ranked;
     // Puts the detached subtree `x` back next to its best sibling, with `parent` as the new node.
     const auto insert = [&](std::int32_t x, std::int32_t parent) {
-        const std::int32_t s =
-            dynamic_detail::find_sibling_branch_and_bound(nodes.data(), root, nodes[x].box, heap);
+        const std::int32_t s = dynamic_detail::find_sibling_branch_and_bound(
+            nodes.data(), root, nodes[x].box, heap, insertion_max_expansions);
         const std::int32_t old_parent = nodes[s].parent;
         Node& p = nodes[parent];
         p.parent = old_parent;

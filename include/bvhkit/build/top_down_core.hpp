@@ -70,10 +70,24 @@ struct Split {
 };
 
 /// Bin of a coordinate for binned builders; the same function bins and partitions, so both agree.
+/// Clamped before converting, so that no value (inf, or NaN from 0 * inf) reaches the conversion:
+/// NaN and values <= 0 give bin 0, as the SSE path's max(b, 0) does.
 template <class T>
 inline std::uint32_t bin_of(T c, T origin, T scale, std::uint32_t bin_count) {
     const T b = (c - origin) * scale;
-    return b <= T(0) ? 0u : std::min(bin_count - 1, static_cast<std::uint32_t>(b));
+    if (!(b > T(0))) return 0u;
+    if (!(b < T(bin_count - 1))) return bin_count - 1;
+    return static_cast<std::uint32_t>(b);
+}
+
+/// The centre of a finite box, inside it even where min + max overflows (extents beyond the
+/// largest float) or halving a denormal rounds away.
+template <class T, std::size_t N>
+Vec<T, N> safe_centroid(const Aabb<T, N>& box) {
+    Vec<T, N> c;
+    for (std::size_t a = 0; a < N; ++a)
+        c[a] = std::clamp(box.min[a] * T(0.5) + box.max[a] * T(0.5), box.min[a], box.max[a]);
+    return c;
 }
 
 namespace top_down_detail {
@@ -123,7 +137,7 @@ std::vector<std::uint32_t> usable_primitives(BuildInput<T, N>& in, std::vector<V
             indices.push_back(i);
             if (!in.boxes[i].contains(in.centroids[i])) {
                 if (fixed.empty()) fixed.assign(in.centroids.begin(), in.centroids.end());
-                fixed[i] = in.boxes[i].centroid();
+                fixed[i] = safe_centroid(in.boxes[i]);
             }
         } else if (options.non_finite == NonFinitePolicy::Reject) {
             throw Error("build: primitive " + std::to_string(i) +
@@ -325,6 +339,13 @@ std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::ui
     return 0;
 }
 
+/// Levels of halving that bring `count` primitives down to leaves of at most `max_leaf`.
+inline std::uint32_t levels_to_halve(std::uint64_t count, std::uint64_t max_leaf) {
+    std::uint32_t levels = 0;
+    for (std::uint64_t c = count; c > max_leaf; c = (c + 1) / 2) ++levels;
+    return levels;
+}
+
 namespace top_down_detail {
 
 /// A node waiting to be split: its slot in the node array, its range of the index array, its
@@ -355,11 +376,17 @@ std::uint32_t split_node(const Context<T, N>& cx, const Work<T, N>& w, SplitRule
     const std::span<std::uint32_t> range(cx.indices + w.begin, count);
     const std::span<std::uint32_t> scratch(cx.scratch ? cx.scratch + w.begin : nullptr,
                                            cx.scratch ? count : 0);
+    // When the depth left only just suffices for halving down to max_leaf primitives, halve:
+    // a rule peeling off a few primitives per level (extents spanning many decades) would
+    // otherwise reach max_depth with a huge leaf.
+    const bool must_halve =
+        count > cx.max_leaf && levels_to_halve(count, cx.max_leaf) + 1 >= cx.max_depth - w.depth;
     const Split<T> split =
-        rule(SplitTask<T, N>{range, w.bounds.boxes.box(), centroid_bounds, w.depth});
+        must_halve ? Split<T>::leaf()
+                   : rule(SplitTask<T, N>{range, w.bounds.boxes.box(), centroid_bounds, w.depth});
     if (split.kind == Split<T>::Kind::Leaf && count <= cx.max_leaf) return 0;
     std::uint32_t left_count =
-        partition_primitives(cx.in, range, split, left, right, scratch, threads);
+        must_halve ? 0 : partition_primitives(cx.in, range, split, left, right, scratch, threads);
     if (left_count == 0 || left_count == count) {
         // The rule gave no split (or could not split). Fall back to the object median on the
         // centroids' longest axis; if all centroids coincide the order is arbitrary, so halve.

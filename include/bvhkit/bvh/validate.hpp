@@ -5,8 +5,9 @@
 // Invariants: children indices are in range and larger than the parent's (the layout refit relies
 // on); every node is reached exactly once from the root; depth <= max_bvh_depth; leaf runs are
 // non-empty and tile `primitive_indices` exactly; every primitive index is in range and appears
-// once; every primitive with a finite box is in the tree and none with a non-finite box is (the
-// builders' rule); each node's box encloses its children's boxes and its primitives' boxes.
+// once; every primitive with a finite, non-empty box is in the tree and none with a non-finite or
+// empty box is (the builders' rule; a primitive listed as skipped must be absent); each node's box
+// encloses its children's boxes and its primitives' boxes.
 #include <span>
 #include <string>
 
@@ -15,21 +16,38 @@
 
 namespace bvhkit {
 
+/// `skipped`: the primitives the build left out (BuildReport::skipped, TriangleBvh::skipped()),
+/// which must be absent whatever `primitive_boxes` says of them (a box computed elsewhere may have
+/// lost the NaN that made the build skip it); any primitive whose box is non-finite or empty may be
+/// absent without being listed (the builders' rule); every other one must be in the tree.
 template <class T, std::size_t N>
-void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes) {
+void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
+              std::span<const std::uint32_t> skipped) {
     auto fail = [](const std::string& what) { throw Error("Bvh::validate: " + what); };
     const std::size_t slot_count = bvh.primitive_indices.size();
     std::vector<std::uint8_t> primitive_seen(primitive_boxes.size(), 0);
+    const auto usable = [&](std::size_t p) {
+        return primitive_boxes[p].is_finite() && !primitive_boxes[p].is_empty();
+    };
     for (std::uint32_t p : bvh.primitive_indices) {
         if (p >= primitive_boxes.size())
             fail("primitive index " + std::to_string(p) + " out of range (" +
                  std::to_string(primitive_boxes.size()) + " primitives)");
         if (primitive_seen[p]++) fail("primitive " + std::to_string(p) + " appears twice");
-        if (!primitive_boxes[p].is_finite())
-            fail("primitive " + std::to_string(p) + " has a non-finite box but is in the tree");
+        if (!usable(p))
+            fail("primitive " + std::to_string(p) +
+                 " has a non-finite or empty box but is in the tree");
+    }
+    std::vector<std::uint8_t> listed(primitive_boxes.size(), 0);
+    for (std::uint32_t p : skipped) {
+        if (p >= primitive_boxes.size())
+            fail("skipped primitive " + std::to_string(p) + " out of range");
+        if (primitive_seen[p])
+            fail("primitive " + std::to_string(p) + " is listed as skipped but is in the tree");
+        listed[p] = 1;
     }
     for (std::size_t p = 0; p < primitive_boxes.size(); ++p)
-        if (!primitive_seen[p] && primitive_boxes[p].is_finite())
+        if (!primitive_seen[p] && !listed[p] && usable(p))
             fail("primitive " + std::to_string(p) + " is missing from the tree");
 
     if (bvh.nodes.empty()) {
@@ -74,8 +92,14 @@ void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_
 }
 
 template <class T, std::size_t N>
-void validate(const Bvh<Aabb<T, N>>& bvh, const std::vector<Aabb<T, N>>& primitive_boxes) {
-    validate(bvh, std::span<const Aabb<T, N>>(primitive_boxes));
+void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes) {
+    validate(bvh, primitive_boxes, std::span<const std::uint32_t>{});
+}
+
+template <class T, std::size_t N>
+void validate(const Bvh<Aabb<T, N>>& bvh, const std::vector<Aabb<T, N>>& primitive_boxes,
+              std::span<const std::uint32_t> skipped = {}) {
+    validate(bvh, std::span<const Aabb<T, N>>(primitive_boxes), skipped);
 }
 
 }  // namespace bvhkit

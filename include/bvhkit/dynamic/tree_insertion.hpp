@@ -13,6 +13,7 @@
 // and the best sibling is the S that minimizes it.
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "bvhkit/dynamic/tree_types.hpp"
@@ -135,10 +136,13 @@ struct SiblingCandidate {
 ///   heap
 ///     (nor anything below it) can win and the search stops.
 /// `heap` is scratch storage owned by the tree, so a steady stream of inserts allocates nothing.
+/// After `max_expansions` expanded nodes the best sibling found so far is taken (heavily
+/// overlapping boxes make the bound weak and the exact search visit most of the tree).
 template <class T, std::size_t N>
-std::int32_t find_sibling_branch_and_bound(const Node<T, N>* nodes, std::int32_t root,
-                                           const Aabb<T, N>& box,
-                                           std::vector<SiblingCandidate<T>>& heap) {
+std::int32_t find_sibling_branch_and_bound(
+    const Node<T, N>* nodes, std::int32_t root, const Aabb<T, N>& box,
+    std::vector<SiblingCandidate<T>>& heap,
+    std::size_t max_expansions = std::numeric_limits<std::size_t>::max()) {
     const Cost leaf_area = box_area(box);
     const auto later = [](const SiblingCandidate<T>& a, const SiblingCandidate<T>& b) {
         return a.inherited >
@@ -154,6 +158,7 @@ std::int32_t find_sibling_branch_and_bound(const Node<T, N>* nodes, std::int32_t
         const SiblingCandidate<T> c = heap.back();
         heap.pop_back();
         if (c.inherited + leaf_area >= best_cost) break;  // nothing left can beat the best
+        if (max_expansions-- == 0) break;
         const Node<T, N>& n = nodes[c.node];
         for (const std::int32_t child : {n.child1, n.child2}) {
             const Node<T, N>& cn = nodes[child];
