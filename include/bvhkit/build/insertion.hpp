@@ -2,8 +2,8 @@
 // Insertion build: the primitives are added one at a time to a growing tree, each next to the
 // sibling that raises the SAH cost least, found exactly by branch and bound, and the ancestors are
 // rotated on the way up (Bittner, Hapala, Havran 2013 for the search; Kopta et al. 2012 for the
-// rotations): seed 000's dynamic-tree algorithm run on a static set. It reuses the dynamic tree's
-// own search and rotations (dynamic/tree_insertion.hpp) on a pool without fat margins.
+// rotations): the dynamic tree's insertion algorithm run on a static set. It reuses the dynamic
+// tree's own search and rotations (dynamic/tree_insertion.hpp) on a pool without fat margins.
 //
 // Order matters: inserting in spatial order grows lopsided trees, so the primitives go in a
 // deterministic pseudo-random order (a fixed seed). Slower than the top-down builders (each insert

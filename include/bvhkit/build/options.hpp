@@ -16,7 +16,8 @@ enum class Builder {
     SweepSah,  // SAH evaluated between every pair of sorted centroids; slowest, best greedy quality
     TopDown,   // the classic rules below: an axis rule and a split-point rule
     BottomUp,  // PLOC (Meister and Bittner 2018): agglomerative clustering in Morton order
-    Insertion,  // one primitive at a time, branch-and-bound SAH with rotations (seed 000)
+    Insertion,  // one primitive at a time, branch-and-bound SAH with rotations (Bittner, Hapala,
+                // Havran 2013)
     Lbvh,       // Karras 2012: the Morton-code hierarchy; the fastest build, lower quality
 };
 

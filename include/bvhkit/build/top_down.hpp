@@ -1,5 +1,5 @@
 #pragma once
-// The classic top-down split rules of seed 001 (after Ericson, Real-Time Collision
+// The classic top-down split rules (after Ericson, Real-Time Collision
 // Detection, 6.2.1): choose an axis (longest extent, or largest centroid variance), then a split
 // point on it (object median, object mean, or the spatial median of the node's box). Leaves hold up
 // to max_leaf_size primitives; the driver's fallback handles a split point with every centroid on

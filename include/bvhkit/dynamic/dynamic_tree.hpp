@@ -18,9 +18,9 @@
 // displacement, so a small motion stays inside it and move() only updates the tight box.
 //
 // Insertion (tree_insertion.hpp): the sibling that minimizes the SAH cost increase, found by branch
-// and bound (or seed 000's greedy descent), then a walk up to the root refitting each ancestor and
-// applying the best of the four rotations. Removal replaces the leaf's parent by its sibling and
-// walks up alike.
+// and bound (or the greedy descent of the classic dynamic AABB trees), then a walk up to the root
+// refitting each ancestor and applying the best of the four rotations. Removal replaces the leaf's
+// parent by its sibling and walks up alike.
 //
 // Callbacks: while a query, cast, for_each_node or pair callback of a tree runs, the calls that
 // change its structure (create, destroy, move, enlarge, rebuild, optimize, clear, shift_origin,

@@ -2,7 +2,7 @@
 // The SAH pieces of the dynamic tree that work on its node pool: choosing the sibling of a new leaf
 // (greedy descent or exact branch and bound), refitting a node, and the four tree rotations.
 //
-// Cost model (seed 000; MacDonald and Booth's SAH): the cost of a tree is the sum of the areas of
+// Cost model (MacDonald and Booth's SAH): the cost of a tree is the sum of the areas of
 // its internal nodes ("area" = perimeter in 2D, surface area in 3D). The root and the leaves are
 // the same in every tree over the same leaves, so only the internal nodes matter.
 //
@@ -178,7 +178,7 @@ std::int32_t find_sibling_branch_and_bound(
     return descend_ties(nodes, best, box, best_cost);
 }
 
-/// The four rotations at node A (seed 000; Kopta et al. 2012 "Fast, effective BVH updates for
+/// The four rotations at node A (Kopta et al. 2012 "Fast, effective BVH updates for
 /// animated scenes"). A has children B and C. If B is internal with children D and E, swapping C
 /// with one of B's children changes only B's box:
 ///     1. swap C and D:  B becomes C u E,  cost change area(C u E) - area(B)

@@ -35,7 +35,7 @@ struct DynamicTreeOptions {
     T margin_relative = T(0);
     T displacement_multiplier = T(4);
     InsertionStrategy insertion = InsertionStrategy::BranchAndBound;
-    /// Try the four rotations while walking up after an insert or a removal (seed 000, Kopta et al.
+    /// Try the four rotations while walking up after an insert or a removal (Kopta et al.
     /// 2012).
     bool rotate = true;
 };

@@ -1,8 +1,8 @@
 #pragma once
 // Nearest-primitive queries over a Bvh of boxes: the closest primitive to a point, the k closest,
-// and all within a radius (seed 003's "distancing" query, done right).
+// and all within a radius (the distance queries of proximity work).
 //
-// Closest and k closest walk best-first (the lecture seed's rule for nearest queries): a min-heap
+// Closest and k closest walk best-first (the usual best-first rule for nearest queries): a min-heap
 // of nodes keyed by the squared distance from the point to their box, and a search radius that
 // shrinks as closer primitives are found; a node farther than the radius is never opened, and the
 // walk ends when the nearest node left is. Popping a node descends straight into its nearer child
