@@ -48,7 +48,9 @@ def test_winding_number_exact_and_fast():
            + np.einsum("kti,kti->kt", b, c) * la + np.einsum("kti,kti->kt", c, a) * lb)
     ref = (2 * np.arctan2(num, den)).sum(axis=1) / (4 * np.pi)
     np.testing.assert_allclose(exact, ref, atol=1e-9)
-    np.testing.assert_allclose(fast, ref, atol=5e-2)  # the first-order dipole expansion
+    # The fast expansion's error near the surface: docs/accuracy.md measures up to 0.065 within 1% of
+    # the diagonal; on this coarse sphere (320 faces) points 5% off the surface see up to ~0.065.
+    np.testing.assert_allclose(fast, ref, atol=8e-2)
     np.testing.assert_array_equal(fast > 0.5, r < 1)
 
 
