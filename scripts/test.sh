@@ -61,8 +61,9 @@ for run in release asan; do
     skipped=$(grep -c "(Skipped)" "$logs/$run.log" || true)
     echo "$run: $skipped skipped"
 done
-# The reasons, once each: GoogleTest's skip messages from the Release run.
-grep -h -A1 "Skipped$" build/release/Testing/Temporary/LastTest.log 2>/dev/null | grep -v -e "Skipped$" -e "^--" |
+# The reasons, once each: GoogleTest's skip messages from both runs.
+grep -h -A1 ": Skipped$" build/release/Testing/Temporary/LastTest.log build/asan/Testing/Temporary/LastTest.log 2>/dev/null |
+    grep -v -e ": Skipped$" -e "^--" |
     sort | uniq -c | sort -rn | head -20 || true
 
 echo "== All tests passed"
