@@ -23,7 +23,7 @@ void usage(std::FILE* out) {
     std::fprintf(
         out,
         "usage: bvhkit draw-tree [-o FILE.svg] [--n N] [--seed S] [--scene random|battle]\n"
-        "              [--strategy bnb|greedy] [--moves M]\n"
+        "              [--strategy guided|bnb|greedy] [--moves M]\n"
         "  Builds a 2D dynamic tree and writes it as SVG (default tree.svg): internal nodes\n"
         "  coloured by depth, fat boxes dashed, proxy boxes filled. --moves moves every box\n"
         "  M times by a small random step first, so the fat boxes show.\n");
@@ -65,13 +65,15 @@ int draw_tree_command(int argc, char** argv) {
     if (scene != "random" && scene != "battle")
         throw Error("--scene: '" + scene + "' is not random or battle");
     DynamicTreeOptions<float> options;
-    const std::string strategy = args.value("--strategy", "bnb");
-    if (strategy == "bnb")
+    const std::string strategy = args.value("--strategy", "guided");
+    if (strategy == "guided")
+        options.insertion = InsertionStrategy::Guided;
+    else if (strategy == "bnb")
         options.insertion = InsertionStrategy::BranchAndBound;
     else if (strategy == "greedy")
         options.insertion = InsertionStrategy::Greedy;
     else
-        throw Error("--strategy: '" + strategy + "' is not bnb or greedy");
+        throw Error("--strategy: '" + strategy + "' is not guided, bnb or greedy");
 
     std::mt19937 rng(seed);
     std::vector<Aabb2f> boxes;

@@ -90,8 +90,13 @@ TEST(DynamicTreeEvents, UpdatePairsMatchesBruteForce) {
             w.tree.find_pairs(ignored);
         }
         std::vector<bvhkit::ProxyPair> begins, ends;
-        w.tree.update_pairs([&](ProxyId a, ProxyId b) { begins.push_back({a, b}); },
-                            [&](ProxyId a, ProxyId b) { ends.push_back({a, b}); });
+        w.tree.update_pairs(
+            [&](ProxyId a, ProxyId b) {
+                begins.push_back({a, b});
+            },
+            [&](ProxyId a, ProxyId b) {
+                ends.push_back({a, b});
+            });
         ASSERT_TRUE(std::is_sorted(begins.begin(), begins.end()));
         ASSERT_TRUE(std::is_sorted(ends.begin(), ends.end()));
         ASSERT_TRUE(std::adjacent_find(begins.begin(), begins.end()) == begins.end());

@@ -306,6 +306,14 @@ void run_random(std::uint64_t seed, InsertionStrategy strategy, T margin_rel) {
 
 constexpr auto BnB = InsertionStrategy::BranchAndBound;
 constexpr auto Greedy = InsertionStrategy::Greedy;
+constexpr auto Guided = InsertionStrategy::Guided;
+
+TEST(DynamicTreeRandom, Float2Guided) {
+    run_random<float, 2>(9, Guided, 0.0f);
+}
+TEST(DynamicTreeRandom, Double3Guided) {
+    run_random<double, 3>(10, Guided, 0.1);
+}
 
 TEST(DynamicTreeRandom, Float2BranchAndBound) {
     run_random<float, 2>(1, BnB, 0.1f);

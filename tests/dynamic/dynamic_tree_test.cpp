@@ -143,7 +143,8 @@ TEST_P(SortedLine, HeightStaysLogarithmic) {
 }
 INSTANTIATE_TEST_SUITE_P(Strategies, SortedLine,
                          ::testing::Values(InsertionStrategy::Greedy,
-                                           InsertionStrategy::BranchAndBound));
+                                           InsertionStrategy::BranchAndBound,
+                                           InsertionStrategy::Guided));
 
 TEST(DynamicTree, WithoutRotationsSortedLineDegenerates) {
     // The same input without rotations: shows the rotations are what keep the tree balanced.
@@ -256,12 +257,15 @@ TEST(DynamicTree, EnlargeThenPartialRebuild) {
     t.validate();
 }
 
-TEST(DynamicTree, BranchAndBoundBeatsGreedyOnCost) {
-    // Random insertion order: the exact best sibling gives a cheaper tree than the greedy descent.
-    double cost[2];
-    for (int s = 0; s < 2; ++s) {
+TEST(DynamicTree, BranchAndBoundBeatsGuidedBeatsGreedyOnCost) {
+    // Random insertion order: the exact best sibling gives the cheapest tree, the guided descent
+    // one within a few percent of it, the greedy descent a much costlier one.
+    const InsertionStrategy strategies[3] = {
+        InsertionStrategy::Greedy, InsertionStrategy::BranchAndBound, InsertionStrategy::Guided};
+    double cost[3];
+    for (int s = 0; s < 3; ++s) {
         bvhkit::DynamicTreeOptions<float> o;
-        o.insertion = s ? InsertionStrategy::BranchAndBound : InsertionStrategy::Greedy;
+        o.insertion = strategies[s];
         DynamicTree<float, 2> t(o);
         std::mt19937 rng(11);
         std::uniform_real_distribution<float> u(0, 300);
@@ -270,6 +274,9 @@ TEST(DynamicTree, BranchAndBoundBeatsGreedyOnCost) {
         cost[s] = t.sah_cost();
     }
     EXPECT_LT(cost[1], cost[0]);
+    EXPECT_LE(cost[1], cost[2]);
+    EXPECT_LT(cost[2], 1.1 * cost[1]);
+    EXPECT_LT(cost[2], 0.8 * cost[0]);
 }
 
 TEST(DynamicTree, ShiftOriginAndStats) {

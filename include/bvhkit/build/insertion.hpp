@@ -34,7 +34,7 @@ Bvh<Aabb<T, N>> build_insertion(std::span<const Aabb<T, N>> boxes,
     SplitMix64 rng(0x1A5E27);
     for (std::size_t k = n; k > 1; --k) std::swap(order[k - 1], order[rng.next() % k]);
     std::vector<Node> nodes(2 * n - 1);
-    std::vector<dynamic_detail::SiblingCandidate<T>> heap;
+    std::vector<dynamic_detail::SiblingCandidate<double>> heap;
     std::int32_t root = null;
     std::int32_t next = 0;
     for (std::size_t k = 0; k < n; ++k) {

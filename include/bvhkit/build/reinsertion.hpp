@@ -85,7 +85,7 @@ ReinsertionReport optimize_reinsertion(Bvh<Aabb<T, N>>& bvh, std::span<const Aab
         if (!nodes[i].is_leaf()) dynamic_detail::refit(nodes.data(), std::int32_t(i));
     std::int32_t root = 0;
 
-    std::vector<dynamic_detail::SiblingCandidate<T>> heap;
+    std::vector<dynamic_detail::SiblingCandidate<double>> heap;
     std::vector<std::pair<double, std::int32_t>> ranked;
     // Puts the detached subtree `x` back next to its best sibling, with `parent` as the new node.
     const auto insert = [&](std::int32_t x, std::int32_t parent) {

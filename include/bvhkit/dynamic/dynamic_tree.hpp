@@ -440,6 +440,7 @@ class DynamicTree {
     std::size_t memory_bytes() const {
         return nodes_.capacity() * sizeof(Node) + proxies_.capacity() * sizeof(Proxy) +
                move_buffer_.capacity() * sizeof(ProxyId) + heap_.capacity() * sizeof(heap_[0]) +
+               float_heap_.capacity() * sizeof(float_heap_[0]) +
                pair_scratch_.capacity() * sizeof(ProxyPair) +
                build_.items.capacity() * sizeof(build_.items[0]) +
                build_.tasks.capacity() * sizeof(build_.tasks[0]) +
@@ -600,6 +601,7 @@ class DynamicTree {
     }
     void release_scratch() {
         release(heap_);
+        release(float_heap_);
         release(pair_scratch_);
         release(build_.items);
         release(build_.tasks);
@@ -681,10 +683,9 @@ class DynamicTree {
         }
         const std::int32_t parent = alloc_node();  // first: it may grow (move) the pool
         const Box box = nodes_[leaf].box;
+        const bool float_costs = dynamic_detail::float_costs_fit(unite(nodes_[root_].box, box));
         const std::int32_t sibling =
-            options_.insertion == InsertionStrategy::Greedy
-                ? dynamic_detail::find_sibling_greedy(nodes_.data(), root_, box)
-                : dynamic_detail::find_sibling_branch_and_bound(nodes_.data(), root_, box, heap_);
+            float_costs ? find_sibling<float>(box) : find_sibling<double>(box);
         const std::int32_t old_parent = nodes_[sibling].parent;
         Node& p = nodes_[parent];
         p.parent = old_parent;
@@ -700,7 +701,22 @@ class DynamicTree {
         }
         Node& op = nodes_[old_parent];
         (op.child1 == sibling ? op.child1 : op.child2) = parent;
-        walk_up(old_parent);
+        walk_up(old_parent, float_costs);
+    }
+
+    template <class Cost>
+    std::int32_t find_sibling(const Box& box) {
+        if (options_.insertion == InsertionStrategy::Greedy)
+            return dynamic_detail::find_sibling_greedy<Cost>(nodes_.data(), root_, box);
+        if (options_.insertion == InsertionStrategy::Guided)
+            return dynamic_detail::find_sibling_guided<Cost>(nodes_.data(), root_, box);
+        if constexpr (std::is_same_v<Cost, float>) {
+            return dynamic_detail::find_sibling_branch_and_bound<Cost>(nodes_.data(), root_, box,
+                                                                       float_heap_);
+        } else {
+            return dynamic_detail::find_sibling_branch_and_bound<Cost>(nodes_.data(), root_, box,
+                                                                       heap_);
+        }
     }
 
     /// Takes the leaf out of the tree (the node stays allocated): its parent is freed and replaced
@@ -723,16 +739,33 @@ class DynamicTree {
         }
         Node& g = nodes_[grand];
         (g.child1 == parent ? g.child1 : g.child2) = sibling;
-        walk_up(grand);
+        walk_up(grand, dynamic_detail::float_costs_fit(nodes_[root_].box));
     }
 
-    /// Refit (and rotate, when enabled) every node from i up to the root.
-    void walk_up(std::int32_t i) {
+    /// Refit (and rotate, when enabled) the nodes from i up: to the root, or to the first node
+    /// above i whose box, height and enlarged flag stay and that does not rotate, since nothing
+    /// above it changes then but the rotations that its unchanged subtree would offer (a heuristic
+    /// either way; stopping there halves the cost of a move in a crowd). `float_costs`: every box
+    /// on the way lies in bounds for which float_costs_fit() holds.
+    void walk_up(std::int32_t i, bool float_costs) {
         Node* nodes = nodes_.data();
-        while (i != dynamic_detail::kNullNode) {
+        for (const std::int32_t first = i; i != dynamic_detail::kNullNode; i = nodes[i].parent) {
+            Node& n = nodes[i];
+            const Box before = n.box;
+            const std::int32_t child1 = n.child1, child2 = n.child2;
+            const std::int32_t height = n.height;
+            const std::uint32_t enlarged = n.enlarged;
             dynamic_detail::refit(nodes, i);
-            if (options_.rotate) dynamic_detail::rotate(nodes, i);
-            i = nodes[i].parent;
+            if (options_.rotate) {
+                if (float_costs) {
+                    dynamic_detail::rotate<float>(nodes, i);
+                } else {
+                    dynamic_detail::rotate<double>(nodes, i);
+                }
+            }
+            if (i != first && n.child1 == child1 && n.child2 == child2 && n.height == height &&
+                n.enlarged == enlarged && n.box == before)
+                break;
         }
     }
 
@@ -746,7 +779,9 @@ class DynamicTree {
     std::size_t node_count_ = 0;
     std::size_t proxy_count_ = 0;
     // Scratch storage kept between calls so that steady use allocates nothing.
-    std::vector<dynamic_detail::SiblingCandidate<T>> heap_;
+    std::vector<dynamic_detail::SiblingCandidate<double>>
+        heap_;  // insertion scratch, per cost type
+    std::vector<dynamic_detail::SiblingCandidate<float>> float_heap_;
     std::vector<ProxyPair> pair_scratch_;
     dynamic_detail::BuildScratch<T, N> build_;
     std::vector<std::pair<double, std::int32_t>> optimize_scratch_;
