@@ -20,7 +20,7 @@ void usage(std::FILE* out) {
         out,
         "usage: bvhkit bench dynamic [--json] [--n N] [--steps S] [--reps R] [--only D1|D2|D3]\n"
         "  D1 2D crowd (vs Box2D b2BroadPhase), D2 3D crowd (vs Bullet btDbvtBroadphase),\n"
-        "  D3 churn. Defaults: --n 100000 --steps 40 --reps 3 (bvhkit-greedy: 1 rep).\n"
+        "  D3 churn. Defaults: --n 100000 --steps 40 --reps 3 (bvhkit-exact, bvhkit-greedy: 1 rep).\n"
         "  step_ms: ms per step (D3: per round of 1,000 ops); speedup: that row's step_ms over\n"
         "  bvhkit's; pairs: pairs found over all steps; agree: same pairs as bvhkit every step.\n");
 }

@@ -2,6 +2,8 @@
 // replayed identically for every library; each library runs single threaded in this process.
 #include "dynamic_bench.hpp"
 
+#include "dynamic_motion.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -22,94 +24,7 @@
 namespace bvhkit::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-/// The motion of a crowd: unit boxes [p, p + 1] in a cube of side `side`, each step each box moves
-/// by its velocity with probability 0.1, bouncing at the walls.
-struct Motion {
-    int n = 0, dim = 0;
-    float side = 0;
-    std::vector<float> start;  // n * 3, min corners (unused axes 0)
-    struct Move {
-        std::int32_t id;
-        float p[3];  // new min corner
-        float v[3];  // displacement of this move
-    };
-    std::vector<std::vector<Move>> steps;
-};
-
-Motion make_motion(int n, int dim, int steps, std::uint64_t seed) {
-    Motion m;
-    m.n = n;
-    m.dim = dim;
-    m.side = float(3.0 * std::pow(double(n), 1.0 / dim));
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<float> pos(0.0f, m.side - 1.0f), vel(-0.5f, 0.5f), u(0.0f, 1.0f);
-    m.start.assign(std::size_t(n) * 3, 0.0f);
-    std::vector<float> v(std::size_t(n) * 3, 0.0f);
-    for (int i = 0; i < n; ++i)
-        for (int a = 0; a < dim; ++a) m.start[i * 3 + a] = pos(rng), v[i * 3 + a] = vel(rng);
-    std::vector<float> p = m.start;
-    m.steps.resize(steps);
-    for (int s = 0; s < steps; ++s) {
-        for (int i = 0; i < n; ++i) {
-            if (u(rng) >= 0.1f) continue;
-            Motion::Move mv{i, {0, 0, 0}, {0, 0, 0}};
-            for (int a = 0; a < dim; ++a) {
-                float& x = p[i * 3 + a];
-                float& vx = v[i * 3 + a];
-                float nx = x + vx;
-                if (nx < 0) nx = -nx, vx = -vx;
-                if (nx > m.side - 1) nx = 2 * (m.side - 1) - nx, vx = -vx;
-                mv.v[a] = nx - x;
-                x = nx;
-                mv.p[a] = nx;
-            }
-            m.steps[s].push_back(mv);
-        }
-    }
-    return m;
-}
-
-/// The tight boxes of every step, to filter the peers' (fat) pairs: positions after each step.
-struct Tight {
-    std::vector<float> p;
-    explicit Tight(const Motion& m) : p(m.start) {}
-    void apply(const std::vector<Motion::Move>& moves) {
-        for (const auto& mv : moves)
-            for (int a = 0; a < 3; ++a) p[mv.id * 3 + a] = mv.p[a];
-    }
-    bool overlap(int a, int b, int dim) const {
-        for (int k = 0; k < dim; ++k)
-            if (std::fabs(p[a * 3 + k] - p[b * 3 + k]) > 1.0f) return false;
-        return true;
-    }
-};
-
-/// A step's pairs summarised: the count and an order-independent hash of the set.
-struct PairSummary {
-    long long count = 0;
-    std::uint64_t hash = 0;
-    void add(std::uint32_t a, std::uint32_t b) {
-        if (a > b) std::swap(a, b);
-        std::uint64_t h = (std::uint64_t(a) << 32 | b) * 0x9E3779B97F4A7C15ull;
-        h ^= h >> 29;
-        hash += h * 0xBF58476D1CE4E5B9ull;
-        ++count;
-    }
-    bool operator==(const PairSummary&) const = default;
-};
-
-struct RunResult {
-    double build_ms = 0, step_ms = 0;
-    std::vector<PairSummary> per_step;  // the first entry is the build's pair pass
-    int height = 0;
-    double sah = 0, ratio = 0;
-    long long touched = 0;
-};
+using namespace dynamic_workload;
 
 // ---------------------------------------------------------------- bvhkit
 
@@ -142,7 +57,7 @@ RunResult run_bvhkit(const Motion& m, InsertionStrategy strategy) {
         r.per_step.push_back(s);
     };
     summarize();
-    double total = 0;
+    double total = 0, moving = 0;
     for (const auto& moves : m.steps) {
         t0 = Clock::now();
         for (const auto& mv : moves) {
@@ -150,11 +65,13 @@ RunResult run_bvhkit(const Motion& m, InsertionStrategy strategy) {
             for (std::size_t a = 0; a < N; ++a) d[a] = mv.v[a];
             r.touched += tree.move(mv.id, box_at(mv.p), d);
         }
+        moving += ms_since(t0);
         tree.find_pairs(pairs);
         total += ms_since(t0);
         summarize();
     }
     r.step_ms = m.steps.empty() ? 0 : total / double(m.steps.size());
+    r.move_ms = m.steps.empty() ? 0 : moving / double(m.steps.size());
     tree.validate();
     r.height = tree.height();
     r.sah = tree.sah_cost();
@@ -215,7 +132,7 @@ RunResult run_box2d(const Motion& m) {
     bp.UpdatePairs(&cb);
     r.build_ms = ms_since(t0);
     summarize();
-    double total = 0;
+    double total = 0, moving = 0;
     for (const auto& moves : m.steps) {
         t0 = Clock::now();
         for (const auto& mv : moves) {
@@ -231,12 +148,14 @@ RunResult run_box2d(const Motion& m) {
                 ++r.touched;
             }
         }
+        moving += ms_since(t0);
         bp.UpdatePairs(&cb);
         total += ms_since(t0);
         tight.apply(moves);
         summarize();
     }
     r.step_ms = m.steps.empty() ? 0 : total / double(m.steps.size());
+    r.move_ms = m.steps.empty() ? 0 : moving / double(m.steps.size());
     r.height = bp.GetTreeHeight();
     // GetTreeQuality() is (sum of the perimeters of all nodes, leaves included) / root perimeter.
     // Take the leaves (their fat boxes) out to get the same measure as bvhkit's area ratio; the
@@ -314,12 +233,13 @@ RunResult run_bullet(const Motion& m) {
     bp.calculateOverlappingPairs(nullptr);
     r.build_ms = ms_since(t0);
     summarize();
-    double total = 0;
+    double total = 0, moving = 0;
     for (const auto& moves : m.steps) {
         std::fill(moved.begin(), moved.end(), 0);
         t0 = Clock::now();
         for (const auto& mv : moves)
             bp.setAabb(proxies[mv.id], corner(mv.p, 0), corner(mv.p, 1), nullptr);
+        moving += ms_since(t0);
         bp.calculateOverlappingPairs(nullptr);
         total += ms_since(t0);
         for (const auto& mv : moves) moved[mv.id] = 1;
@@ -327,6 +247,7 @@ RunResult run_bullet(const Motion& m) {
         summarize();
     }
     r.step_ms = m.steps.empty() ? 0 : total / double(m.steps.size());
+    r.move_ms = m.steps.empty() ? 0 : moving / double(m.steps.size());
     double area = 0;
     btVector3 lo(BT_LARGE_FLOAT, BT_LARGE_FLOAT, BT_LARGE_FLOAT), hi = -lo;
     dbvt_measure(bp.m_sets[0].m_root, area, r.height, lo, hi);
@@ -342,18 +263,23 @@ RunResult run_bullet(const Motion& m) {
 
 // ---------------------------------------------------------------- medians and rows
 
+/// The last run with its times replaced by the medians over all runs.
+RunResult collapse_runs(const std::vector<RunResult>& runs) {
+    std::vector<double> build, step, move;
+    for (const auto& r : runs)
+        build.push_back(r.build_ms), step.push_back(r.step_ms), move.push_back(r.move_ms);
+    RunResult out = runs.back();
+    out.build_ms = median(build);
+    out.step_ms = median(step);
+    out.move_ms = median(move);
+    return out;
+}
+
 template <class F>
 RunResult median_run(int reps, F&& run) {
-    std::vector<double> build, step;
-    RunResult last;
-    for (int k = 0; k < std::max(1, reps); ++k) {
-        last = run();
-        build.push_back(last.build_ms);
-        step.push_back(last.step_ms);
-    }
-    last.build_ms = median(build);
-    last.step_ms = median(step);
-    return last;
+    std::vector<RunResult> runs;
+    for (int k = 0; k < std::max(1, reps); ++k) runs.push_back(run());
+    return collapse_runs(runs);
 }
 
 /// Medians of f() and g() with their repetitions interleaved (f, g, f, g, ...), so that a change of
@@ -365,15 +291,7 @@ std::pair<RunResult, RunResult> median_runs_interleaved(int reps, F&& f, G&& g) 
         a.push_back(f());
         b.push_back(g());
     }
-    const auto collapse = [](std::vector<RunResult>& runs) {
-        std::vector<double> build, step;
-        for (const auto& r : runs) build.push_back(r.build_ms), step.push_back(r.step_ms);
-        RunResult out = runs.back();
-        out.build_ms = median(build);
-        out.step_ms = median(step);
-        return out;
-    };
-    return {collapse(a), collapse(b)};
+    return {collapse_runs(a), collapse_runs(b)};
 }
 
 long long total_pairs(const RunResult& r) {
@@ -386,19 +304,24 @@ Row make_row(const std::string& workload, const std::string& library, const RunR
              const RunResult* reference) {
     Row row;
     row.set("workload", workload).set("library", library);
-    row.set("build_ms", r.build_ms).set("step_ms", r.step_ms);
+    row.set("build_ms", r.build_ms).set("step_ms", r.step_ms).set("move_ms", r.move_ms);
     if (reference && r.step_ms > 0) {
         row.set("speedup", r.step_ms / reference->step_ms);
     } else {
         row.set("speedup", std::string(reference ? "" : "-"));
     }
-    row.set("pairs", total_pairs(r));
+    row.set("pairs", r.reported >= 0 ? r.reported : total_pairs(r));
     if (reference) {
         row.set("agree", std::string(r.per_step == reference->per_step ? "yes" : "NO"));
     } else {
         row.set("agree", std::string("-"));
     }
-    row.set("height", (long long)r.height).set("sah_cost", r.sah).set("area_ratio", r.ratio);
+    if (r.tree_measured) {
+        row.set("height", (long long)r.height).set("sah_cost", r.sah).set("area_ratio", r.ratio);
+    } else {
+        row.set("height", std::string("-")).set("sah_cost", std::string("-"));
+        row.set("area_ratio", std::string("-"));
+    }
     if (r.touched >= 0) {
         row.set("touched", r.touched);
     } else {
@@ -407,22 +330,36 @@ Row make_row(const std::string& workload, const std::string& library, const RunR
     return row;
 }
 
+/// D1-own: D1 in Box2D's own semantics (dynamic_events_bench.cpp). "pairs" counts what each library
+/// reported (bvhkit: begin events; Box2D: fat pairs of re-inserted proxies); "agree": the tight
+/// pairs overlapping after every step, rebuilt from each library's reports, are the same.
+void own_semantics(const Motion& m, const DynamicBenchConfig& c, std::vector<Row>& rows) {
+    const auto ours = [&] { return run_bvhkit_events(m); };
+#ifdef BVHKIT_HAVE_BOX2D
+    auto [events, box2d] = median_runs_interleaved(c.reps, ours, [&] { return run_box2d_own(m); });
+    rows.push_back(make_row("D1-own", "bvhkit-events", events, nullptr));
+    rows.push_back(make_row("D1-own", "box2d-2.4.1", box2d, &events));
+#else
+    rows.push_back(make_row("D1-own", "bvhkit-events", median_run(c.reps, ours), nullptr));
+#endif
+}
+
 void crowd(const char* workload, int dim, const DynamicBenchConfig& c, std::FILE* log,
            std::vector<Row>& rows) {
     const Motion m = make_motion(c.n, dim, c.steps, dim == 2 ? 1001 : 2002);
     std::fprintf(log, "%s: %d boxes, %d steps, %d repetitions\n", workload, c.n, c.steps, c.reps);
     const auto run_ours = [&] {
-        return dim == 2 ? run_bvhkit<2>(m, InsertionStrategy::BranchAndBound)
-                        : run_bvhkit<3>(m, InsertionStrategy::BranchAndBound);
+        return dim == 2 ? run_bvhkit<2>(m, InsertionStrategy::Guided)
+                        : run_bvhkit<3>(m, InsertionStrategy::Guided);
     };
     // bvhkit and the peer alternate repetitions; without the peer, bvhkit runs alone.
-    RunResult bnb;
+    RunResult base;
     std::optional<std::pair<const char*, RunResult>> peer;
 #ifdef BVHKIT_HAVE_BOX2D
     if (dim == 2) {
-        auto [ours, theirs] =
+        auto [mine, theirs] =
             median_runs_interleaved(c.reps, run_ours, [&] { return run_box2d(m); });
-        bnb = ours;
+        base = mine;
         peer.emplace("box2d-2.4.1", theirs);
     }
 #else
@@ -431,25 +368,29 @@ void crowd(const char* workload, int dim, const DynamicBenchConfig& c, std::FILE
 #endif
 #ifdef BVHKIT_HAVE_BULLET
     if (dim == 3) {
-        auto [ours, theirs] =
+        auto [mine, theirs] =
             median_runs_interleaved(c.reps, run_ours, [&] { return run_bullet(m); });
-        bnb = ours;
+        base = mine;
         peer.emplace("bullet-dbvt", theirs);
     }
 #else
     if (dim == 3)
         std::fprintf(log, "%s: Bullet not built in (libbullet-dev missing); skipped\n", workload);
 #endif
-    if (!peer) bnb = median_run(c.reps, run_ours);
-    rows.push_back(make_row(workload, "bvhkit", bnb, nullptr));
-    // The greedy descent builds much costlier trees (see sah_cost) and runs an order of magnitude
-    // slower here, so it gets a single repetition to keep the whole bench near a minute.
-    const auto greedy = median_run(1, [&] {
-        return dim == 2 ? run_bvhkit<2>(m, InsertionStrategy::Greedy)
-                        : run_bvhkit<3>(m, InsertionStrategy::Greedy);
-    });
-    rows.push_back(make_row(workload, "bvhkit-greedy", greedy, &bnb));
-    if (peer) rows.push_back(make_row(workload, peer->first, peer->second, &bnb));
+    if (!peer) base = median_run(c.reps, run_ours);
+    rows.push_back(make_row(workload, "bvhkit", base, nullptr));
+    // The other insertion strategies, one repetition each to keep the whole bench near a minute:
+    // the exact search builds slightly cheaper trees at twice the cost of a move; the greedy
+    // descent much costlier trees (see sah_cost) that make the step an order of magnitude slower.
+    for (const auto& [name, strategy] :
+         {std::pair{"bvhkit-exact", InsertionStrategy::BranchAndBound},
+          std::pair{"bvhkit-greedy", InsertionStrategy::Greedy}}) {
+        const auto other = median_run(
+            1, [&, s = strategy] { return dim == 2 ? run_bvhkit<2>(m, s) : run_bvhkit<3>(m, s); });
+        rows.push_back(make_row(workload, name, other, &base));
+    }
+    if (peer) rows.push_back(make_row(workload, peer->first, peer->second, &base));
+    if (dim == 2) own_semantics(m, c, rows);
 }
 
 /// D3: churn. Starts from n / 10 boxes; then rounds of 1,000 operations (inserts, removes, moves in
