@@ -163,6 +163,12 @@ struct alignas(16) TrianglePack4 {
 
     /// Bit per lane: a triangle whose squared distance from p is at most `bound`, or a sliver.
     unsigned lanes_within(const Vec<T, 3>& p, T bound) const {
+        T d[4];
+        return lanes_within(p, bound, d);
+    }
+    /// The same, with each lane's squared distance by the pack's formula in `d` (meaningless for
+    /// the lanes in exact_lanes).
+    unsigned lanes_within(const Vec<T, 3>& p, T bound, T (&d)[4]) const {
         const unsigned used = used_lanes();
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>) {
@@ -172,13 +178,18 @@ struct alignas(16) TrianglePack4 {
                 a[i] = _mm_load_ps(corner[0][i]), b[i] = _mm_load_ps(corner[1][i]);
                 c[i] = _mm_load_ps(corner[2][i]), q[i] = F4(p[i]);
             }
-            const F4 d = pack_detail::triangle_distance_squared(a, b, c, q);
-            const unsigned near = unsigned(_mm_movemask_ps(_mm_cmple_ps(d.v, _mm_set1_ps(bound))));
+            const F4 dist = pack_detail::triangle_distance_squared(a, b, c, q);
+            _mm_storeu_ps(d, dist.v);
+            const unsigned near =
+                unsigned(_mm_movemask_ps(_mm_cmple_ps(dist.v, _mm_set1_ps(bound))));
             return (near | exact_lanes) & used;
         }
 #endif
         unsigned near = 0;
-        for (int l = 0; l < 4; ++l) near |= unsigned(distance_squared(l, p) <= bound) << l;
+        for (int l = 0; l < 4; ++l) {
+            d[l] = distance_squared(l, p);
+            near |= unsigned(d[l] <= bound) << l;
+        }
         return (near | exact_lanes) & used;
     }
 

@@ -70,42 +70,61 @@ class ClosestPointMesh {
         using W = AccurateScalar<T>;
         NearestSlot<T> best;
         // Candidates are measured accurately, in W (closest_point_accurate), and compared there:
-        // a squared distance past T's range (a point 1e19 from a float mesh) still ranks.
-        // search2, the best distance widened by what rounding can put between the true distance
-        // and the float bounds on it, prunes boxes and packs. The packs hold the mesh scaled to
-        // unit magnitude (see build): p likewise.
-        W best2 = std::numeric_limits<W>::infinity();
-        const T magnitude = max_component(abs(p));
-        T search2 = widened(max_distance_squared, magnitude);
+        // a squared distance past T's range (a point 1e19 from a float mesh) still ranks. The
+        // walk ranks by the packs' float distances and measures accurately only at the end, and
+        // only the candidates that rounding leaves in the running: a pack's distance is within
+        // the slack of widened() of the true one, so a candidate can still win while its estimate
+        // is within twice that slack of the best estimate. Slivers (a pack's exact_lanes) and
+        // points too far for the pack's formula are measured at once. The packs hold the mesh
+        // scaled to unit magnitude (see build): p likewise.
+        W best2 = std::numeric_limits<W>::infinity();  // accurate
+        T best_estimate = std::numeric_limits<T>::infinity();
+        auto& candidates = scratch.candidates;
+        candidates.clear();
+        const T limit2 = widened(max_distance_squared);
+        T search2 = limit2;
         const Vec<T, 3> ps = p * pack_scale_;
         // The pack formula squares lengths twice over: beyond 2^(max_exponent / 4) from the
         // (unit) mesh it would overflow, and every lane is measured.
         const bool scaled_ok =
             max_component(abs(ps)) < std::ldexp(T(1), std::numeric_limits<T>::max_exponent / 4);
         const T unscale = T(1) / pack_scale_;  // exact: a power of two
+        const T unscale2 = unscale * unscale;
+        const auto measure = [&](std::uint32_t s, const Triangle<T>& t) {
+            const W d2 = distance_squared_accurate(t, p);
+            // The limit is judged on the distance as returned (rounded to T).
+            if (d2 < best2 && T(d2) <= max_distance_squared) best = {s, T(d2)}, best2 = d2;
+        };
+        const auto tighten = [&] {
+            T bound = std::min(limit2, widened(widened(best_estimate)));
+            if (best) bound = std::min(bound, widened(best.distance_squared));
+            search2 = bound;
+        };
         const auto open_leaf = [&](std::uint32_t first, std::uint32_t groups) {
             for (std::uint32_t g = first; g < first + groups; ++g) {
                 const TrianglePack4<T>& pack = packs_[g];
                 for (int l = 0; l < 4; ++l)
                     if (pack.slot[l] != invalid_index) stats.primitive();
-                // The pack's distances decide which lanes to measure accurately.
+                T d[4];
                 const unsigned lanes =
-                    scaled_ok ? pack.lanes_within(ps, search2 * pack_scale_ * pack_scale_)
+                    scaled_ok ? pack.lanes_within(ps, search2 * pack_scale_ * pack_scale_, d)
                               : pack.used_lanes();
-                for (unsigned m = lanes; m; m &= m - 1) {
+                const unsigned now = scaled_ok ? lanes & pack.exact_lanes : lanes;
+                bool changed = false;
+                for (unsigned m = now; m; m &= m - 1) {
                     const int l = __builtin_ctz(m);
                     const std::uint32_t s = pack.slot[l];
                     // The pack's own copy, in cache already, when it unscales exactly.
-                    const Triangle<T> t =
-                        packs_unscale_exactly_ ? pack.triangle(l, unscale) : tris_[s];
-                    const W d2 = distance_squared_accurate(t, p);
-                    // The limit is judged on the distance as returned (rounded to T).
-                    if (d2 < best2 && T(d2) <= max_distance_squared) {
-                        best = {s, T(d2)};
-                        best2 = d2;
-                        search2 = widened(T(d2), magnitude);
-                    }
+                    measure(s, packs_unscale_exactly_ ? pack.triangle(l, unscale) : tris_[s]);
+                    changed = true;
                 }
+                for (unsigned m = lanes & ~now; m; m &= m - 1) {
+                    const int l = __builtin_ctz(m);
+                    const T estimate = d[l] * unscale2;
+                    candidates.push_back({estimate, pack.slot[l]});
+                    if (estimate < best_estimate) best_estimate = estimate, changed = true;
+                }
+                if (changed) tighten();
             }
         };
         struct OpenLeaf {
@@ -117,6 +136,14 @@ class ClosestPointMesh {
             }
         };
         nearest_wide(wide_, p, scratch, search2, OpenLeaf{open_leaf, packs_.data()}, stats);
+        // Nearest estimate first; stop at the first whose estimate rounding cannot bring below
+        // the best measured so far.
+        std::sort(candidates.begin(), candidates.end());
+        for (const auto& [estimate, s] : candidates) {
+            if (best && estimate > widened(best.distance_squared)) break;
+            if (estimate > search2) break;
+            measure(s, tris_[s]);
+        }
         return best ? point_of(best.slot, p) : MeshPoint<T>{};
     }
     MeshPoint<T> closest_point(const Vec<T, 3>& p) const {
@@ -186,7 +213,17 @@ class ClosestPointMesh {
             bvh_.empty()
                 ? T(0)
                 : max_component(max(abs(bvh_.root().bounds.min), abs(bvh_.root().bounds.max)));
-        magnitude_ = magnitude;
+        // The longest edge, rounded up, for widened(); triangles with a NaN or infinite
+        // coordinate are left out of the tree and of this.
+        double longest2 = 0;
+        for (const Triangle<T>& t : tris) {
+            const Triangle<double> d{Vec<double, 3>(t.p0), Vec<double, 3>(t.p1),
+                                     Vec<double, 3>(t.p2)};
+            const double e2 = std::max({length_squared(d.p1 - d.p0), length_squared(d.p2 - d.p1),
+                                        length_squared(d.p0 - d.p2)});
+            if (std::isfinite(e2)) longest2 = std::max(longest2, e2);
+        }
+        longest_edge_ = T(std::sqrt(longest2) * (1 + 1e-6));
         constexpr int max_shift = std::numeric_limits<T>::max_exponent - 8;
         pack_scale_ =
             magnitude > T(0) && std::isfinite(magnitude)
@@ -208,15 +245,16 @@ class ClosestPointMesh {
         }
     }
     /// `radius2` widened by what rounding can put between a triangle's true distance and the
-    /// float bounds on it: the pack's distance, the triangle's box, a node's box. 1024 ulps of the
-    /// lengths involved: the largest gap measured between a pack's distance and the true one was
-    /// ~150 ulps on triangles that are not flagged as slivers (slivers are always measured).
-    /// `point_magnitude` is the query point's largest |coordinate|.
-    T widened(T radius2, T point_magnitude) const {
+    /// float bounds on it: the pack's distance, the triangle's box, a node's box. Each is computed
+    /// from differences of the (exact) coordinates, so its error scales with the lengths between
+    /// the point and the triangle's corners, at most r + the longest edge for a triangle that can
+    /// still be within r; tests/proximity/triangle_pack_test.cpp bounds a pack's distance error by
+    /// 560 ulps of that length on triangles not flagged as slivers (slivers are always measured).
+    /// The slack is 1024 ulps of it.
+    T widened(T radius2) const {
         if (!(radius2 >= T(0) && radius2 < std::numeric_limits<T>::infinity())) return radius2;
         const T r = std::sqrt(radius2);
-        const T slack =
-            T(1024) * std::numeric_limits<T>::epsilon() * (r + magnitude_ + point_magnitude);
+        const T slack = T(1024) * std::numeric_limits<T>::epsilon() * (r + longest_edge_);
         return (r + slack) * (r + slack);
     }
     /// The squared distance to the triangle in a leaf slot, for nearest().
@@ -231,9 +269,7 @@ class ClosestPointMesh {
             return T(distance_squared_accurate(t, p));
         }
         /// The bound the walks prune boxes with: see widened().
-        T widen(const Vec<T, 3>& p, T bound) const {
-            return mesh->widened(bound, max_component(abs(p)));
-        }
+        T widen(const Vec<T, 3>& /*p*/, T bound) const { return mesh->widened(bound); }
         /// Asks for a leaf's first triangle ahead of time (nearest() calls it for leaves it will
         /// open later).
         void prefetch(std::uint32_t slot) const { __builtin_prefetch(tris + slot); }
@@ -278,7 +314,7 @@ class ClosestPointMesh {
     std::vector<Triangle<T>> tris_;        // leaf-slot order, then one of padding
     WideBvh4<T> wide_;                     // bvh_ collapsed, for closest_point
     std::vector<TrianglePack4<T>> packs_;  // wide_'s leaf groups: triangles four abreast
-    T magnitude_ = 0;                      // the mesh's largest |coordinate|
+    T longest_edge_ = 0;                   // the mesh's longest edge (finite triangles)
     T pack_scale_ = 1;                     // packs_ hold the triangles times this (a power of 2)
     bool packs_unscale_exactly_ = true;    // and dividing by it gives tris_ back, bit for bit
     std::size_t triangle_count_ = 0;

@@ -40,7 +40,8 @@ struct NearestEntry {
 template <class T>
 struct NearestScratch {
     std::vector<NearestEntry<T>> heap;
-    std::vector<std::pair<T, std::uint32_t>> best;  // k nearest: (squared distance, slot)
+    std::vector<std::pair<T, std::uint32_t>> best;        // k nearest: (squared distance, slot)
+    std::vector<std::pair<T, std::uint32_t>> candidates;  // closest point: (float estimate, slot)
 };
 
 /// The result of a nearest query: the leaf slot of the primitive (invalid_index when none lies
