@@ -12,12 +12,18 @@
 // from a point farther than beta * r from c, counts as its Taylor expansion; nearer nodes are
 // opened (leaves summed exactly). Order 1 is the dipole,
 //     w_node = (c - q) . sum(a_i n_i) / (4 pi |c - q|^3);
-// order 2 (the default) adds the first moment M = sum(a_i (centroid_i - c) (x) n_i) against the
-// Jacobian of r / |r|^3: (tr M / |r|^3 - 3 r.M.r / |r|^5) / (4 pi), r = c - q.
+// order 2 adds the first moment M = sum(a_i (centroid_i - c) (x) n_i) against the Jacobian of
+// r / |r|^3: (tr M / |r|^3 - 3 r.M.r / |r|^5) / (4 pi), r = c - q; order 3 (the default, Barill
+// et al.'s second order, libigl's default) adds the second moment
+// S_jki = sum over triangles of n_i * integral of (x - c)_j (x - c)_k dA against the Hessian:
+// (1/2) H_ijk S_jki / (4 pi), H_ijk = -3 (d_ij r_k + d_ik r_j + d_jk r_i) / |r|^5
+// + 15 r_i r_j r_k / |r|^7. A triangle's integral is exact: area * ((g - c)(g - c)^T +
+// sum over corners (v - g)(v - g)^T / 12), g its centroid.
 // Measured against exact() on spot for 3,000 points within 1% of the diagonal from the surface,
-// beta = 2 (tests/proximity/winding_accuracy_test.cpp): order 1 mean error 0.027, max 0.065,
-// 92% of points off by more than 1e-2; order 2 mean 0.010, max 0.036, 46%. Far from the surface
-// the error falls off fast. A larger beta is more exact and slower; beta must be at least 1.
+// beta = 2 (tests/proximity/winding_accuracy_test.cpp prints these): order 1 mean error 0.027,
+// max 0.065, 92% of points off by more than 1e-2; order 2 mean 0.010, max 0.036, 46%; order 3:
+// see docs/accuracy.md. Far from the surface the error falls off fast. A larger beta is more
+// exact and slower; beta must be at least 1.
 
 #include <array>
 #include <cmath>
@@ -66,7 +72,10 @@ class WindingNumberMesh {
         const std::size_t n = bvh_.nodes.size();
         dipoles_.resize(n);
         std::vector<std::array<double, 9>> moment(n);
+        std::vector<std::array<double, 27>> second(n);  // S[9 * j + 3 * k + i]
         std::vector<Vec<double, 3>> centres(n), normals(n);
+        std::vector<Vec<double, 3>> weighted_centres(n);  // sum of area * centroid
+        std::vector<double> areas(n);
         for (std::size_t k = n; k-- > 0;) {
             const auto& node = bvh_.nodes[k];
             Dipole& d = dipoles_[k];
@@ -84,8 +93,8 @@ class WindingNumberMesh {
             } else {
                 for (std::uint32_t c : {node.left(), node.right()}) {
                     an += normals[c];
-                    centre += dipoles_[c].weighted_centre;
-                    area += dipoles_[c].area;
+                    centre += weighted_centres[c];
+                    area += areas[c];
                 }
             }
             const Vec<double, 3> c =
@@ -95,23 +104,57 @@ class WindingNumberMesh {
                 for (int i = 0; i < 3; ++i)
                     for (int j = 0; j < 3; ++j) m[3 * i + j] += x[i] * y[j];
             };
+            std::array<double, 27> sm{};
+            // sm += (x (x) y) (x) z, the first two indices symmetric by construction or by use.
+            const auto add_outer3 = [&sm](const Vec<double, 3>& x, const Vec<double, 3>& y,
+                                          const Vec<double, 3>& z) {
+                for (int j = 0; j < 3; ++j)
+                    for (int l = 0; l < 3; ++l)
+                        for (int i = 0; i < 3; ++i) sm[9 * j + 3 * l + i] += x[j] * y[l] * z[i];
+            };
             if (node.is_leaf()) {
                 for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
                     const Triangle<T>& t = tris_[s];
-                    add_outer(Vec<double, 3>(t.centroid()) - c, Vec<double, 3>(t.normal()) * 0.5);
+                    const Vec<double, 3> g(t.centroid()), area_n = Vec<double, 3>(t.normal()) * 0.5;
+                    add_outer(g - c, area_n);
+                    add_outer3(g - c, g - c, area_n);
+                    for (const Vec<T, 3>& v : {t.p0, t.p1, t.p2}) {
+                        const Vec<double, 3> e = Vec<double, 3>(v) - g;
+                        add_outer3(e, e, area_n / 12.0);
+                    }
                 }
             } else {
+                // A child's moments move from its centre c' to c: x - c = (x - c') + d.
                 for (std::uint32_t ch : {node.left(), node.right()}) {
+                    const Vec<double, 3> dc = centres[ch] - c;
                     for (int i = 0; i < 9; ++i) m[i] += moment[ch][i];
-                    add_outer(centres[ch] - c, normals[ch]);
+                    add_outer(dc, normals[ch]);
+                    for (int i = 0; i < 27; ++i) sm[i] += second[ch][i];
+                    for (int j = 0; j < 3; ++j)
+                        for (int l = 0; l < 3; ++l)
+                            for (int i = 0; i < 3; ++i)
+                                sm[9 * j + 3 * l + i] += dc[j] * moment[ch][3 * l + i] +
+                                                         dc[l] * moment[ch][3 * j + i] +
+                                                         dc[j] * dc[l] * normals[ch][i];
                 }
+            }
+            second[k] = sm;
+            for (int j = 0, u = 0; j < 3; ++j)
+                for (int kk = j; kk < 3; ++kk, ++u)
+                    for (int i = 0; i < 3; ++i)
+                        d.second[3 * u + i] = T(sm[9 * j + 3 * kk + i] * (j == kk ? 1.0 : 2.0));
+            for (int j = 0; j < 3; ++j) {
+                double su = 0, sv = 0;
+                for (int i = 0; i < 3; ++i)
+                    su += sm[9 * j + 3 * i + i], sv += sm[9 * i + 3 * i + j];
+                d.traces[j] = T(2 * su + sv);
             }
             moment[k] = m;
             centres[k] = c;
             normals[k] = an;
             d.an = Vec<T, 3>(an);
-            d.area = area;
-            d.weighted_centre = centre;
+            areas[k] = area;
+            weighted_centres[k] = centre;
             d.centre = Vec<T, 3>(c);
             for (int i = 0; i < 9; ++i) d.moment[i] = T(m[i]);
             // Radius: the farthest corner of the node's box bounds every triangle below it.
@@ -136,7 +179,7 @@ class WindingNumberMesh {
     /// Barill et al.'s approximation; `beta` (>= 1, +inf allowed: exact) trades accuracy for
     /// speed. Throws Error for a beta below 1 or NaN: nearer than its radius a node's expansion
     /// does not converge.
-    T fast(const Vec<T, 3>& q, T beta = T(2), int order = 2) const {
+    T fast(const Vec<T, 3>& q, T beta = T(2), int order = 3) const {
         check_beta(beta);
         check_order(order);
         if (bvh_.empty()) return T(0);
@@ -155,7 +198,7 @@ class WindingNumberMesh {
                 // Jacobian I / |r|^3 - 3 r r^T / |r|^5 against the first moment.
                 const double rr = double(dist) * dist, inv3 = 1.0 / (rr * dist);
                 sum += double(dot(r, d.an)) * inv3;
-                if (order == 2) {
+                if (order >= 2) {
                     const Vec<double, 3> rd(r);
                     double trace = 0, rmr = 0;
                     for (int i = 0; i < 3; ++i) {
@@ -165,6 +208,7 @@ class WindingNumberMesh {
                     }
                     sum += trace * inv3 - 3.0 * rmr * inv3 / rr;
                 }
+                if (order == 3) sum += second_order_term(d, Vec<double, 3>(r), rr, inv3);
                 continue;
             }
             if (node.is_leaf()) {
@@ -180,7 +224,7 @@ class WindingNumberMesh {
 
     /// fast() for many points (in parallel with oneTBB; the same values as serial).
     void fast(std::span<const Vec<T, 3>> points, std::span<T> out, T beta = T(2),
-              unsigned threads = 0, int order = 2) const {
+              unsigned threads = 0, int order = 3) const {
         check_beta(beta);
         check_order(order);
         if (out.size() < points.size())
@@ -200,18 +244,37 @@ class WindingNumberMesh {
                         std::to_string(double(beta)));
     }
     static void check_order(int order) {
-        if (order != 1 && order != 2)
-            throw Error("WindingNumberMesh::fast: order must be 1 or 2, got " +
+        if (order < 1 || order > 3)
+            throw Error("WindingNumberMesh::fast: order must be 1, 2 or 3, got " +
                         std::to_string(order));
     }
     struct Dipole {
+        Vec<T, 3> centre;  // area-weighted centre (first: the walk reads it and radius first)
+        T radius = 0;
         Vec<T, 3> an;      // sum of area * unit normal
         T moment[9] = {};  // sum of area * (centroid - centre) (x) unit normal, row-major
-        Vec<T, 3> centre;  // area-weighted centre
-        T radius = 0;
-        double area = 0;
-        Vec<double, 3> weighted_centre;  // sum of area * centroid (for the parents)
+        // The second moment S_jki for the six (j <= k) pairs (00, 01, 02, 11, 12, 22), then i,
+        // the off-diagonal pairs doubled (they stand for jk and kj); and
+        // traces_j = 2 sum_i S_jii + sum_i S_iij.
+        T second[18] = {};
+        T traces[3] = {};
     };
+    /// (1/2) H_ijk(r) S_jki (see the top of the file): with S symmetric in j, k it is
+    /// (1/2) (-3 r.traces / |r|^5 + 15 r_i r_j r_k S_jki / |r|^7). rr = |r|^2, inv3 = 1 / |r|^3.
+    static double second_order_term(const Dipole& d, const Vec<double, 3>& r, double rr,
+                                    double inv3) {
+        const double rjrk[6] = {r[0] * r[0], r[0] * r[1], r[0] * r[2],
+                                r[1] * r[1], r[1] * r[2], r[2] * r[2]};
+        double rS = 0;
+        for (int u = 0; u < 6; ++u)
+            rS += rjrk[u] * (r[0] * double(d.second[3 * u]) + r[1] * double(d.second[3 * u + 1]) +
+                             r[2] * double(d.second[3 * u + 2]));
+        const double rt =
+            r[0] * double(d.traces[0]) + r[1] * double(d.traces[1]) + r[2] * double(d.traces[2]);
+        const double inv5 = inv3 / rr;
+        return 0.5 * inv5 * (15.0 * rS / rr - 3.0 * rt);
+    }
+
     AabbBvh<T, 3> bvh_;
     std::vector<Triangle<T>> tris_;  // leaf-slot order
     std::vector<Dipole> dipoles_;
