@@ -201,4 +201,30 @@ int orient3d_sign(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, co
                                  Vec<double, 3>(d));
 }
 
+/// orient3d_sign(a, b, c, d[i]) for the three points d[0..2]: the plane's products are computed
+/// once, by the same operations in the same order, so every sign is the one orient3d_sign gives.
+template <class T>
+void orient3d_signs(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, const Vec<T, 3>* d,
+                    int* out) {
+    const double ux = double(b[0]) - double(a[0]), uy = double(b[1]) - double(a[1]),
+                 uz = double(b[2]) - double(a[2]);
+    const double vx = double(c[0]) - double(a[0]), vy = double(c[1]) - double(a[1]),
+                 vz = double(c[2]) - double(a[2]);
+    const double p0 = uy * vz, q0 = uz * vy, p1 = uz * vx, q1 = ux * vz, p2 = ux * vy, q2 = uy * vx;
+    const double n0 = p0 - q0, n1 = p1 - q1, n2 = p2 - q2;
+    const double m0 = std::fabs(p0) + std::fabs(q0), m1 = std::fabs(p1) + std::fabs(q1),
+                 m2 = std::fabs(p2) + std::fabs(q2);
+    for (int i = 0; i < 3; ++i) {
+        const double wx = double(d[i][0]) - double(a[0]), wy = double(d[i][1]) - double(a[1]),
+                     wz = double(d[i][2]) - double(a[2]);
+        const double det = n0 * wx + n1 * wy + n2 * wz;
+        const double bound =
+            exact::orient3d_bound * (m0 * std::fabs(wx) + m1 * std::fabs(wy) + m2 * std::fabs(wz));
+        out[i] = det > bound    ? 1
+                 : -det > bound ? -1
+                                : exact::orient3d_exact(Vec<double, 3>(a), Vec<double, 3>(b),
+                                                        Vec<double, 3>(c), Vec<double, 3>(d[i]));
+    }
+}
+
 }  // namespace bvhkit

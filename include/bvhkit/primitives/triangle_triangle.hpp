@@ -172,9 +172,9 @@ enum class Meet { None, Crossing, General };
 template <class T>
 Meet decide(const Vec<T, 3>* u, const Vec<T, 3>* v, Vec<T, 3>* a, Vec<T, 3>* b) {
     int dv[3], du[3];
-    for (int i = 0; i < 3; ++i) dv[i] = orient3d_sign(u[0], u[1], u[2], v[i]);
+    orient3d_signs(u[0], u[1], u[2], v, dv);
     if (dv[0] == dv[1] && dv[1] == dv[2]) return dv[0] == 0 ? Meet::General : Meet::None;
-    for (int i = 0; i < 3; ++i) du[i] = orient3d_sign(v[0], v[1], v[2], u[i]);
+    orient3d_signs(v[0], v[1], v[2], u, du);
     if (du[0] == du[1] && du[1] == du[2]) return du[0] == 0 ? Meet::General : Meet::None;
     // Both have non-zero area (a zero-area triangle puts every point on its "plane") and they
     // are not coplanar. Guigue-Devillers: rotate each so its apex comes first, flip the other's
