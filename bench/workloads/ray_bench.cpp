@@ -51,68 +51,71 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
         const std::vector<Ray3f> r1 = camera_rays(bounds, options.camera_size, options.camera_size);
         const std::vector<Ray3f> r2 = random_rays(bounds, options.random_rays, 1);
 
-        // Build: from a mesh in memory to a tree ready to trace, for both libraries.
-        TriangleBvh<float> ours;
+        // Build: from a mesh in memory to a tree ready to trace, for both libraries. bvhkit's
+        // default traces the four-wide layout; the binary layout is measured beside it.
+        TriangleBvh<float> ours, binary;
+        TriangleBvhOptions binary_options(build_options);
+        binary_options.ray_layout = RayLayout::Binary;
         const auto build_ours = [&] { ours = TriangleBvh<float>(mesh, build_options); };
+        const auto build_binary = [&] { binary = TriangleBvh<float>(mesh, binary_options); };
 #if BVHKIT_HAVE_EMBREE
         EmbreeScene embree(mesh, 1);
-        const auto [our_build, peer_build] =
-            median_ms_interleaved(options.repetitions, build_ours, [&] { embree.build(mesh); });
+        const std::vector<double> build_ms = median_ms_interleaved(
+            options.repetitions, {build_ours, build_binary, [&] { embree.build(mesh); }});
 #else
-        const double our_build = median_ms(options.repetitions, build_ours);
+        const std::vector<double> build_ms =
+            median_ms_interleaved(options.repetitions, {build_ours, build_binary});
 #endif
-        Row build_row = row_for("build", "bvhkit");
-        build_row.set("ms", our_build).set("sah_cost", statistics(ours.bvh()).sah_cost);
-#if BVHKIT_HAVE_EMBREE
-        build_row.set("speedup", peer_build / our_build);
-        rows.push_back(build_row);
-        rows.push_back(row_for("build", "embree3").set("ms", peer_build));
-#else
-        rows.push_back(build_row);
-#endif
+        for (int layout = 0; layout < 2; ++layout) {
+            Row row = row_for("build", layout == 0 ? "bvhkit" : "bvhkit-binary");
+            row.set("ms", build_ms[layout]).set("sah_cost", statistics(ours.bvh()).sah_cost);
+            if (build_ms.size() == 3) row.set("speedup", build_ms[2] / build_ms[layout]);
+            rows.push_back(row);
+        }
+        if (build_ms.size() == 3)
+            rows.push_back(row_for("build", "embree3").set("ms", build_ms[2]));
 
         for (const Workload& w :
              {Workload{"R1", &r1, false}, Workload{"R2", &r2, false}, Workload{"R3", &r2, true}}) {
             if (progress) std::fprintf(progress, "  %s ...\n", w.name);
-            std::size_t our_hits = 0;
+            std::size_t hits[3] = {};
             // In its own file: see ray_timed_calls.cpp.
-            const auto trace_ours = [&] { our_hits = trace_rays(ours, *w.rays, w.occlusion); };
+            std::vector<std::function<void()>> runs{
+                [&] { hits[0] = trace_rays(ours, *w.rays, w.occlusion); },
+                [&] { hits[1] = trace_rays(binary, *w.rays, w.occlusion); }};
 #if BVHKIT_HAVE_EMBREE
-            std::size_t peer_hits = 0;
-            const auto trace_peer = [&] {
-                peer_hits = 0;
+            runs.push_back([&] {
+                hits[2] = 0;
                 for (const auto& r : *w.rays)
-                    peer_hits += w.occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
-            };
-            const auto [our_ms, peer_ms] =
-                median_ms_interleaved(options.repetitions, trace_ours, trace_peer);
-#else
-            const double our_ms = median_ms(options.repetitions, trace_ours);
+                    hits[2] += w.occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
+            });
 #endif
-            // Tree quality per ray, counted in a separate untimed pass.
-            TraversalStats traversal;
-            for (const auto& r : *w.rays) {
-                if (w.occlusion)
-                    ours.any_hit(r, traversal);
-                else
-                    ours.closest_hit(r, traversal);
-            }
+            const std::vector<double> ms = median_ms_interleaved(options.repetitions, runs);
             const double n = double(w.rays->size());
-            Row row = row_for(w.name, "bvhkit");
-            row.set("rays", (long long)w.rays->size()).set("hits", (long long)our_hits);
-            row.set("ms", our_ms).set("mrays_per_s", n / our_ms / 1e3);
-            row.set("nodes_per_ray", double(traversal.nodes_visited) / n);
-            row.set("tris_per_ray", double(traversal.primitives_tested) / n);
-#if BVHKIT_HAVE_EMBREE
-            row.set("speedup", peer_ms / our_ms);
-            rows.push_back(row);
-            Row peer = row_for(w.name, "embree3");
-            peer.set("rays", (long long)w.rays->size()).set("hits", (long long)peer_hits);
-            peer.set("ms", peer_ms).set("mrays_per_s", n / peer_ms / 1e3);
-            rows.push_back(peer);
-#else
-            rows.push_back(row);
-#endif
+            for (int layout = 0; layout < 2; ++layout) {
+                // Tree quality per ray, counted in a separate untimed pass.
+                const TriangleBvh<float>& tree = layout == 0 ? ours : binary;
+                TraversalStats traversal;
+                for (const auto& r : *w.rays) {
+                    if (w.occlusion)
+                        tree.any_hit(r, traversal);
+                    else
+                        tree.closest_hit(r, traversal);
+                }
+                Row row = row_for(w.name, layout == 0 ? "bvhkit" : "bvhkit-binary");
+                row.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[layout]);
+                row.set("ms", ms[layout]).set("mrays_per_s", n / ms[layout] / 1e3);
+                row.set("nodes_per_ray", double(traversal.nodes_visited) / n);
+                row.set("tris_per_ray", double(traversal.primitives_tested) / n);
+                if (ms.size() == 3) row.set("speedup", ms[2] / ms[layout]);
+                rows.push_back(row);
+            }
+            if (ms.size() == 3) {
+                Row peer = row_for(w.name, "embree3");
+                peer.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[2]);
+                peer.set("ms", ms[2]).set("mrays_per_s", n / ms[2] / 1e3);
+                rows.push_back(peer);
+            }
         }
     }
     return rows;

@@ -24,16 +24,21 @@ double median_ms(int repetitions, const std::function<void()>& f, bool warm_up) 
     return median(times);
 }
 
+std::vector<double> median_ms_interleaved(int repetitions,
+                                          const std::vector<std::function<void()>>& fs) {
+    for (const auto& f : fs) f();  // warm-up
+    std::vector<std::vector<double>> times(fs.size());
+    for (int r = 0; r < std::max(1, repetitions); ++r)
+        for (std::size_t i = 0; i < fs.size(); ++i) times[i].push_back(median_ms(1, fs[i], false));
+    std::vector<double> out;
+    for (auto& t : times) out.push_back(median(t));
+    return out;
+}
+
 std::pair<double, double> median_ms_interleaved(int repetitions, const std::function<void()>& f,
                                                 const std::function<void()>& g) {
-    f();  // warm-up
-    g();
-    std::vector<double> tf, tg;
-    for (int r = 0; r < std::max(1, repetitions); ++r) {
-        tf.push_back(median_ms(1, f, false));
-        tg.push_back(median_ms(1, g, false));
-    }
-    return {median(tf), median(tg)};
+    const std::vector<double> t = median_ms_interleaved(repetitions, {f, g});
+    return {t[0], t[1]};
 }
 
 Row& Row::set(const std::string& key, Value v) {

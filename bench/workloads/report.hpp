@@ -21,6 +21,9 @@ double median(std::vector<double> values);
 /// change of load on a shared machine affects both alike and their ratio stays fair.
 std::pair<double, double> median_ms_interleaved(int repetitions, const std::function<void()>& f,
                                                 const std::function<void()>& g);
+/// The same for any number of functions, run in turn each repetition.
+std::vector<double> median_ms_interleaved(int repetitions,
+                                          const std::vector<std::function<void()>>& fs);
 
 /// One cell of a result row: text, an integer count or a real figure.
 using Value = std::variant<std::string, long long, double>;

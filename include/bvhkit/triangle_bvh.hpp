@@ -15,6 +15,7 @@
 #include "bvhkit/build/refit.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/ray.hpp"
+#include "bvhkit/query/ray_wide.hpp"
 
 namespace bvhkit {
 
@@ -23,10 +24,21 @@ enum class TriangleTest {
     Fast,        // Moller-Trumbore on precomputed edges: a ray can slip through a shared edge
 };
 
-/// How a TriangleBvh is built (every BuildOptions member) and which triangle test its queries run.
-/// Converts from BuildOptions, so `TriangleBvh<float>(mesh, build_options)` keeps working.
+/// Which tree rays walk. The wide layouts serve float trees with the watertight test, on x86
+/// (query/ray_wide.hpp); anything else walks the binary tree.
+enum class RayLayout {
+    Auto,    // eight wide when the CPU has AVX2, else four wide (the default)
+    Wide8,   // eight wide; four wide on a CPU without AVX2
+    Wide4,   // four wide (SSE2)
+    Binary,  // the binary tree only
+};
+
+/// How a TriangleBvh is built (every BuildOptions member), which triangle test its queries run and
+/// on which layout. Converts from BuildOptions, so `TriangleBvh<float>(mesh, build_options)` keeps
+/// working.
 struct TriangleBvhOptions : BuildOptions {
     TriangleTest triangle_test = TriangleTest::Watertight;
+    RayLayout ray_layout = RayLayout::Auto;
 
     TriangleBvhOptions() = default;
     TriangleBvhOptions(const BuildOptions& build) : BuildOptions(build) {}  // NOLINT: implicit
@@ -39,7 +51,7 @@ class TriangleBvh {
 
     template <IndexedTriangleMesh M>
     explicit TriangleBvh(const M& mesh, const TriangleBvhOptions& options = {})
-        : triangle_test_(options.triangle_test) {
+        : triangle_test_(options.triangle_test), ray_layout_(options.ray_layout) {
         check_triangle_indices(mesh);
         build([&](std::size_t i) { return triangle_at<T>(mesh, i); }, mesh.triangle_count(),
               options);
@@ -47,13 +59,27 @@ class TriangleBvh {
 
     explicit TriangleBvh(const std::vector<Triangle<T>>& triangles,
                          const TriangleBvhOptions& options = {})
-        : triangle_test_(options.triangle_test) {
+        : triangle_test_(options.triangle_test), ray_layout_(options.ray_layout) {
         build([&](std::size_t i) { return triangles[i]; }, triangles.size(), options);
     }
 
     Hit<T> closest_hit(const Ray<T, 3>& ray) const { return closest_hit(ray, NoStats{}); }
     template <class Stats>
     Hit<T> closest_hit(const Ray<T, 3>& ray, Stats&& stats) const {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>) {
+            if (traces_wide() && wide_ray_usable(ray)) {
+                TriangleHit<float> h;
+                std::uint32_t slot;
+                const WatertightRay<float> prep(ray);
+                const bool hit = wide8_.empty()
+                                     ? closest_hit_wide(wide4_, ray, prep, h, slot, stats)
+                                     : closest_hit_wide(wide8_, ray, prep, h, slot, stats);
+                if (!hit) return Hit<T>{};
+                return Hit<T>{h.t, bvh_.primitive_indices[slot], h.u, h.v, exact_[slot].normal()};
+            }
+        }
+#endif
         if (triangle_test_ == TriangleTest::Watertight)
             return bvhkit::closest_hit(bvh_, ray, WatertightTest{exact_.data(), ray}, stats);
         return bvhkit::closest_hit(bvh_, ray, FastTest{fast_.data()}, stats);
@@ -62,6 +88,12 @@ class TriangleBvh {
     bool any_hit(const Ray<T, 3>& ray) const { return any_hit(ray, NoStats{}); }
     template <class Stats>
     bool any_hit(const Ray<T, 3>& ray, Stats&& stats) const {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>)
+            if (traces_wide() && wide_ray_usable(ray))
+                return wide8_.empty() ? any_hit_wide(wide4_, ray, WatertightRay<float>(ray), stats)
+                                      : any_hit_wide(wide8_, ray, WatertightRay<float>(ray), stats);
+#endif
         if (triangle_test_ == TriangleTest::Watertight)
             return bvhkit::any_hit(bvh_, ray, WatertightTest{exact_.data(), ray}, stats);
         return bvhkit::any_hit(bvh_, ray, FastTest{fast_.data()}, stats);
@@ -77,6 +109,9 @@ class TriangleBvh {
     }
 
     TriangleTest triangle_test() const { return triangle_test_; }
+    /// The width of the tree rays walk: 8 or 4 (a wide layout), or 2 (the binary tree).
+    int ray_width() const { return !wide8_.empty() ? 8 : !wide4_.empty() ? 4 : 2; }
+    bool traces_wide() const { return ray_width() > 2; }
 
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
     template <IndexedTriangleMesh M>
@@ -125,6 +160,20 @@ class TriangleBvh {
             fast_.reserve(order.size());
             for (std::uint32_t i : order) fast_.emplace_back(triangle(i));
         }
+        wide4_ = {};
+        wide8_ = {};
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>) {
+            if (ray_layout_ == RayLayout::Binary || triangle_test_ != TriangleTest::Watertight ||
+                bvh_.empty())
+                return;
+            const auto at = [&](std::uint32_t slot) { return exact_[slot]; };
+            if (ray_layout_ != RayLayout::Wide4 && cpu_has_avx2())
+                wide8_ = make_wide_ray_bvh<8>(bvh_, at);
+            else
+                wide4_ = make_wide_ray_bvh<4>(bvh_, at);
+        }
+#endif
     }
 
     // The leaf tests (query/ray.hpp): the watertight one carries its per-ray constants, made once
@@ -154,6 +203,9 @@ class TriangleBvh {
     BuildReport report_;
     std::size_t triangle_count_ = 0;
     TriangleTest triangle_test_ = TriangleTest::Watertight;
+    RayLayout ray_layout_ = RayLayout::Auto;
+    WideRayBvh<4> wide4_;  // at most one of the two is filled (float, watertight, x86 only)
+    WideRayBvh<8> wide8_;
 };
 
 }  // namespace bvhkit

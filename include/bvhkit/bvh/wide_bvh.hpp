@@ -1,9 +1,10 @@
 #pragma once
-// WideBvh4<T>: a binary Bvh of 3D boxes collapsed into nodes of up to four children whose boxes
-// lie side by side, one array per axis and bound, so that one SSE instruction measures a point
-// against all four (the wide layout of Wald, Benthin and Boulos 2008, "Getting rid of packets",
-// and Dammertz et al. 2008, "Shallow bounding volume hierarchies"). Half as many levels as the
-// binary tree means half as many dependent loads on a walk that misses the caches at every node.
+// WideBvh<T, W> (WideBvh4<T> for W = 4): a binary Bvh of 3D boxes collapsed into nodes of up to W
+// children whose boxes lie side by side, one array per axis and bound, so that one SIMD instruction
+// measures a point against all of them (W = 4 for SSE, 8 for AVX) (the wide layout of Wald, Benthin
+// and Boulos 2008, "Getting rid of packets", and Dammertz et al. 2008, "Shallow bounding volume
+// hierarchies"). Half as many levels as the binary tree means half as many dependent loads on a
+// walk that misses the caches at every node.
 //
 // A leaf child is a run of groups of four leaf slots of the binary tree (its primitive slots, in
 // groups so that a caller can store four primitives side by side too); invalid_index pads a
@@ -18,13 +19,14 @@
 
 namespace bvhkit {
 
-template <class T>
-struct alignas(64) WideNode4 {
-    T lo[3][4];  // lo[axis][child]: the children's boxes
-    T hi[3][4];
+template <class T, int W = 4>
+struct alignas(64) WideNode {
+    static constexpr int width = W;
+    T lo[3][W];  // lo[axis][child]: the children's boxes
+    T hi[3][W];
     std::uint32_t
-        child[4];  // inner child: node index; leaf child: first group; invalid_index: no child
-    std::uint32_t groups[4];  // leaf child: how many groups; 0 for an inner child or none
+        child[W];  // inner child: node index; leaf child: first group; invalid_index: no child
+    std::uint32_t groups[W];  // leaf child: how many groups; 0 for an inner child or none
 
     bool is_leaf(int c) const { return groups[c] != 0; }
     bool has(int c) const { return child[c] != invalid_index; }
@@ -33,20 +35,25 @@ struct alignas(64) WideNode4 {
     }
 };
 
-template <class T>
-struct WideBvh4 {
-    std::vector<WideNode4<T>> nodes;         // nodes[0] is the root; empty for an empty tree
+template <class T, int W = 4>
+struct WideBvh {
+    std::vector<WideNode<T, W>> nodes;       // nodes[0] is the root; empty for an empty tree
     std::vector<std::uint32_t> group_slots;  // four slots a group; invalid_index pads
 
     bool empty() const { return nodes.empty(); }
     std::size_t group_count() const { return group_slots.size() / 4; }
 };
 
-/// Collapses `bvh` into a WideBvh4. An inner binary node takes up to four children by opening, of
-/// its children and grandchildren, the one of largest area until four or none is left to open.
 template <class T>
-WideBvh4<T> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4) {
-    WideBvh4<T> out;
+using WideNode4 = WideNode<T, 4>;
+template <class T>
+using WideBvh4 = WideBvh<T, 4>;
+
+/// Collapses `bvh` into a WideBvh<T, W>. An inner binary node takes up to W children by opening,
+/// of its children and grandchildren, the one of largest area until W or none is left to open.
+template <class T, int W = 4>
+WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4) {
+    WideBvh<T, W> out;
     if (bvh.empty()) return out;
     const auto& nodes = bvh.nodes;
 
@@ -94,11 +101,12 @@ WideBvh4<T> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limi
     while (!work.empty()) {
         const auto [b, w] = work.back();
         work.pop_back();
-        std::uint32_t lanes[4] = {b, invalid_index, invalid_index, invalid_index};
+        std::uint32_t lanes[W];
+        lanes[0] = b;
         int size = 1;
         if (opens(b)) {
             lanes[0] = nodes[b].left(), lanes[1] = nodes[b].right(), size = 2;
-            while (size < 4) {
+            while (size < W) {
                 int pick = -1;
                 for (int c = 0; c < size; ++c)
                     if (opens(lanes[c]) && (pick < 0 || nodes[lanes[c]].bounds.area() >
@@ -110,8 +118,8 @@ WideBvh4<T> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limi
                 lanes[size++] = nodes[opened].right();
             }
         }
-        WideNode4<T> node{};
-        for (int c = 0; c < 4; ++c) {
+        WideNode<T, W> node{};
+        for (int c = 0; c < W; ++c) {
             node.child[c] = invalid_index;
             for (int a = 0; a < 3; ++a) node.lo[a][c] = T(0), node.hi[a][c] = T(0);
         }
@@ -134,9 +142,9 @@ WideBvh4<T> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limi
 
 /// Throws Error unless `wide` holds every slot of [0, slot_boxes.size()) exactly once, each inside
 /// its leaf child's box, and every inner child's box holds its node's boxes.
-template <class T>
-void validate(const WideBvh4<T>& wide, const std::vector<Aabb<T, 3>>& slot_boxes) {
-    const auto fail = [](const std::string& what) { throw Error("WideBvh4: " + what); };
+template <class T, int W>
+void validate(const WideBvh<T, W>& wide, const std::vector<Aabb<T, 3>>& slot_boxes) {
+    const auto fail = [](const std::string& what) { throw Error("WideBvh: " + what); };
     if (wide.empty()) {
         if (!slot_boxes.empty())
             fail("empty tree over " + std::to_string(slot_boxes.size()) + " slots");
@@ -152,14 +160,14 @@ void validate(const WideBvh4<T>& wide, const std::vector<Aabb<T, 3>>& slot_boxes
             fail("node " + std::to_string(w) + " reached twice or out of range");
         const auto& node = wide.nodes[w];
         if (!node.has(0)) fail("node " + std::to_string(w) + " has no first child");
-        for (int c = 0; c < 4; ++c) {
+        for (int c = 0; c < W; ++c) {
             if (!node.has(c)) continue;
             const Aabb<T, 3> box = node.box(c);
             if (!node.is_leaf(c)) {
                 const std::uint32_t k = node.child[c];
                 if (k <= w || k >= wide.nodes.size())
                     fail("child " + std::to_string(k) + " of node " + std::to_string(w));
-                for (int d = 0; d < 4; ++d)
+                for (int d = 0; d < W; ++d)
                     if (wide.nodes[k].has(d) && !box.contains(wide.nodes[k].box(d)))
                         fail("node " + std::to_string(w) + " lane " + std::to_string(c) +
                              " does not hold its child's boxes");

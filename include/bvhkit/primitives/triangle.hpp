@@ -77,20 +77,15 @@ template <class T>
 }
 }  // namespace detail
 
-/// The watertight test of the triangle (p0, p1, p2) for a ray prepared as `r`: hits with t in
-/// [tmin, tmax]. A ray through an edge or vertex shared by two triangles hits at least one of them
-/// (edge functions of zero count as inside). Degenerate triangles and rays in the triangle's plane
-/// (det = 0) miss, as does a hit whose t is not finite (a subnormal direction whose t overflows).
+/// The watertight test's second half, for the triangle's corners already moved to the ray's origin
+/// and sheared (a*, b*, c*: corners p0, p1, p2; x, y sheared, z along the ray): the edge functions
+/// and t in `Wide`. Shared by the scalar test below and the four-abreast one
+/// (primitives/triangle_group4.hpp), which shears in SIMD and finishes here.
 template <class T>
-inline bool intersect_watertight(const WatertightRay<T>& r, const Vec<T, 3>& p0,
-                                 const Vec<T, 3>& p1, const Vec<T, 3>& p2, T tmin, T tmax,
-                                 TriangleHit<T>& hit) {
+inline bool watertight_finish(const WatertightRay<T>& r, T ax_, T ay_, T az, T bx_, T by_, T bz,
+                              T cx_, T cy_, T cz, T tmin, T tmax, TriangleHit<T>& hit) {
     using W = typename WatertightRay<T>::Wide;
-    // Vertices relative to the origin, sheared so that the ray runs along the kz axis.
-    const T az = p0[r.kz] - r.oz, bz = p1[r.kz] - r.oz, cz = p2[r.kz] - r.oz;
-    const W ax = p0[r.kx] - r.ox - r.sx * az, ay = p0[r.ky] - r.oy - r.sy * az;
-    const W bx = p1[r.kx] - r.ox - r.sx * bz, by = p1[r.ky] - r.oy - r.sy * bz;
-    const W cx = p2[r.kx] - r.ox - r.sx * cz, cy = p2[r.ky] - r.oy - r.sy * cz;
+    const W ax = ax_, ay = ay_, bx = bx_, by = by_, cx = cx_, cy = cy_;
     using detail::opaque;
     const W eu = opaque(cx * by) - opaque(cy * bx);  // edge b-c: weight of p0
     const W ev = opaque(ax * cy) - opaque(ay * cx);  // edge c-a: weight of p1
@@ -105,6 +100,25 @@ inline bool intersect_watertight(const WatertightRay<T>& r, const Vec<T, 3>& p0,
     const W inv_det = W(1) / det;
     hit = {t, T(ev * inv_det), T(ew * inv_det)};
     return true;
+}
+
+/// The watertight test of the triangle (p0, p1, p2) for a ray prepared as `r`: hits with t in
+/// [tmin, tmax]. A ray through an edge or vertex shared by two triangles hits at least one of them
+/// (edge functions of zero count as inside). Degenerate triangles and rays in the triangle's plane
+/// (det = 0) miss, as does a hit whose t is not finite (a subnormal direction whose t overflows).
+template <class T>
+inline bool intersect_watertight(const WatertightRay<T>& r, const Vec<T, 3>& p0,
+                                 const Vec<T, 3>& p1, const Vec<T, 3>& p2, T tmin, T tmax,
+                                 TriangleHit<T>& hit) {
+    // Vertices relative to the origin, sheared so that the ray runs along the kz axis. The
+    // products are kept apart from the subtractions, as in the four-abreast test, so both round
+    // alike whatever the compiler would contract.
+    using detail::opaque;
+    const T az = p0[r.kz] - r.oz, bz = p1[r.kz] - r.oz, cz = p2[r.kz] - r.oz;
+    const T ax = (p0[r.kx] - r.ox) - opaque(r.sx * az), ay = (p0[r.ky] - r.oy) - opaque(r.sy * az);
+    const T bx = (p1[r.kx] - r.ox) - opaque(r.sx * bz), by = (p1[r.ky] - r.oy) - opaque(r.sy * bz);
+    const T cx = (p2[r.kx] - r.ox) - opaque(r.sx * cz), cy = (p2[r.ky] - r.oy) - opaque(r.sy * cz);
+    return watertight_finish(r, ax, ay, az, bx, by, bz, cx, cy, cz, tmin, tmax, hit);
 }
 
 template <class T>

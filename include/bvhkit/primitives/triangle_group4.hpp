@@ -1,0 +1,108 @@
+#pragma once
+// TriangleGroup4: four float triangles side by side (each corner coordinate an array of four), and
+// the watertight ray test of Woop, Benthin and Wald 2013 run on all four at once.
+//
+// The test keeps the scalar test's answers (primitives/triangle.hpp). The corners are moved to the
+// ray's origin and sheared in SSE with the same float operations as the scalar code. The edge
+// functions are then formed in float, as a filter: rounding is monotonic, so fl(a b) - fl(c d) is
+// never of the opposite sign to a b - c d (at worst it is zero; overflow to inf keeps the order
+// too), and a lane whose float edge functions have strictly mixed signs has mixed exact signs,
+// which the scalar test rejects. Every other lane, padding excluded, is finished in double by
+// watertight_finish on the same sheared floats, so a hit, its t and barycentrics are the scalar
+// test's.
+#include <cstdint>
+
+#include "bvhkit/primitives/triangle.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace bvhkit {
+
+struct alignas(16) TriangleGroup4 {
+    float corner[9][4];  // corner[3 * k + axis][lane]: corner k (p0, p1, p2) of the lane's triangle
+    std::uint32_t slot[4];  // the lane's triangle (the caller's index); invalid_index pads
+
+    /// Puts `tri` in `lane` as triangle `index`.
+    void set(int lane, const Triangle<float>& tri, std::uint32_t index) {
+        const Vec<float, 3>* p[3] = {&tri.p0, &tri.p1, &tri.p2};
+        for (int k = 0; k < 3; ++k)
+            for (int a = 0; a < 3; ++a) corner[3 * k + a][lane] = (*p[k])[a];
+        slot[lane] = index;
+    }
+    /// An empty lane: never tested.
+    void clear(int lane) {
+        for (auto& c : corner) c[lane] = 0.0f;
+        slot[lane] = invalid_index;
+    }
+};
+
+#if defined(__SSE2__)
+/// The ray's constants of the watertight test, as SSE registers.
+struct WatertightRay4 {
+    const WatertightRay<float>& ray;
+    __m128 ox, oy, oz, sx, sy;
+
+    explicit WatertightRay4(const WatertightRay<float>& r)
+        : ray(r),
+          ox(_mm_set1_ps(r.ox)),
+          oy(_mm_set1_ps(r.oy)),
+          oz(_mm_set1_ps(r.oz)),
+          sx(_mm_set1_ps(r.sx)),
+          sy(_mm_set1_ps(r.sy)) {}
+};
+
+namespace detail {
+// Lanes whose float edge function x0 y1 - y0 x1 is below zero, and above: an exact sign.
+[[gnu::always_inline]] inline void edge_signs(__m128 x0, __m128 y1, __m128 y0, __m128 x1,
+                                              __m128& negative, __m128& positive) {
+    const __m128 e = _mm_sub_ps(_mm_mul_ps(x0, y1), _mm_mul_ps(y0, x1));
+    negative = _mm_or_ps(negative, _mm_cmplt_ps(e, _mm_setzero_ps()));
+    positive = _mm_or_ps(positive, _mm_cmpgt_ps(e, _mm_setzero_ps()));
+}
+}  // namespace detail
+
+/// Tests the ray against the group's triangles; for each hit with t in [tmin, tmax] calls
+/// on_hit(lane, hit), which returns the new tmax (the caller's closest so far, or anything to go
+/// on). The lanes are finished in order 0..3 with tmax shrinking as they hit.
+template <class OnHit>
+[[gnu::always_inline]] inline void intersect_watertight4(const WatertightRay4& r,
+                                                         const TriangleGroup4& g, float tmin,
+                                                         float& tmax, OnHit&& on_hit) {
+    const WatertightRay<float>& s = r.ray;
+    const auto corner = [&](int k, std::uint32_t axis) {
+        return _mm_load_ps(g.corner[3 * k + axis]);
+    };
+    __m128 x[3], y[3], z[3];
+    for (int k = 0; k < 3; ++k) {
+        z[k] = _mm_sub_ps(corner(k, s.kz), r.oz);
+        x[k] = _mm_sub_ps(_mm_sub_ps(corner(k, s.kx), r.ox), _mm_mul_ps(r.sx, z[k]));
+        y[k] = _mm_sub_ps(_mm_sub_ps(corner(k, s.ky), r.oy), _mm_mul_ps(r.sy, z[k]));
+    }
+    __m128 negative = _mm_setzero_ps(), positive = _mm_setzero_ps();
+    detail::edge_signs(x[2], y[1], y[2], x[1], negative, positive);  // eu = cx by - cy bx
+    detail::edge_signs(x[0], y[2], y[0], x[2], negative, positive);  // ev = ax cy - ay cx
+    detail::edge_signs(x[1], y[0], y[1], x[0], negative, positive);  // ew = bx ay - by ax
+    const __m128i pad = _mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(g.slot)),
+                                        _mm_set1_epi32(-1));
+    const unsigned rejected =
+        unsigned(_mm_movemask_ps(_mm_or_ps(_mm_and_ps(negative, positive), _mm_castsi128_ps(pad))));
+    if (rejected == 0xFu) return;
+    alignas(16) float v[9][4];
+    for (int k = 0; k < 3; ++k) {
+        _mm_store_ps(v[3 * k], x[k]);
+        _mm_store_ps(v[3 * k + 1], y[k]);
+        _mm_store_ps(v[3 * k + 2], z[k]);
+    }
+    for (int lane = 0; lane < 4; ++lane) {
+        if ((rejected >> lane) & 1u) continue;
+        TriangleHit<float> h;
+        if (watertight_finish(s, v[0][lane], v[1][lane], v[2][lane], v[3][lane], v[4][lane],
+                              v[5][lane], v[6][lane], v[7][lane], v[8][lane], tmin, tmax, h))
+            tmax = on_hit(lane, h);
+    }
+}
+#endif
+
+}  // namespace bvhkit

@@ -1,0 +1,240 @@
+// The four-wide ray layout (query/ray_wide.hpp) against the binary walk, and the four-abreast
+// watertight test (primitives/triangle_group4.hpp) against the scalar one. Both must give the same
+// answers to the bit: the wide walk only changes the order in which boxes are opened, and the
+// four-abreast test must reject a lane only when the scalar test would. Whether those answers are
+// right is judged against a long-double reference in ray_exactness_test.cpp, which runs on the
+// wide layout (TriangleBvh<float>'s default).
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "bvhkit/io/read_mesh.hpp"
+#include "bvhkit/mesh/procedural.hpp"
+#include "bvhkit/primitives/triangle_group4.hpp"
+#include "bvhkit/triangle_bvh.hpp"
+#include "random_geometry.hpp"
+#include "test_support.hpp"
+
+using namespace bvhkit;
+
+namespace {
+
+bool same_bits(float a, float b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+std::vector<Triangle<float>> placed(const TriangleMesh& mesh, double scale, double offset) {
+    std::vector<Triangle<float>> out;
+    const auto at = [&](std::uint32_t v) {
+        Vec<float, 3> p;
+        for (int k = 0; k < 3; ++k) p[k] = float(double(mesh.vertices[v][k]) * scale + offset);
+        return p;
+    };
+    for (const auto& t : mesh.triangles) out.push_back({at(t[0]), at(t[1]), at(t[2])});
+    return out;
+}
+
+/// Rays through the triangles' bounding box: from outside and inside, some aimed exactly at a
+/// vertex or along an axis, some with direction components +0, -0 or subnormal.
+std::vector<Ray3f> rays_for(const std::vector<Triangle<float>>& tris, std::size_t n,
+                            std::uint64_t seed) {
+    Aabb3f box;
+    for (const auto& t : tris) box.grow(t.bounds());
+    const Vec<double, 3> lo{box.min[0], box.min[1], box.min[2]};
+    const Vec<double, 3> ext{double(box.max[0]) - lo[0], double(box.max[1]) - lo[1],
+                             double(box.max[2]) - lo[2]};
+    test::Random rng(seed);
+    std::vector<Ray3f> rays;
+    for (std::size_t i = 0; i < n; ++i) {
+        Vec<double, 3> o, target;
+        const double spread = i % 5 == 0 ? 0.5 : 3.0;  // one in five starts inside the box
+        for (int k = 0; k < 3; ++k) {
+            o[k] = lo[k] + ext[k] * (0.5 + spread * rng.uniform(-0.5, 0.5));
+            target[k] = lo[k] + ext[k] * rng.uniform(0, 1);
+        }
+        if (i % 7 == 0) {
+            const auto& t = tris[rng.below(std::uint32_t(tris.size()))];
+            target = {t.p0[0], t.p0[1], t.p0[2]};
+        }
+        Ray3f ray;
+        for (int k = 0; k < 3; ++k) {
+            ray.origin[k] = float(o[k]);
+            ray.direction[k] = float(target[k] - double(ray.origin[k]));
+        }
+        if (i % 4 == 1) ray.direction[i % 3] = (i / 4) % 2 ? 0.0f : -0.0f;
+        if (i % 11 == 3) ray.direction[(i + 1) % 3] = (i / 11) % 2 ? 1e-40f : -1e-41f;
+        if (i % 13 == 5) ray.tmax = float(rng.uniform(0, 1));  // short rays
+        rays.push_back(ray);
+    }
+    return rays;
+}
+
+/// The same hits from both layouts. Where two triangles are hit at the same t (a ray through a
+/// shared vertex or edge), which one is reported depends on the order they are tested in, so then
+/// the t must be the same and each must really be hit there.
+void expect_same(const TriangleBvh<float>& wide, const TriangleBvh<float>& binary,
+                 const std::vector<Triangle<float>>& tris, const std::vector<Ray3f>& rays) {
+    std::size_t hits = 0, ties = 0;
+    for (std::size_t r = 0; r < rays.size(); ++r) {
+        const Hit<float> a = wide.closest_hit(rays[r]), b = binary.closest_hit(rays[r]);
+        ASSERT_EQ(bool(a), bool(b)) << "ray " << r;
+        if (a.primitive != b.primitive) {
+            ++ties;
+            ASSERT_TRUE(same_bits(a.t, b.t)) << "ray " << r << ": t " << a.t << " vs " << b.t;
+            const auto h = tris[a.primitive].intersect_watertight(rays[r]);
+            ASSERT_TRUE(h && same_bits(h->t, a.t) && same_bits(h->u, a.u) && same_bits(h->v, a.v))
+                << "ray " << r;
+            continue;
+        }
+        ASSERT_TRUE(same_bits(a.t, b.t) && same_bits(a.u, b.u) && same_bits(a.v, b.v))
+            << "ray " << r << ": t " << a.t << " vs " << b.t;
+        ASSERT_EQ(a.normal, b.normal) << "ray " << r;
+        ASSERT_EQ(wide.any_hit(rays[r]), binary.any_hit(rays[r])) << "ray " << r;
+        hits += bool(a);
+    }
+    // Enough hits and misses for the comparison to mean something.
+    EXPECT_GT(hits, rays.size() / 20);
+    EXPECT_LT(hits, rays.size());
+    EXPECT_LT(ties, rays.size() / 10);
+}
+
+}  // namespace
+
+TEST(WideRays, LayoutChosenAsDocumented) {
+    const TriangleMesh mesh = make_sphere(2);
+    EXPECT_EQ(TriangleBvh<float>(mesh).ray_width(), cpu_has_avx2() ? 8 : 4);
+    TriangleBvhOptions four, eight;
+    four.ray_layout = RayLayout::Wide4;
+    eight.ray_layout = RayLayout::Wide8;
+    EXPECT_EQ(TriangleBvh<float>(mesh, four).ray_width(), 4);
+    EXPECT_EQ(TriangleBvh<float>(mesh, eight).ray_width(), cpu_has_avx2() ? 8 : 4);
+    EXPECT_FALSE(TriangleBvh<double>(mesh).traces_wide());
+    TriangleBvhOptions fast, binary;
+    fast.triangle_test = TriangleTest::Fast;
+    binary.ray_layout = RayLayout::Binary;
+    EXPECT_FALSE(TriangleBvh<float>(mesh, fast).traces_wide());
+    EXPECT_FALSE(TriangleBvh<float>(mesh, binary).traces_wide());
+    EXPECT_FALSE(TriangleBvh<float>(TriangleMesh{}).traces_wide());
+    EXPECT_FALSE(TriangleBvh<float>(TriangleMesh{}).closest_hit(Ray3f({0, 0, 0}, {1, 0, 0})));
+}
+
+TEST(WideRays, SameAnswersAsTheBinaryWalkOnHardGeometry) {
+    struct Case {
+        std::string name;
+        std::vector<Triangle<float>> tris;
+    };
+    std::vector<Case> cases{{"sphere", placed(make_sphere(4), 1, 0)},
+                            {"torus", placed(make_torus(96, 48), 1, 0)},
+                            {"far sphere", placed(make_sphere(3), 1, 1e5)},
+                            {"tiny sphere", placed(make_sphere(3), 1e-6, 0)},
+                            {"huge terrain", placed(make_terrain(64), 1e6, 0)}};
+    // Needles and slivers, duplicates and zero-area triangles.
+    test::Random rng(7);
+    std::vector<Triangle<float>> odd;
+    for (int i = 0; i < 1500; ++i) {
+        Vec3f a, d, s;
+        for (int k = 0; k < 3; ++k) {
+            a[k] = float(rng.uniform(-1, 1));
+            d[k] = float(rng.uniform(-1, 1));
+            s[k] = float(rng.uniform(-1, 1));
+        }
+        const float width = float(std::pow(10.0, rng.uniform(-6, -2)));
+        odd.push_back({a, a + d, a + d * 0.5f + s * width});
+        if (i % 10 == 0) odd.push_back(odd.back());                // a duplicate
+        if (i % 15 == 0) odd.push_back({a, a + d, a + d * 2.0f});  // collinear: zero area
+        if (i % 20 == 0) odd.push_back({a, a, a});                 // a point
+    }
+    cases.push_back({"needles", odd});
+    if (const auto spot = test::shared_mesh("spot.obj"); !spot.empty())
+        cases.push_back({"spot", placed(read_mesh(spot), 1, 0)});
+    TriangleBvhOptions binary, four, eight;
+    binary.ray_layout = RayLayout::Binary;
+    four.ray_layout = RayLayout::Wide4;
+    eight.ray_layout = RayLayout::Wide8;
+    for (const Case& c : cases) {
+        const TriangleBvh<float> flat(c.tris, binary);
+        const auto rays = rays_for(c.tris, test::scaled(20000), 3);
+        // Every width this CPU runs (eight needs AVX2).
+        for (const auto& options : {four, eight}) {
+            const TriangleBvh<float> wide(c.tris, options);
+            SCOPED_TRACE(c.name + ", width " + std::to_string(wide.ray_width()));
+            expect_same(wide, flat, c.tris, rays);
+            if (testing::Test::HasFatalFailure()) return;
+        }
+    }
+}
+
+TEST(WideRays, RefitKeepsTheWideLayoutInStep) {
+    TriangleMesh mesh = make_sphere(4);
+    TriangleBvhOptions binary;
+    binary.ray_layout = RayLayout::Binary;
+    TriangleBvh<float> wide(mesh), flat(mesh, binary);
+    ASSERT_TRUE(wide.traces_wide());
+    for (auto& v : mesh.vertices) v = v * (1.0f + 0.3f * v[0]) + Vec3f{0.1f, 0, 0};
+    wide.refit(mesh);
+    flat.refit(mesh);
+    const auto tris = placed(mesh, 1, 0);
+    expect_same(wide, flat, tris, rays_for(tris, test::scaled(5000), 5));
+}
+
+// Every lane of the four-abreast test against the scalar test, with the whole range open (so that
+// every hit is reported), on triangles and rays chosen to sit at the edge of the float filter:
+// rays through vertices and edges, needles, zero-area triangles, coordinates from 1e-30 to 1e30.
+TEST(WideRays, FourAbreastTestEqualsTheScalarTest) {
+    test::Random rng(11);
+    const std::size_t n = test::scaled(200000);
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double scale = std::pow(10.0, rng.uniform(-30, 30) * (i % 3 == 0));
+        TriangleGroup4 group;
+        Triangle<float> tris[4];
+        for (int lane = 0; lane < 4; ++lane) {
+            Vec3f p[3];
+            for (auto& q : p)
+                for (int k = 0; k < 3; ++k) q[k] = float(rng.uniform(-1, 1) * scale);
+            if (lane == 1) p[2] = p[0] + (p[1] - p[0]) * float(rng.uniform(0, 1));  // zero area
+            if (lane == 2) p[2] = p[1] + Vec3f{1e-7f, 0, 0} * float(scale);         // a needle
+            tris[lane] = {p[0], p[1], p[2]};
+            group.set(lane, tris[lane], std::uint32_t(lane));
+        }
+        if (i % 9 == 0) group.clear(3);
+        // Aim at a vertex, an edge point or an inside point of one lane's triangle.
+        const Triangle<float>& aim = tris[rng.below(4)];
+        const float a = float(rng.uniform(0, 1));
+        Vec3f target = i % 3 == 0   ? aim.p1
+                       : i % 3 == 1 ? aim.p0 + (aim.p2 - aim.p0) * a
+                                    : (aim.p0 + aim.p1 + aim.p2) * (1.0f / 3.0f);
+        Ray3f ray;
+        for (int k = 0; k < 3; ++k) ray.origin[k] = float(rng.uniform(-3, 3) * scale);
+        ray.direction = target - ray.origin;
+        if (i % 10 == 0) ray.direction[i % 3] = 0.0f;
+        const WatertightRay<float> prep(ray);
+        bool got[4] = {}, want[4] = {};
+        TriangleHit<float> got_hit[4], want_hit[4];
+        float tmax = ray.tmax;
+        intersect_watertight4(WatertightRay4(prep), group, ray.tmin, tmax,
+                              [&](int lane, const TriangleHit<float>& h) {
+                                  got[lane] = true;
+                                  got_hit[lane] = h;
+                                  return ray.tmax;  // keep the whole range open
+                              });
+        for (int lane = 0; lane < 4; ++lane) {
+            if (group.slot[lane] == invalid_index) continue;
+            want[lane] = intersect_watertight(prep, tris[lane].p0, tris[lane].p1, tris[lane].p2,
+                                              ray.tmin, ray.tmax, want_hit[lane]);
+            ASSERT_EQ(got[lane], want[lane]) << "case " << i << " lane " << lane;
+            if (want[lane]) {
+                ++hits;
+                ASSERT_TRUE(same_bits(got_hit[lane].t, want_hit[lane].t) &&
+                            same_bits(got_hit[lane].u, want_hit[lane].u) &&
+                            same_bits(got_hit[lane].v, want_hit[lane].v))
+                    << "case " << i << " lane " << lane;
+            }
+        }
+        for (int lane = 0; lane < 4; ++lane)
+            if (group.slot[lane] == invalid_index) {
+                ASSERT_FALSE(got[lane]) << "a padding lane hit";
+            }
+    }
+    EXPECT_GT(hits, n / 4);
+}
