@@ -188,8 +188,11 @@ class Builder {
         auto consider = [&](const Candidate<T>& c) {
             const Counts r = count(list, c.plane, best_score);
             if (r.spanning == std::numeric_limits<std::size_t>::max()) return;
-            // A plane with every polygon on one side and none in it would not shrink the problem.
-            if (r.coplanar == 0 && r.spanning == 0 && (r.front == 0 || r.back == 0)) return;
+            // An axis-aligned plane must leave each side fewer polygons than the node has (in the
+            // sample, hence in the list), or splitting could go on forever; a polygon plane always
+            // keeps its own polygon at the node.
+            const std::size_t m = r.front + r.back + r.spanning + r.coplanar;
+            if (c.axis && (r.front + r.spanning >= m || r.back + r.spanning >= m)) return;
             const double score =
                 w * double(r.spanning) + (1 - w) * std::abs(double(r.front) - double(r.back));
             if (score < best_score) {
@@ -213,7 +216,7 @@ class Builder {
             }
         }
         if (!found && !polygons) {
-            // Axis planes made no progress (all polygons bunched at one coordinate): fall back.
+            // No axis plane makes progress (a node of few polygons, or all at one coordinate).
             for (std::size_t j = 0; j < k; ++j) consider({pool_.plane_of(list[j * n / k]), false});
         }
         return found;
