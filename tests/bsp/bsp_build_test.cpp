@@ -207,7 +207,7 @@ TEST(BspBuild, PolygonSoupWithManySplits) {
     const BspTree<double> tree(mesh, o);
     check_statistics(tree, o, "soup");
     // Needle triangles of the soup may be dropped: only the kept ones must tile.
-    EXPECT_GT(tree.statistics().splits, 100u);
+    EXPECT_GT(tree.statistics().splits, soup.size() / 10);
     if (tree.statistics().dropped_degenerate == 0) check_parts(mesh, tree, "soup");
 }
 
