@@ -1,11 +1,15 @@
 // `bvhkit bsp`: the BSP tree of a mesh and its statistics.
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
 #include "args.hpp"
 #include "bvhkit/bsp/bsp_tree.hpp"
+#include "bvhkit/bsp/ray.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
+#include "bvhkit/query/ray_sets.hpp"
+#include "bvhkit/triangle_bvh.hpp"
 #include "commands.hpp"
 #include "output.hpp"
 #include "report.hpp"
@@ -15,7 +19,7 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: bvhkit bsp MESH [--split-weight W] [--max-depth D] [--leaf-size N]
-                       [--candidates polygon|axis|both] [--json]
+                       [--candidates polygon|axis|both] [--compare] [--json]
 
 Builds a BSP tree over the mesh's triangles (docs/bsp.md) and prints the mesh's triangle count, then
 the build milliseconds (median of 3), nodes, leaves, depth, splits made, polygons after splitting
@@ -25,6 +29,9 @@ leaf an empty cell known to be inside or outside).
   --max-depth D     a node at depth D becomes a leaf (default 65536)
   --leaf-size N     a node of at most N polygons becomes a leaf (default 0: split to empty leaves)
   --candidates C    splitter candidates: polygon planes (default), axis-aligned planes, or both
+  --compare         also build the TriangleBvh (binned SAH, double) and trace workload R2 (100,000
+                    random rays from the mesh's box) through both: build time, nodes, memory,
+                    rays per second (one thread) for the closest hit, and hits that differ
 MESH is a file (OBJ, PLY, STL) or a generator spec such as torus:u=48,v=24.
 )";
 
@@ -43,11 +50,54 @@ BspCandidates parse_candidates(const std::string& s) {
     throw Error("option --candidates: '" + s + "' is not one of polygon, axis, both");
 }
 
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Adds the BVH's row and both structures' ray throughput on workload R2.
+void compare_with_bvh(const TriangleMesh& mesh, const BspTree<double>& bsp,
+                      std::vector<bench::Row>& rows) {
+    TriangleBvh<double> bvh;
+    const double bvh_ms = bench::median_ms(
+        3, [&] { bvh = TriangleBvh<double>(mesh); }, false);
+    std::vector<Ray<double, 3>> rays;
+    for (const auto& r : random_rays(mesh.bounds(), 100000, 1))
+        rays.emplace_back(Vec<double, 3>(r.origin), Vec<double, 3>(r.direction), r.tmin, r.tmax);
+    std::vector<double> bsp_t(rays.size()), bvh_t(rays.size());
+    BspRayStats stats;
+    auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < rays.size(); ++i) bsp_t[i] = closest_hit(bsp, rays[i], &stats).t;
+    const double bsp_s = seconds_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < rays.size(); ++i) bvh_t[i] = bvh.closest_hit(rays[i]).t;
+    const double bvh_s = seconds_since(t0);
+    long long differ = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i)
+        if (std::isinf(bsp_t[i]) != std::isinf(bvh_t[i]) ||
+            std::abs(bsp_t[i] - bvh_t[i]) > 1e-9 * std::max(1.0, std::abs(bvh_t[i])))
+            ++differ;
+    rows[0].set("r2_rays_per_s", double(rays.size()) / bsp_s);
+    rows[0].set("r2_nodes_per_ray", double(stats.nodes_visited) / double(rays.size()));
+    rows[0].set("r2_polys_per_ray", double(stats.polygons_tested) / double(rays.size()));
+    rows[0].set("r2_hits_differ", differ);
+    const auto& b = bvh.bvh();
+    const std::size_t bytes = b.nodes.size() * sizeof(b.nodes[0]) +
+                              b.primitive_indices.size() * sizeof(std::uint32_t) +
+                              bvh.triangle_count() * sizeof(Triangle<double>);
+    bench::Row row;
+    row.set("structure", std::string("bvh")).set("build_ms", bvh_ms);
+    row.set("nodes", (long long)b.nodes.size());
+    row.set("polygons", (long long)bvh.triangle_count());
+    row.set("memory_kib", double(bytes) / 1024.0);
+    row.set("r2_rays_per_s", double(rays.size()) / bvh_s);
+    rows.push_back(row);
+}
+
 }  // namespace
 
 int bsp_command(int argc, char** argv) {
     const Args args(argc, argv, {"--split-weight", "--max-depth", "--leaf-size", "--candidates"},
-                    {"--json"});
+                    {"--json", "--compare"});
     if (args.help()) {
         std::fputs(kHelp, stdout);
         return 0;
@@ -70,6 +120,7 @@ int bsp_command(int argc, char** argv) {
         3, [&] { tree = BspTree<double>(mesh, options); }, false);
     const BspStatistics& s = tree.statistics();
     bench::Row row;
+    row.set("structure", std::string("bsp"));
     row.set("build_ms", ms).set("nodes", (long long)s.nodes).set("leaves", (long long)s.leaves);
     row.set("depth", (long long)s.depth).set("splits", (long long)s.splits);
     row.set("polygons", (long long)s.polygons).set("at_nodes", (long long)s.polygons_at_nodes);
@@ -77,7 +128,9 @@ int bsp_command(int argc, char** argv) {
     row.set("dropped", (long long)s.dropped_degenerate);
     row.set("memory_kib", double(s.memory_bytes) / 1024.0);
     row.set("solid", std::string(s.solid ? "yes" : "no"));
-    print_rows({row}, json);
+    std::vector<bench::Row> rows{row};
+    if (args.flag("--compare")) compare_with_bvh(mesh, tree, rows);
+    print_rows(rows, json);
     return 0;
 }
 
