@@ -1,6 +1,6 @@
 #pragma once
-// The explicit stack of the BSP traversals: a fixed array on the call stack for trees up to 60
-// deep, one heap block per query beyond that; never an allocation per step.
+// The explicit stack of the BSP traversals: a fixed array of 128 entries on the call stack (a ray
+// query needs depth + 2, a visit 2 depth + 4), one heap block per query beyond; none per step.
 #include <cstddef>
 #include <vector>
 
