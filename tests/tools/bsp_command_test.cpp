@@ -112,4 +112,20 @@ TEST(BspCommand, TraceThroughTheBspEqualsTheBvh) {
     for (const auto& p : {ray_file, bvh_file, bsp_file}) std::filesystem::remove(p);
 }
 
+// `render --structure bsp` draws through the BSP (where the build has libpng; else it says so).
+TEST(BspCommand, RenderThroughTheBsp) {
+    const auto png = std::filesystem::temp_directory_path() /
+                     ("bvhkit_bsp_render_" + std::to_string(::getpid()) + ".png");
+    const Result r =
+        run_cli("render torus:u=24,v=12 --structure bsp --size 64x64 -o " + png.string());
+    if (r.status != 0 && r.output.find("libpng") != std::string::npos)
+        GTEST_SKIP() << "built without libpng";
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("BSP of"), std::string::npos) << r.output;
+    EXPECT_GT(std::filesystem::file_size(png), 100u);
+    std::filesystem::remove(png);
+    EXPECT_NE(run_cli("render torus --structure octree -o " + png.string()).status, 0);
+    EXPECT_NE(run_cli("render torus --structure bsp --builder lbvh -o " + png.string()).status, 0);
+}
+
 }  // namespace
