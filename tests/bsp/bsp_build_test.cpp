@@ -16,9 +16,9 @@ using V = Vec<double, 3>;
 TEST(BspSplit, SquareAcrossAPlaneTilesExactly) {
     const std::vector<V> square = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}};
     const auto plane = Plane<double>::axis_aligned(0, 0.5);
-    ASSERT_EQ(classify_polygon<double>(square, plane, 1e-9), Side::Spanning);
+    ASSERT_EQ((classify_polygon<double, 3>)(square, plane, 1e-9), Side::Spanning);
     std::vector<V> f, b;
-    split_polygon<double>(square, plane, 1e-9, f, b);
+    split_polygon<double, 3>(square, plane, 1e-9, f, b);
     ASSERT_EQ(f.size(), 4u);
     ASSERT_EQ(b.size(), 4u);
     EXPECT_DOUBLE_EQ(polygon_area<double>(f), 3.0);
@@ -26,18 +26,19 @@ TEST(BspSplit, SquareAcrossAPlaneTilesExactly) {
     for (const auto& p : f) EXPECT_GE(p[0], 0.5);
     for (const auto& p : b) EXPECT_LE(p[0], 0.5);
     // Within the thick plane: coplanar, or on one side without a split.
-    EXPECT_EQ(classify_polygon<double>(square, Plane<double>::axis_aligned(2, 1e-10), 1e-9),
+    EXPECT_EQ((classify_polygon<double, 3>)(square, Plane<double>::axis_aligned(2, 1e-10), 1e-9),
               Side::Coplanar);
-    EXPECT_EQ(classify_polygon<double>(square, Plane<double>::axis_aligned(0, 1e-10), 1e-9),
+    EXPECT_EQ((classify_polygon<double, 3>)(square, Plane<double>::axis_aligned(0, 1e-10), 1e-9),
               Side::Front);
-    EXPECT_EQ(classify_polygon<double>(square, Plane<double>::axis_aligned(0, 2 - 1e-10), 1e-9),
-              Side::Back);
+    EXPECT_EQ(
+        (classify_polygon<double, 3>)(square, Plane<double>::axis_aligned(0, 2 - 1e-10), 1e-9),
+        Side::Back);
 }
 
 TEST(BspSplit, ThroughAVertexMakesTwoTriangles) {
     const std::vector<V> tri = {{0, 0, 0}, {2, 0, 0}, {1, 2, 0}};
     std::vector<V> f, b;
-    split_polygon<double>(tri, Plane<double>::axis_aligned(0, 1.0), 1e-9, f, b);
+    split_polygon<double, 3>(tri, Plane<double>::axis_aligned(0, 1.0), 1e-9, f, b);
     EXPECT_EQ(f.size(), 3u);
     EXPECT_EQ(b.size(), 3u);
     EXPECT_DOUBLE_EQ(polygon_area<double>(f) + polygon_area<double>(b), 2.0);
@@ -47,7 +48,7 @@ TEST(BspSplit, AVertexInsideTheThickPlaneIsTheCutPoint) {
     // The apex lies 1e-12 off the plane: it becomes the chord's end, no crossing point beside it.
     const std::vector<V> tri = {{0, 0, 0}, {2, 0, 0}, {1 + 1e-12, 2, 0}};
     std::vector<V> f, b;
-    split_polygon<double>(tri, Plane<double>::axis_aligned(0, 1.0), 1e-9, f, b);
+    split_polygon<double, 3>(tri, Plane<double>::axis_aligned(0, 1.0), 1e-9, f, b);
     ASSERT_EQ(f.size(), 3u);
     ASSERT_EQ(b.size(), 3u);
     EXPECT_NE(std::find(f.begin(), f.end(), tri[2]), f.end());

@@ -22,10 +22,10 @@
 
 namespace bvhkit {
 
-template <class T>
+template <class T, std::size_t N = 3>
 struct BspBuildResult {
-    std::vector<BspNode<T>> nodes;
-    PolygonPool<T> polygons;  // ordered by node: a node's polygons are one run
+    std::vector<BspNode<T, N>> nodes;
+    PolygonPool<T, N> polygons;  // ordered by node: a node's polygons are one run
     BspStatistics stats;
 };
 
@@ -35,20 +35,20 @@ struct Counts {
     std::size_t front = 0, back = 0, spanning = 0, coplanar = 0;
 };
 
-template <class T>
+template <class T, std::size_t N>
 struct Candidate {
-    Plane<T> plane;
+    Plane<T, N> plane;
     bool axis = false;
 };
 
-template <class T>
+template <class T, std::size_t N>
 class Builder {
   public:
-    Builder(PolygonPool<T> pool, const BspOptions& options, T epsilon)
+    Builder(PolygonPool<T, N> pool, const BspOptions& options, T epsilon)
         : pool_(std::move(pool)), options_(options), eps_(epsilon) {}
 
-    BspBuildResult<T> run(std::size_t input_triangles, std::size_t dropped) {
-        BspBuildResult<T> out;
+    BspBuildResult<T, N> run(std::size_t input_triangles, std::size_t dropped) {
+        BspBuildResult<T, N> out;
         out.polygons.source_planes = pool_.source_planes;
         out.nodes.emplace_back();
         std::vector<std::uint32_t> all(pool_.size());
@@ -65,16 +65,16 @@ class Builder {
         s.input_triangles = input_triangles;
         s.dropped_degenerate = dropped;
         s.epsilon = double(eps_);
-        std::vector<Vec<T, 3>> f_part, b_part;
+        std::vector<Vec<T, N>> f_part, b_part;
         while (!stack.empty()) {
             Task task = std::move(stack.back());
             stack.pop_back();
             s.depth = std::max<std::size_t>(s.depth, task.depth);
-            BspNode<T> node;
+            BspNode<T, N> node;
             node.first = std::uint32_t(out.polygons.size());
             const bool halt =
                 task.list.size() <= options_.leaf_size || task.depth >= options_.max_depth;
-            Candidate<T> best;
+            Candidate<T, N> best;
             if (!task.list.empty() && !halt && choose(task.list, best)) {
                 std::vector<std::uint32_t> front, back, facing_back;
                 for (const std::uint32_t i : task.list) {
@@ -135,19 +135,19 @@ class Builder {
         s.solid = true;
         for (const auto& n : out.nodes)
             if (n.is_leaf() && (n.count != 0 || n.cell == BspCell::Unknown)) s.solid = false;
-        s.memory_bytes = out.nodes.size() * sizeof(BspNode<T>) +
+        s.memory_bytes = out.nodes.size() * sizeof(BspNode<T, N>) +
                          out.polygons.polygons.size() * sizeof(BspPolygon) +
-                         out.polygons.vertices.size() * sizeof(Vec<T, 3>) +
-                         out.polygons.source_planes.size() * sizeof(Plane<T>);
+                         out.polygons.vertices.size() * sizeof(Vec<T, N>) +
+                         out.polygons.source_planes.size() * sizeof(Plane<T, N>);
         return out;
     }
 
   private:
-    void emit(PolygonPool<T>& to, std::uint32_t i) {
+    void emit(PolygonPool<T, N>& to, std::uint32_t i) {
         to.add(pool_.vertices_of(i), pool_.polygons[i].source);
     }
 
-    Counts count(const std::vector<std::uint32_t>& list, const Plane<T>& plane,
+    Counts count(const std::vector<std::uint32_t>& list, const Plane<T, N>& plane,
                  double bound) const {
         Counts c;
         const double w = options_.split_weight;
@@ -179,13 +179,13 @@ class Builder {
     }
 
     // The best candidate for `list`, false when none makes progress.
-    bool choose(const std::vector<std::uint32_t>& list, Candidate<T>& best) const {
+    bool choose(const std::vector<std::uint32_t>& list, Candidate<T, N>& best) const {
         const std::size_t n = list.size();
         const std::size_t k = std::min<std::size_t>(n, options_.candidate_count);
         double best_score = std::numeric_limits<double>::infinity();
         bool found = false;
         const double w = options_.split_weight;
-        auto consider = [&](const Candidate<T>& c) {
+        auto consider = [&](const Candidate<T, N>& c) {
             const Counts r = count(list, c.plane, best_score);
             if (r.spanning == std::numeric_limits<std::size_t>::max()) return;
             // An axis-aligned plane must leave each side fewer polygons than the node has (in the
@@ -208,11 +208,11 @@ class Builder {
             if (polygons) consider({pool_.plane_of(i), false});
             if (axes) {
                 const auto v = pool_.vertices_of(i);
-                Vec<T, 3> c{};
+                Vec<T, N> c{};
                 for (const auto& p : v) c += p;
                 c = c / T(v.size());
-                for (int a = 0; a < 3; ++a)
-                    consider({Plane<T>::axis_aligned(a, c[std::size_t(a)]), true});
+                for (int a = 0; a < int(N); ++a)
+                    consider({Plane<T, N>::axis_aligned(a, c[std::size_t(a)]), true});
             }
         }
         if (!found && !polygons) {
@@ -222,7 +222,7 @@ class Builder {
         return found;
     }
 
-    PolygonPool<T> pool_;
+    PolygonPool<T, N> pool_;
     BspOptions options_;
     T eps_;
 };
@@ -231,11 +231,12 @@ class Builder {
 
 /// Builds a BSP over `pool` (polygons with their source planes set) with thick-plane `epsilon`
 /// (absolute). `input_triangles` and `dropped` are passed through to the statistics.
-template <class T>
-BspBuildResult<T> build_bsp(PolygonPool<T> pool, const BspOptions& options, T epsilon,
-                            std::size_t input_triangles, std::size_t dropped) {
+template <class T, std::size_t N>
+BspBuildResult<T, N> build_bsp(PolygonPool<T, N> pool, const BspOptions& options, T epsilon,
+                               std::size_t input_triangles, std::size_t dropped) {
     options.validate();
-    return bsp_detail::Builder<T>(std::move(pool), options, epsilon).run(input_triangles, dropped);
+    return bsp_detail::Builder<T, N>(std::move(pool), options, epsilon)
+        .run(input_triangles, dropped);
 }
 
 }  // namespace bvhkit

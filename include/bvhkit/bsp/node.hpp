@@ -13,10 +13,10 @@ namespace bvhkit {
 /// that holds polygons (a halted build) or lies beside an axis-aligned splitter.
 enum class BspCell : std::uint8_t { Unknown, Outside, Inside };
 
-template <class T>
+template <class T, std::size_t N = 3>
 struct BspNode {
     static constexpr std::uint32_t none = 0xFFFFFFFFu;
-    Plane<T> plane{};                         // the splitter (interior nodes)
+    Plane<T, N> plane{};                      // the splitter (interior nodes)
     std::uint32_t front = none, back = none;  // children; both none for a leaf
     std::uint32_t first = 0;                  // first polygon of this node in the tree's pool
     std::uint32_t count = 0;  // interior: polygons in the splitter plane; leaf: polygons held

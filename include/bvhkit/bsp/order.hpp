@@ -13,8 +13,8 @@ namespace bvhkit {
 
 namespace bsp_detail {
 
-template <class T, class F>
-void visit_in_order(const BspTree<T>& tree, const Vec<T, 3>& eye, bool front_to_back, F&& f) {
+template <class T, std::size_t N, class F>
+void visit_in_order(const BspTree<T, N>& tree, const Vec<T, N>& eye, bool front_to_back, F&& f) {
     struct Entry {
         std::uint32_t node;
         bool emit;  // the node's own polygons, its subtrees already scheduled
@@ -24,7 +24,7 @@ void visit_in_order(const BspTree<T>& tree, const Vec<T, 3>& eye, bool front_to_
     stack.push({0, false});
     while (!stack.empty()) {
         const Entry e = stack.pop();
-        const BspNode<T>& n = nodes[e.node];
+        const BspNode<T, N>& n = nodes[e.node];
         if (e.emit || n.is_leaf()) {
             for (std::uint32_t i = n.first; i < n.first + n.count; ++i) f(i);
             continue;
@@ -43,14 +43,14 @@ void visit_in_order(const BspTree<T>& tree, const Vec<T, 3>& eye, bool front_to_
 
 /// Calls f(polygon index) for every stored polygon, nearest the eye first (polygons().polygons
 /// [index].source is the input triangle).
-template <class T, class F>
-void for_each_front_to_back(const BspTree<T>& tree, const Vec<T, 3>& eye, F&& f) {
+template <class T, std::size_t N, class F>
+void for_each_front_to_back(const BspTree<T, N>& tree, const Vec<T, N>& eye, F&& f) {
     bsp_detail::visit_in_order(tree, eye, true, f);
 }
 
 /// Calls f(polygon index) for every stored polygon, farthest from the eye first (painter's order).
-template <class T, class F>
-void for_each_back_to_front(const BspTree<T>& tree, const Vec<T, 3>& eye, F&& f) {
+template <class T, std::size_t N, class F>
+void for_each_back_to_front(const BspTree<T, N>& tree, const Vec<T, N>& eye, F&& f) {
     bsp_detail::visit_in_order(tree, eye, false, f);
 }
 

@@ -1,8 +1,10 @@
 #pragma once
-// Convex polygons in 3D as the BSP stores them: one shared array of vertices, each polygon a run of
-// it, counter-clockwise seen from the front of its source triangle's plane. A polygon remembers the
-// input triangle it came from (its source), so that the parts a split makes can be traced back.
+// Convex polygons in 3D (segments in 2D) as the BSP stores them: one shared array of vertices, each
+// polygon a run of it, counter-clockwise seen from the front of its source triangle's plane (a
+// segment: two vertices). A polygon remembers the input triangle or segment it came from (its
+// source), so that the parts a split makes can be traced back.
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -32,24 +34,34 @@ T polygon_area(std::span<const Vec<T, 3>> v) {
     return length(polygon_double_area_vector(v)) / T(2);
 }
 
+/// The measure of a stored polygon: its area in 3D, its length in 2D (a segment).
+template <class T, std::size_t N>
+T polygon_measure(std::span<const Vec<T, N>> v) {
+    if constexpr (N == 3)
+        return polygon_area<T>(v);
+    else
+        return v.size() == 2 ? length(v[1] - v[0]) : T(0);
+}
+
 /// The polygons of a BSP (or of its build): vertices, polygons, and the plane of each source
 /// triangle, which every part of that triangle shares (a split never tilts a part).
-template <class T>
+template <class T, std::size_t N = 3>
 struct PolygonPool {
-    std::vector<Vec<T, 3>> vertices;
+    std::vector<Vec<T, N>> vertices;
     std::vector<BspPolygon> polygons;
-    std::vector<Plane<T>> source_planes;
+    std::vector<Plane<T, N>> source_planes;
 
     std::size_t size() const { return polygons.size(); }
-    std::span<const Vec<T, 3>> vertices_of(std::size_t i) const {
+    std::span<const Vec<T, N>> vertices_of(std::size_t i) const {
         const BspPolygon& p = polygons[i];
         return {vertices.data() + p.first, p.count};
     }
-    const Plane<T>& plane_of(std::size_t i) const { return source_planes[polygons[i].source]; }
-    T area(std::size_t i) const { return polygon_area(vertices_of(i)); }
+    const Plane<T, N>& plane_of(std::size_t i) const { return source_planes[polygons[i].source]; }
+    /// Area in 3D, length in 2D.
+    T area(std::size_t i) const { return polygon_measure<T, N>(vertices_of(i)); }
 
     /// Appends a polygon with the given vertices and source; returns its index.
-    std::uint32_t add(std::span<const Vec<T, 3>> v, std::uint32_t source) {
+    std::uint32_t add(std::span<const Vec<T, N>> v, std::uint32_t source) {
         BspPolygon p;
         p.first = std::uint32_t(vertices.size());
         p.count = std::uint32_t(v.size());

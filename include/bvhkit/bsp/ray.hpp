@@ -61,10 +61,31 @@ bool intersect_polygon(const Ray<T, 3>& ray, std::span<const Vec<T, 3>> v, const
     return true;
 }
 
+/// Where the ray meets the 2D segment `v` lying on line `plane`, if at t in [tmin, tmax): the
+/// crossing's position along the segment with a tolerance of a few roundings of the segment's
+/// length (for the same reason as above).
+template <class T>
+bool intersect_polygon(const Ray<T, 2>& ray, std::span<const Vec<T, 2>> v, const Plane<T, 2>& plane,
+                       T tmax, T& t_out) {
+    const T dn = dot(plane.normal, ray.direction);
+    if (dn == T(0)) return false;
+    const T t = (plane.offset - dot(plane.normal, ray.origin)) / dn;
+    if (!(t >= ray.tmin && t < tmax)) return false;
+    const Vec<T, 2> e = v[1] - v[0];
+    const T len2 = dot(e, e);
+    const T s = dot(ray.at(t) - v[0], e);
+    const T tol = 64 * std::numeric_limits<T>::epsilon() *
+                  (len2 + std::sqrt(len2) * length(ray.at(t) - v[0]));
+    if (!(s >= -tol && s <= len2 + tol)) return false;
+    t_out = t;
+    return true;
+}
+
 /// The closest polygon the ray meets in [ray.tmin, ray.tmax]; a miss for a ray that is not
 /// traceable (math/ray.hpp). Ties go to the polygon found first.
-template <class T>
-BspHit<T> closest_hit(const BspTree<T>& tree, const Ray<T, 3>& ray, BspRayStats* stats = nullptr) {
+template <class T, std::size_t N>
+BspHit<T> closest_hit(const BspTree<T, N>& tree, const Ray<T, N>& ray,
+                      BspRayStats* stats = nullptr) {
     BspHit<T> best;
     if (!is_traceable(ray)) return best;
     struct Entry {
@@ -97,7 +118,7 @@ BspHit<T> closest_hit(const BspTree<T>& tree, const Ray<T, 3>& ray, BspRayStats*
         const Entry e = stack.pop();
         if (e.t0 > best_t) continue;
         ++visited;
-        const BspNode<T>& n = nodes[e.node];
+        const BspNode<T, N>& n = nodes[e.node];
         if (n.is_leaf()) {
             test_range(n.first, n.count);
             continue;

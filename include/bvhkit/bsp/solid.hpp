@@ -1,6 +1,7 @@
 #pragma once
 // Point classification against a solid BSP (Thibault and Naylor 1987): built by auto-partition to
-// empty leaves over a closed mesh whose triangles face outwards, every empty leaf is wholly inside
+// empty leaves over a closed mesh whose triangles face outwards (in 2D: closed polygons whose
+// segments run counter-clockwise), every empty leaf is wholly inside
 // or wholly outside, so one descent (the point's side of each splitter) answers.
 #include "bvhkit/bsp/bsp_tree.hpp"
 
@@ -12,14 +13,14 @@ enum class PointLocation : std::uint8_t { Outside, Inside, Unknown };
 /// holds polygons or lies beside an axis-aligned splitter (a non-solid tree), and for a point that
 /// is not finite. A point within the plane thickness of a splitter goes to its front; the answer
 /// for points that close to the surface itself is either.
-template <class T>
-PointLocation classify_point(const BspTree<T>& tree, const Vec<T, 3>& p) {
+template <class T, std::size_t N>
+PointLocation classify_point(const BspTree<T, N>& tree, const Vec<T, N>& p) {
     if (!is_finite(p)) return PointLocation::Unknown;
     const auto& nodes = tree.nodes();
     std::uint32_t k = 0;
     while (!nodes[k].is_leaf())
         k = nodes[k].plane.distance(p) >= T(0) ? nodes[k].front : nodes[k].back;
-    const BspNode<T>& leaf = nodes[k];
+    const BspNode<T, N>& leaf = nodes[k];
     if (leaf.count != 0) return PointLocation::Unknown;
     switch (leaf.cell) {
         case BspCell::Inside:

@@ -18,8 +18,8 @@
 namespace bvhkit {
 
 /// Counts of a polygon's vertices against a thick plane.
-template <class T>
-Side classify_polygon(std::span<const Vec<T, 3>> v, const Plane<T>& plane, T epsilon) {
+template <class T, std::size_t N>
+Side classify_polygon(std::span<const Vec<T, N>> v, const Plane<T, N>& plane, T epsilon) {
     bool front = false, back = false;
     for (const auto& p : v) {
         const T d = plane.distance(p);
@@ -33,14 +33,28 @@ Side classify_polygon(std::span<const Vec<T, 3>> v, const Plane<T>& plane, T eps
 }
 
 /// Splits a spanning convex polygon `v` by `plane` into `front` and `back` (both cleared first),
-/// each convex and in the same vertex order. Called only for Spanning polygons, so both parts have
-/// at least three vertices.
-template <class T>
-void split_polygon(std::span<const Vec<T, 3>> v, const Plane<T>& plane, T epsilon,
-                   std::vector<Vec<T, 3>>& front, std::vector<Vec<T, 3>>& back) {
+/// each convex and in the same vertex order (a 2D segment into two segments, the same way round).
+/// Called only for Spanning polygons, so both parts have at least three vertices (two for a
+/// segment).
+template <class T, std::size_t N>
+void split_polygon(std::span<const Vec<T, N>> v, const Plane<T, N>& plane, T epsilon,
+                   std::vector<Vec<T, N>>& front, std::vector<Vec<T, N>>& back) {
     front.clear();
     back.clear();
     const std::size_t n = v.size();
+    if (n == 2) {
+        // A segment (2D): the crossing, interpolated from the lexicographically smaller end.
+        const T da = plane.distance(v[0]), db = plane.distance(v[1]);
+        const bool a_first = std::lexicographical_compare(v[0].v, v[0].v + N, v[1].v, v[1].v + N);
+        const Vec<T, N>& p = a_first ? v[0] : v[1];
+        const Vec<T, N>& q = a_first ? v[1] : v[0];
+        const T dp = a_first ? da : db, dq = a_first ? db : da;
+        const Vec<T, N> x = p + (q - p) * (dp / (dp - dq));
+        const bool a_front = da > T(0);
+        front = {a_front ? v[0] : x, a_front ? x : v[1]};
+        back = {a_front ? x : v[0], a_front ? v[1] : x};
+        return;
+    }
     // Each vertex goes to the front part (+1), the back part (-1) or both (0, a cut point).
     constexpr std::size_t max_inline = 64;
     T dist_inline[max_inline];
@@ -86,13 +100,13 @@ void split_polygon(std::span<const Vec<T, 3>> v, const Plane<T>& plane, T epsilo
             // The edge crosses from one side to the other, the crossing interpolated from the
             // lexicographically smaller end: the same point whichever way the edge is walked, so
             // a neighbour split by the same plane gets the identical vertex.
-            const Vec<T, 3>& a = v[k];
-            const Vec<T, 3>& b = v[k1];
-            const bool a_first = std::lexicographical_compare(a.v, a.v + 3, b.v, b.v + 3);
-            const Vec<T, 3>& p = a_first ? a : b;
-            const Vec<T, 3>& q = a_first ? b : a;
+            const Vec<T, N>& a = v[k];
+            const Vec<T, N>& b = v[k1];
+            const bool a_first = std::lexicographical_compare(a.v, a.v + N, b.v, b.v + N);
+            const Vec<T, N>& p = a_first ? a : b;
+            const Vec<T, N>& q = a_first ? b : a;
             const T dp = a_first ? dist[k] : dist[k1], dq = a_first ? dist[k1] : dist[k];
-            const Vec<T, 3> x = p + (q - p) * (dp / (dp - dq));
+            const Vec<T, N> x = p + (q - p) * (dp / (dp - dq));
             front.push_back(x);
             back.push_back(x);
         }
