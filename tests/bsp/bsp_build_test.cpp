@@ -76,6 +76,9 @@ std::vector<Variant> variants() {
     shallow.max_depth = 6;
     shallow.candidates = BspCandidates::Both;
     v.push_back({"shallow", shallow});
+    BspOptions thick;
+    thick.epsilon = 1e-7;  // a thousand times the default plane thickness
+    v.push_back({"thick", thick});
     return v;
 }
 
