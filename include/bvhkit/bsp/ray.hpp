@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <type_traits>
 
 #include "bvhkit/bsp/bsp_tree.hpp"
 #include "bvhkit/bsp/stack.hpp"
@@ -32,25 +33,28 @@ struct BspRayStats {
 /// Where the ray meets the convex polygon `v` lying in `plane`, if at t in [tmin, tmax). Edges are
 /// tested by the sign of dir . ((a - o) x (b - o)), with a tolerance of a few roundings scaled by
 /// the operands: the parts of a split share end points but may meet a neighbour's unsplit edge at
-/// a T-junction, and the tolerance keeps rays from slipping through such seams.
+/// a T-junction, and the tolerance keeps rays from slipping through such seams. The products are
+/// taken in double for a float tree: float's tolerance, scaled by the distances from the origin,
+/// would accept rays that graze the polygon's plane far from it.
 template <class T>
 bool intersect_polygon(const Ray<T, 3>& ray, std::span<const Vec<T, 3>> v, const Plane<T>& plane,
                        T tmax, T& t_out) {
+    using W = std::conditional_t<(sizeof(T) < sizeof(double)), double, T>;
     const T dn = dot(plane.normal, ray.direction);
     if (dn == T(0)) return false;
     const T t = (plane.offset - dot(plane.normal, ray.origin)) / dn;
     if (!(t >= ray.tmin && t < tmax)) return false;
-    constexpr T tol = 64 * std::numeric_limits<T>::epsilon();
-    const Vec<T, 3>& d = ray.direction;
-    const T dsize = std::abs(d[0]) + std::abs(d[1]) + std::abs(d[2]);
+    constexpr W tol = 64 * std::numeric_limits<W>::epsilon();
+    const Vec<W, 3> d(ray.direction), o(ray.origin);
+    const W dsize = std::abs(d[0]) + std::abs(d[1]) + std::abs(d[2]);
     bool neg = false, pos = false;
-    Vec<T, 3> a = v[v.size() - 1] - ray.origin;
-    T asize = std::abs(a[0]) + std::abs(a[1]) + std::abs(a[2]);
+    Vec<W, 3> a = Vec<W, 3>(v[v.size() - 1]) - o;
+    W asize = std::abs(a[0]) + std::abs(a[1]) + std::abs(a[2]);
     for (std::size_t k = 0; k < v.size(); ++k) {
-        const Vec<T, 3> b = v[k] - ray.origin;
-        const T bsize = std::abs(b[0]) + std::abs(b[1]) + std::abs(b[2]);
-        const T e = dot(d, cross(a, b));
-        const T margin = tol * dsize * asize * bsize;
+        const Vec<W, 3> b = Vec<W, 3>(v[k]) - o;
+        const W bsize = std::abs(b[0]) + std::abs(b[1]) + std::abs(b[2]);
+        const W e = dot(d, cross(a, b));
+        const W margin = tol * dsize * asize * bsize;
         pos = pos || e > margin;
         neg = neg || e < -margin;
         if (pos && neg) return false;
