@@ -284,6 +284,12 @@ TEST(BspSolid, CubeOfQuadsFromAPolygonPool) {
     PolygonPool<double> bad = pool;
     bad.vertices[2][1] = std::numeric_limits<double>::infinity();
     EXPECT_THROW(BspTree<double>(bad, BspOptions{}), Error);
+    bad = pool;
+    bad.polygons[3].source = 6;  // no such plane
+    EXPECT_THROW(BspTree<double>(bad, BspOptions{}), Error);
+    bad = pool;
+    bad.polygons[5].count = 5;  // past the vertices
+    EXPECT_THROW(BspTree<double>(bad, BspOptions{}), Error);
 }
 
 TEST(BspSolid, NonSolidTreesSayUnknown) {

@@ -103,6 +103,14 @@ class BspTree {
     /// degenerate ones are dropped.
     BspTree(PolygonPool<T, N> polygons, const BspOptions& options) {
         options.validate();
+        for (std::size_t i = 0; i < polygons.size(); ++i) {
+            const BspPolygon& p = polygons.polygons[i];
+            if (p.source >= polygons.source_planes.size() || p.count < (N == 3 ? 3u : 2u) ||
+                (N == 2 && p.count != 2) ||
+                std::size_t(p.first) + p.count > polygons.vertices.size())
+                throw Error("BspTree: polygon " + std::to_string(i) +
+                            " names vertices or a source plane the pool does not have");
+        }
         Aabb<T, N> box;
         for (const auto& p : polygons.vertices) {
             if (!is_finite(p)) throw Error("BspTree: a polygon vertex is NaN or infinite");
