@@ -7,7 +7,7 @@
 #   1 math
 #   2 primitives
 #   3 volumes
-#   4 bvh
+#   4 bvh bsp
 #   5 build dynamic
 #   6 query
 #   7 triangle_bvh.hpp
@@ -19,6 +19,7 @@ set(rank_math 1)
 set(rank_primitives 2)
 set(rank_volumes 3)
 set(rank_bvh 4)
+set(rank_bsp 4)
 set(rank_build 5)
 set(rank_dynamic 5)
 set(rank_query 6)

@@ -15,5 +15,6 @@ int closest_command(int argc, char** argv);        // tools/closest.cpp
 int collide_command(int argc, char** argv);        // tools/collide.cpp
 int bench_collide_command(int argc, char** argv);  // tools/collide.cpp
 int distance_command(int argc, char** argv);       // tools/distance.cpp
+int bsp_command(int argc, char** argv);            // tools/bsp.cpp
 
 }  // namespace bvhkit::tools

@@ -19,6 +19,7 @@ struct Subcommand {
 const Subcommand kSubcommands[] = {
     {"bench", "same-run benchmarks against the peers (rays, dynamic, nearest, collide)",
      bvhkit::tools::bench_command},
+    {"bsp", "the BSP tree of a mesh and its statistics", bvhkit::tools::bsp_command},
     {"closest", "closest points on a mesh for a points file", bvhkit::tools::closest_command},
     {"collide", "collision of two meshes at the poses of a file", bvhkit::tools::collide_command},
     {"distance", "distance between two meshes at the poses of a file",

@@ -7,6 +7,8 @@
 #include <cstdlib>
 
 #include "args.hpp"
+#include "bvhkit/bsp/bsp_tree.hpp"
+#include "bvhkit/bsp/ray.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/ray_sets.hpp"
 #include "bvhkit/triangle_bvh.hpp"
@@ -18,6 +20,7 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: bvhkit render [MESH] -o IMAGE.png [--heatmap [--scale N]] [--size WxH] [--builder NAME]
+                     [--structure bvh|bsp]
 
 Renders MESH (a file or a generator spec; default: sphere:subdiv=7,displacement=0.25) through its BVH
 with the camera of workload R1. The default picture is shaded by the surface normal; --heatmap colours
@@ -31,6 +34,8 @@ each pixel by the number of BVH nodes its ray tested, with the scale drawn at th
                   first (the camera stays where workload R1 puts it)
   --size WxH      image size (default 800x800; at most 4096x4096 pixels in all)
   --builder NAME  builder (default binned-sah; see bvhkit info --all-builders)
+  --structure S   bvh (default) or bsp: trace through a BSP tree (docs/bsp.md, double, default
+                  options) instead; the heat map then counts BSP nodes visited per ray
 )";
 
 // A picture takes about 48 bytes a pixel while it is traced (the ray, its cost, the colour), so the
@@ -115,7 +120,8 @@ void draw_scale(Image& image, std::uint32_t scale_top, bool fixed) {
 }  // namespace
 
 int render_command(int argc, char** argv) {
-    const Args args(argc, argv, {"-o", "--size", "--builder", "--scale", "--turn"}, {"--heatmap"});
+    const Args args(argc, argv, {"-o", "--size", "--builder", "--scale", "--turn", "--structure"},
+                    {"--heatmap"});
     if (args.help()) {
         std::fputs(kHelp, stdout);
         return 0;
@@ -129,11 +135,22 @@ int render_command(int argc, char** argv) {
     if (args.has("--scale") && !args.flag("--heatmap")) throw Error("--scale goes with --heatmap");
     const auto fixed_scale = std::uint32_t(args.integer("--scale", 0, 1, 1000000));
     const BuildOptions build_options = parse_builder(args.value("--builder", "binned-sah"));
+    const std::string structure = args.value("--structure", "bvh");
+    if (structure != "bvh" && structure != "bsp")
+        throw Error("option --structure: '" + structure + "' is not one of bvh, bsp");
+    if (structure == "bsp" && args.has("--builder"))
+        throw Error("--builder applies to --structure bvh only");
+    const bool use_bsp = structure == "bsp";
 
     TriangleMesh mesh = load_mesh(spec);
     if (args.has("--turn")) turn_about_vertical(mesh, parse_degrees(args.value("--turn")));
     const auto t0 = std::chrono::steady_clock::now();
-    const TriangleBvh<float> bvh(mesh, build_options);
+    TriangleBvh<float> bvh;
+    BspTree<double> bsp;
+    if (use_bsp)
+        bsp = BspTree<double>(mesh);
+    else
+        bvh = TriangleBvh<float>(mesh, build_options);
     const double build_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     const std::vector<Ray3f> rays = camera_rays(mesh.bounds(), width, height);
@@ -144,9 +161,19 @@ int render_command(int argc, char** argv) {
     std::uint32_t max_cost = 1;
     const auto t1 = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < rays.size(); ++i) {
-        TraversalStats stats;
-        const Hit<float> hit = bvh.closest_hit(rays[i], stats);
-        cost[i] = std::uint32_t(stats.nodes_visited);
+        Hit<float> hit;
+        if (use_bsp) {
+            BspRayStats stats;
+            const Ray<double, 3> ray(Vec<double, 3>(rays[i].origin),
+                                     Vec<double, 3>(rays[i].direction), rays[i].tmin, rays[i].tmax);
+            const BspHit<double> h = closest_hit(bsp, ray, &stats);
+            if (h) hit.t = float(h.t), hit.primitive = h.source;
+            cost[i] = std::uint32_t(stats.nodes_visited);
+        } else {
+            TraversalStats stats;
+            hit = bvh.closest_hit(rays[i], stats);
+            cost[i] = std::uint32_t(stats.nodes_visited);
+        }
         max_cost = std::max(max_cost, cost[i]);
         Rgb& px = image.pixels[i];
         if (!hit) {  // background: a soft vertical gradient
@@ -182,12 +209,20 @@ int render_command(int argc, char** argv) {
     }
     write_png(args.value("-o"), image);
 
-    const BvhStatistics s = statistics(bvh.bvh());
     double mean_cost = 0;
     for (auto c : cost) mean_cost += c;
     mean_cost /= double(cost.size());
-    std::printf("%s: %zu triangles, %zu nodes, depth %u, SAH cost %.2f, built in %.1f ms\n",
-                spec.c_str(), mesh.triangle_count(), s.node_count, s.depth, s.sah_cost, build_ms);
+    if (use_bsp) {
+        const BspStatistics& s = bsp.statistics();
+        std::printf(
+            "%s: %zu triangles, BSP of %zu nodes, depth %zu, %zu splits, built in %.1f ms\n",
+            spec.c_str(), mesh.triangle_count(), s.nodes, s.depth, s.splits, build_ms);
+    } else {
+        const BvhStatistics s = statistics(bvh.bvh());
+        std::printf("%s: %zu triangles, %zu nodes, depth %u, SAH cost %.2f, built in %.1f ms\n",
+                    spec.c_str(), mesh.triangle_count(), s.node_count, s.depth, s.sah_cost,
+                    build_ms);
+    }
     std::printf(
         "traced %zu rays in %.1f ms (%.1f Mrays/s); nodes tested per ray: mean %.1f, max %u\n",
         rays.size(), trace_ms, rays.size() / trace_ms / 1e3, mean_cost, max_cost);

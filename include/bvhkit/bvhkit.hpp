@@ -1,7 +1,9 @@
 #pragma once
 // Everything in one include: the static trees and their builders, rays, proximity (closest point,
 // k nearest, radius, signed distance, winding number), collision and distance between meshes, the
-// dynamic tree, the mesh readers and generators. The finer headers stay for those who want less.
+// dynamic tree, the BSP tree, the mesh readers and generators. The finer headers stay for those who
+// want less.
+#include "bvhkit/bsp/bsp.hpp"
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/refit.hpp"
 #include "bvhkit/bvh/iterate.hpp"

@@ -1,0 +1,32 @@
+#pragma once
+// The explicit stack of the BSP traversals: a fixed array of 128 entries on the call stack (a ray
+// query needs depth + 2, a visit 2 depth + 4), one heap block per query beyond; none per step.
+#include <cstddef>
+#include <vector>
+
+namespace bvhkit::bsp_detail {
+
+template <class E>
+class TraversalStack {
+  public:
+    static constexpr std::size_t inline_capacity = 128;
+    explicit TraversalStack(std::size_t capacity) {
+        if (capacity > inline_capacity) {
+            heap_.resize(capacity);
+            data_ = heap_.data();
+        }
+    }
+    TraversalStack(const TraversalStack&) = delete;
+    TraversalStack& operator=(const TraversalStack&) = delete;
+    void push(const E& e) { data_[size_++] = e; }
+    E pop() { return data_[--size_]; }
+    bool empty() const { return size_ == 0; }
+
+  private:
+    E inline_[inline_capacity];
+    std::vector<E> heap_;
+    E* data_ = inline_;
+    std::size_t size_ = 0;
+};
+
+}  // namespace bvhkit::bsp_detail
