@@ -122,10 +122,10 @@ void check_collapse(const Bvh<Aabb<T, 3>>& bvh, const std::vector<Aabb<T, 3>>& b
     const WideBvh4<T> wide = collapse_to_wide(bvh, leaf_limit);
     ASSERT_NO_THROW(validate(wide, slot_boxes));
     ASSERT_EQ(wide.empty(), bvh.empty());
-    // Eight wide (the AVX ray layout): the same slots and containment, in fewer nodes.
+    // Eight wide (the AVX ray layout): every slot once, inside its boxes, and the same leaf
+    // children (the subtrees that do not open do not depend on the width).
     const WideBvh<T, 8> wide8 = collapse_to_wide<T, 8>(bvh, leaf_limit);
     ASSERT_NO_THROW(validate(wide8, slot_boxes));
-    EXPECT_LE(wide8.nodes.size(), wide.nodes.size());
     EXPECT_EQ(wide8.group_count(), wide.group_count());
     if (wide.empty()) return;
     // Binary leaves reached from the root: first slot -> count.
