@@ -2,15 +2,20 @@
 process: ``python -m bvhkit.bench [--scale S] [--reps R] [--only P1,P2,...]``.
 
 Workloads (sizes times --scale):
-  P1  rays: 1M random rays through a mesh (closest hit), and occlusion
+  P1  rays: 1M random rays (closest hit) through a scanned mesh and a 1.3M-triangle sphere
   P2  closest point for 1M points
   P3  signed distance on a 128^3 grid, for a closed mesh and for one with holes; sign errors are
       counted against the exact winding number on a sample of the grid
   P4  1,000 random poses of collision (yes/no) and of distance between two copies of a mesh
 
-A peer runs when it can be imported: Open3D (RaycastingScene), trimesh (with embreex for rays when
-present), libigl (igl), python-fcl (fcl). bvhkit runs with threads=1 and with every core; peers
-as they run by default. Times are medians of interleaved repetitions (each library in turn).
+A peer runs when it imports and sets up; a peer that fails is listed with the reason and the rest
+go on. Peers: Open3D (RaycastingScene), trimesh (with embreex for rays when present), libigl (igl),
+fcpw, python-fcl (fcl) and coal. Each row says its threads: "1", "all" (every core) or "own" (the
+peer's default, which may use several). The ratio compares a row with bvhkit on as many threads
+(bvhkit's "1" for a "1" row, "all" otherwise): above 1 means bvhkit is faster. Times are medians of
+interleaved repetitions (each library in turn), after one untimed round in which the peers
+that build lazily build their trees. Every peer's answers are checked against bvhkit's
+on the same input and the agreement is printed beside its time.
 """
 
 from __future__ import annotations
@@ -30,87 +35,234 @@ import bvhkit
 def _optional(name: str):
     try:
         return importlib.import_module(name)
-    except Exception:
-        return None
+    except Exception as e:  # a peer missing or broken is reported, never fatal
+        return e
 
 
-def _mesh(spec: str) -> Tuple[np.ndarray, np.ndarray]:
-    data = os.environ.get("BVHKIT_DATA_DIR")
-    if data and os.path.exists(os.path.join(data, spec)):
-        spec = os.path.join(data, spec)
-    if not os.path.exists(spec) and ":" not in spec:
-        spec = "sphere:subdiv=7"
-    return bvhkit.load_mesh(spec)
+def _mesh(spec: str) -> Tuple[np.ndarray, np.ndarray, str]:
+    """The mesh named by spec, looked up in $BVHKIT_DATA_DIR and ../shared/data; a file that is
+    not found is replaced by a procedural sphere, and the name printed says which was used."""
+    if ":" in spec or os.path.exists(spec):
+        return (*bvhkit.load_mesh(spec), spec)
+    for folder in (os.environ.get("BVHKIT_DATA_DIR"), os.path.join("..", "shared", "data")):
+        if folder and os.path.exists(os.path.join(folder, spec)):
+            path = os.path.join(folder, spec)
+            return (*bvhkit.load_mesh(path), path)
+    fallback = "sphere:subdiv=7"
+    return (*bvhkit.load_mesh(fallback), f"{fallback} ({spec} not found)")
 
 
-def _time(runs: Dict[str, Callable[[], object]], reps: int) -> Dict[str, float]:
-    """Medians over `reps` rounds; each round calls every entry once, in turn."""
-    times: Dict[str, List[float]] = {k: [] for k in runs}
-    for _ in range(reps):
-        for k, f in runs.items():
-            t = time.perf_counter()
-            f()
-            times[k].append(time.perf_counter() - t)
-    return {k: statistics.median(v) for k, v in times.items()}
+class Workload:
+    """The runs of one workload: each a timed call, its thread mode, and how to read its answer."""
+
+    def __init__(self, name: str, items: int):
+        self.name, self.items = name, items
+        self.runs: Dict[str, Tuple[str, Callable[[], object], Optional[Callable]]] = {}
+        self.skipped: Dict[str, str] = {}
+        self.rate_items: Dict[str, int] = {}  # a run over fewer items than the workload
+
+    def add(self, label: str, threads: str, run: Callable[[], object],
+            answer: Optional[Callable[[object], object]] = None) -> None:
+        self.runs[label] = (threads, run, answer)
+
+    def peer(self, label: str, setup: Callable[[], None]) -> None:
+        """Runs setup (which calls add); a failure is recorded instead of raised."""
+        try:
+            setup()
+        except Exception as e:
+            self.skipped[label] = f"{type(e).__name__}: {str(e).splitlines()[0][:90]}"
+
+    def measure(self, reps: int, check: Callable[[object, object], str]) -> List[str]:
+        times: Dict[str, List[float]] = {k: [] for k in self.runs}
+        last: Dict[str, object] = {}
+        # One untimed round first: some peers build their tree lazily, on the first query.
+        for rep in range(reps + 1):
+            for k, (_, run, _) in list(self.runs.items()):
+                if k in self.skipped:
+                    continue
+                try:
+                    t = time.perf_counter()
+                    last[k] = run()
+                    if rep > 0:
+                        times[k].append(time.perf_counter() - t)
+                except Exception as e:
+                    self.skipped[k] = f"{type(e).__name__}: {str(e).splitlines()[0][:90]}"
+        med = {k: statistics.median(v) for k, v in times.items() if v and k not in self.skipped}
+        reference = last.get("bvhkit (all threads)")
+        base = {"1": med.get("bvhkit (1 thread)"), "all": med.get("bvhkit (all threads)")}
+        rows = []
+        for k, t in med.items():
+            threads, _, answer = self.runs[k]
+            b = base["1" if threads == "1" else "all"]
+            items = self.rate_items.get(k, self.items)
+            if b and items != self.items:
+                b *= items / self.items  # bvhkit's time for as many items
+            ratio = "" if k.startswith("bvhkit") or not b else f"{t / b:8.2f}x"
+            note = ""
+            if answer is not None and reference is not None:
+                try:
+                    note = check(answer(last[k]), reference)
+                except Exception as e:
+                    note = f"answer not read: {type(e).__name__}"
+            rows.append(f"{self.name:9} {k:38} {threads:>4} {t * 1e3:10.1f} ms "
+                        f"{items / t / 1e6:8.2f} M/s {ratio:>9}  {note}")
+        rows += [f"{self.name:9} {k:38}  skipped: {why}" for k, why in self.skipped.items()]
+        return rows
 
 
-def _rows(workload: str, result: Dict[str, float], items: int, notes: Optional[Dict] = None):
-    base = result.get("bvhkit (1 thread)")
-    out = []
-    for k, t in result.items():
-        speed = "" if base is None or k.startswith("bvhkit") else f"{t / base:8.2f}x"
-        note = (notes or {}).get(k, "")
-        out.append(f"{workload:4}  {k:34} {t * 1e3:10.1f} ms  {items / t / 1e6:8.2f} M/s  "
-                   f"{speed:>9}  {note}")
-    return out
-
-
-def p1(v, f, n, reps, mods):
-    rng = np.random.default_rng(1)
+def _rays(v, n, seed):
+    rng = np.random.default_rng(seed)
     lo, hi = v.min(0), v.max(0)
     o = rng.uniform(lo - (hi - lo), hi + (hi - lo), (n, 3)).astype(np.float32)
     d = (rng.uniform(lo, hi, (n, 3)) - o).astype(np.float32)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)  # unit: every library's t is then a distance
+    return o, d
+
+
+def _check_hits(t, reference) -> str:
+    """Share of rays with the same hit or miss and, on a hit, t within 1e-4 relative."""
+    t = np.asarray(t, dtype=np.float64)
+    t_ref = reference[0][: len(t)].astype(np.float64)
+    hit, hit_ref = np.isfinite(t), np.isfinite(t_ref)
+    with np.errstate(invalid="ignore"):  # inf - inf where both miss
+        close = np.abs(t - t_ref) <= 1e-4 * np.maximum(1.0, np.abs(t_ref))
+    same = (hit == hit_ref) & (~hit | close)
+    return f"agree {same.mean() * 100:.3f}% of {len(t)} rays"
+
+
+def p1(v, f, n, reps, mods, label):
+    o, d = _rays(v, n, 1)
+    w = Workload(f"P1 {label}", n)
     scene = bvhkit.TriangleMesh(v, f)
-    runs = {"bvhkit (1 thread)": lambda: scene.intersect(o, d, threads=1),
-            "bvhkit (all threads)": lambda: scene.intersect(o, d)}
+    fast = bvhkit.TriangleMesh(v, f, ray_test="fast")
+    w.add("bvhkit (1 thread)", "1", lambda: scene.intersect(o, d, threads=1))
+    w.add("bvhkit (all threads)", "all", lambda: scene.intersect(o, d))
+    w.add("bvhkit fast test", "all", lambda: fast.intersect(o, d), lambda r: r[0])
     o3d = mods.get("open3d")
     if o3d:
-        rs = o3d.t.geometry.RaycastingScene()
-        rs.add_triangles(o3d.core.Tensor(v), o3d.core.Tensor(f.astype(np.uint32)))
-        rays = o3d.core.Tensor(np.hstack([o, d]))
-        runs["open3d cast_rays"] = lambda: rs.cast_rays(rays)
+        def setup_o3d():
+            rs = o3d.t.geometry.RaycastingScene()
+            rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)),
+                             o3d.core.Tensor(f.astype(np.uint32)))
+            rays = o3d.core.Tensor(np.hstack([o, d]))
+            read = lambda r: r["t_hit"].numpy()
+            w.add("open3d cast_rays (1 thread)", "1", lambda: rs.cast_rays(rays, nthreads=1),
+                  read)
+            w.add("open3d cast_rays (all threads)", "all", lambda: rs.cast_rays(rays), read)
+        w.peer("open3d cast_rays", setup_o3d)
     tm = mods.get("trimesh")
     if tm:
-        mesh = tm.Trimesh(v, f, process=False)
-        runs["trimesh intersects_first"] = lambda: mesh.ray.intersects_first(o, d)
-    return _rows("P1", _time(runs, reps), n)
+        def setup_trimesh():
+            mesh = tm.Trimesh(v, f, process=False)
+            engine = type(mesh.ray).__module__.split(".")[-1]
+            w.add(f"trimesh intersects_first ({engine})", "own",
+                  lambda: mesh.ray.intersects_first(o, d),
+                  lambda faces: np.where(np.asarray(faces) >= 0, 0.0, np.inf))
+        w.peer("trimesh intersects_first", setup_trimesh)
+    fcpw = mods.get("fcpw")
+    if fcpw:
+        def setup_fcpw():
+            s = _fcpw_scene(fcpw, v, f)
+            of, df = np.asfortranarray(o), np.asfortranarray(d)
+            bound = np.full(n, np.inf, np.float32)
+
+            def run():
+                hits = fcpw.interaction_3D_list()
+                s.intersect(of, df, bound, hits, False)
+                return hits
+            w.add("fcpw intersect", "own", run, _fcpw_distances)
+        w.peer("fcpw intersect", setup_fcpw)
+    return w.measure(reps, _check_hits_any)
+
+
+def _check_hits_any(answer, reference) -> str:
+    """Rays: t from peers that give it; trimesh gives 0 for a hit (hit/miss only)."""
+    t = np.asarray(answer, dtype=np.float64)
+    if np.all((t == 0) | np.isinf(t)):  # hit/miss only
+        same = np.isfinite(t) == np.isfinite(reference[0][: len(t)])
+        return f"hit/miss agree {same.mean() * 100:.3f}% of {len(t)} rays"
+    return _check_hits(t, reference)
+
+
+def _fcpw_scene(fcpw, v, f):
+    s = fcpw.scene_3D()
+    s.set_object_count(1)
+    s.set_object_vertices(np.asfortranarray(v, dtype=np.float32), 0)
+    s.set_object_triangles(np.asfortranarray(f, dtype=np.int32), 0)
+    s.build(fcpw.aggregate_type.bvh_surface_area, True)
+    return s
+
+
+def _fcpw_distances(interactions, limit=20000):
+    """fcpw's distances (inf on a miss), read for the first `limit` queries only: reading its
+    result objects one by one in Python is slow and is not part of the timing."""
+    k = min(len(interactions), limit)
+    d = np.array([interactions[i].d for i in range(k)], dtype=np.float64)
+    d[d >= np.finfo(np.float32).max] = np.inf
+    return d
+
+
+def _check_distances(d, reference) -> str:
+    d_ref = reference[0][: len(d)].astype(np.float64)
+    d = np.asarray(d, dtype=np.float64)
+    rel = np.abs(d - d_ref) / np.maximum(d_ref, 1e-12 * np.abs(d_ref).max())
+    return f"max rel diff {rel.max():.1e} over {len(d)} points"
 
 
 def p2(v, f, n, reps, mods):
     rng = np.random.default_rng(2)
     lo, hi = v.min(0), v.max(0)
     p = rng.uniform(lo - 0.2 * (hi - lo), hi + 0.2 * (hi - lo), (n, 3)).astype(np.float32)
+    w = Workload("P2", n)
     scene = bvhkit.TriangleMesh(v, f)
     scene.closest_point(p[:10])  # build outside the timing, as the peers' scenes are
-    runs = {"bvhkit (1 thread)": lambda: scene.closest_point(p, threads=1),
-            "bvhkit (all threads)": lambda: scene.closest_point(p)}
+    w.add("bvhkit (1 thread)", "1", lambda: scene.closest_point(p, threads=1))
+    w.add("bvhkit (all threads)", "all", lambda: scene.closest_point(p))
     o3d = mods.get("open3d")
     if o3d:
-        rs = o3d.t.geometry.RaycastingScene()
-        rs.add_triangles(o3d.core.Tensor(v), o3d.core.Tensor(f.astype(np.uint32)))
-        q = o3d.core.Tensor(p)
-        runs["open3d compute_closest_points"] = lambda: rs.compute_closest_points(q)
+        def setup_o3d():
+            rs = o3d.t.geometry.RaycastingScene()
+            rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)),
+                             o3d.core.Tensor(f.astype(np.uint32)))
+            q = o3d.core.Tensor(p)
+            read = lambda r: np.linalg.norm(r["points"].numpy().astype(np.float64) - p, axis=1)
+            w.add("open3d compute_closest_points (1)", "1",
+                  lambda: rs.compute_closest_points(q, nthreads=1), read)
+            w.add("open3d compute_closest_points (all)", "all",
+                  lambda: rs.compute_closest_points(q), read)
+        w.peer("open3d compute_closest_points", setup_o3d)
     igl = mods.get("igl")
     if igl:
-        v64, f64 = v.astype(np.float64), f.astype(np.int64)
-        p64 = p.astype(np.float64)
-        runs["igl point_mesh_squared_distance"] = lambda: igl.point_mesh_squared_distance(
-            p64, v64, f64)
+        def setup_igl():
+            v64, f64, p64 = v.astype(np.float64), f.astype(np.int64), p.astype(np.float64)
+            w.add("igl point_mesh_squared_distance", "own",
+                  lambda: igl.point_mesh_squared_distance(p64, v64, f64),
+                  lambda r: np.sqrt(r[0]))
+        w.peer("igl point_mesh_squared_distance", setup_igl)
+    fcpw = mods.get("fcpw")
+    if fcpw:
+        def setup_fcpw():
+            s = _fcpw_scene(fcpw, v, f)
+            pf, r2 = np.asfortranarray(p), np.full(n, np.inf, np.float32)
+
+            def run():
+                out = fcpw.interaction_3D_list()
+                s.find_closest_points(pf, r2, out)
+                return out
+            w.add("fcpw find_closest_points", "own", run, _fcpw_distances)
+        w.peer("fcpw find_closest_points", setup_fcpw)
     tm = mods.get("trimesh")
-    if tm and n <= 100_000:  # trimesh's closest point is far slower: only small batches
-        mesh = tm.Trimesh(v, f, process=False)
-        runs["trimesh closest_point"] = lambda: tm.proximity.closest_point(mesh, p)
-    return _rows("P2", _time(runs, reps), n)
+    if tm:
+        # trimesh's closest_point gathers candidate triangles per point in one array (24 GiB for
+        # 50,000 points on igea): it runs on the first 2,000 points, and its rate is of those.
+        def setup_trimesh():
+            mesh = tm.Trimesh(v, f, process=False)
+            few = p[:2000]
+            w.add("trimesh closest_point (2,000 points)", "own",
+                  lambda: tm.proximity.closest_point(mesh, few), lambda r: r[1])
+            w.rate_items["trimesh closest_point (2,000 points)"] = len(few)
+        w.peer("trimesh closest_point", setup_trimesh)
+    return w.measure(reps, _check_distances)
 
 
 def p3(v, f, grid, reps, mods, label):
@@ -118,36 +270,42 @@ def p3(v, f, grid, reps, mods, label):
     axes = [np.linspace(lo[i] - 0.1 * (hi - lo)[i], hi[i] + 0.1 * (hi - lo)[i], grid)
             for i in range(3)]
     p = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 3).astype(np.float32)
+    w = Workload(f"P3 {label}", len(p))
     scene = bvhkit.TriangleMesh(v, f)
     scene.signed_distance(p[:10], sign="winding_number")
-    runs = {"bvhkit (1 thread)": lambda: scene.signed_distance(p, threads=1),
-            "bvhkit (all threads)": lambda: scene.signed_distance(p),
-            "bvhkit winding_number sign": lambda: scene.signed_distance(p, sign="winding_number")}
-    # Sign errors on a sample, against the exact winding number in float64.
+    # Signs are judged on a sample of the grid against the exact winding number in float64.
     rng = np.random.default_rng(3)
-    sample = p[rng.choice(len(p), min(len(p), 2000), replace=False)]
-    exact = bvhkit.TriangleMesh(v, f, dtype=np.float64).winding_number(sample, exact=True)
+    pick = rng.choice(len(p), min(len(p), 2000), replace=False)
+    exact = bvhkit.TriangleMesh(v, f, dtype=np.float64).winding_number(p[pick], exact=True)
     inside = exact > 0.5
-    results = {"bvhkit (1 thread)": scene.signed_distance(sample) < 0,
-               "bvhkit winding_number sign":
-                   scene.signed_distance(sample, sign="winding_number") < 0}
+    signs = lambda r: np.asarray(r)[pick] < 0
+    w.add("bvhkit (1 thread)", "1", lambda: scene.signed_distance(p, threads=1), signs)
+    w.add("bvhkit (all threads)", "all", lambda: scene.signed_distance(p), signs)
+    w.add("bvhkit winding_number sign", "all",
+          lambda: scene.signed_distance(p, sign="winding_number"), signs)
     o3d = mods.get("open3d")
     if o3d:
-        rs = o3d.t.geometry.RaycastingScene()
-        rs.add_triangles(o3d.core.Tensor(v), o3d.core.Tensor(f.astype(np.uint32)))
-        q = o3d.core.Tensor(p)
-        runs["open3d compute_signed_distance"] = lambda: rs.compute_signed_distance(q)
-        results["open3d compute_signed_distance"] = (
-            rs.compute_signed_distance(o3d.core.Tensor(sample)).numpy() < 0)
+        def setup_o3d():
+            rs = o3d.t.geometry.RaycastingScene()
+            rs.add_triangles(o3d.core.Tensor(v.astype(np.float32)),
+                             o3d.core.Tensor(f.astype(np.uint32)))
+            q = o3d.core.Tensor(p)
+            read = lambda r: r.numpy()[pick] < 0
+            w.add("open3d compute_signed_distance (1)", "1",
+                  lambda: rs.compute_signed_distance(q, nthreads=1), read)
+            w.add("open3d compute_signed_distance (all)", "all",
+                  lambda: rs.compute_signed_distance(q), read)
+        w.peer("open3d compute_signed_distance", setup_o3d)
     igl = mods.get("igl")
     if igl:
-        v64, f64, p64 = v.astype(np.float64), f.astype(np.int64), p.astype(np.float64)
-        runs["igl signed_distance"] = lambda: igl.signed_distance(p64, v64, f64)
-        results["igl signed_distance"] = igl.signed_distance(sample.astype(np.float64), v64,
-                                                             f64)[0] < 0
-    notes = {k: f"sign errors {int((r != inside).sum())}/{len(sample)}"
-             for k, r in results.items()}
-    return _rows(f"P3{label}", _time(runs, reps), len(p), notes)
+        def setup_igl():
+            v64, f64, p64 = v.astype(np.float64), f.astype(np.int64), p.astype(np.float64)
+            w.add("igl signed_distance", "own", lambda: igl.signed_distance(p64, v64, f64),
+                  lambda r: r[0][pick] < 0)
+        w.peer("igl signed_distance", setup_igl)
+    # Every row, bvhkit's own included, is judged against the exact winding number.
+    return w.measure(reps, lambda negative, _: (
+        f"sign errors {int((negative != inside).sum())}/{len(pick)}"))
 
 
 def _rotations(rng, k):
@@ -168,34 +326,75 @@ def p4(v, f, k, reps, mods):
     trans = rng.uniform(-0.5, 0.5, (k, 3)) * diag
     obb = bvhkit.CollisionModel(v, f, volume="obb")
     rss = bvhkit.CollisionModel(v, f, volume="rss")
-    runs = {"bvhkit (1 thread)": lambda: bvhkit.collide(obb, obb, rot, trans, threads=1),
-            "bvhkit (all threads)": lambda: bvhkit.collide(obb, obb, rot, trans)}
-    dist_runs = {"bvhkit (1 thread)": lambda: bvhkit.distance(rss, rss, rot, trans * 2,
-                                                               threads=1),
-                 "bvhkit (all threads)": lambda: bvhkit.distance(rss, rss, rot, trans * 2)}
+    c = Workload("P4 collide", k)
+    d = Workload("P4 dist", k)
+    c.add("bvhkit (1 thread)", "1", lambda: bvhkit.collide(obb, obb, rot, trans, threads=1))
+    c.add("bvhkit (all threads)", "all", lambda: bvhkit.collide(obb, obb, rot, trans))
+    d.add("bvhkit (1 thread)", "1", lambda: bvhkit.distance(rss, rss, rot, trans * 2, threads=1))
+    d.add("bvhkit (all threads)", "all", lambda: bvhkit.distance(rss, rss, rot, trans * 2))
+    v64 = v.astype(np.float64)
+
     fcl = mods.get("fcl")
     if fcl:
-        model = fcl.BVHModel()
-        model.beginModel(len(v), len(f))
-        model.addSubModel(v.astype(np.float64), f.astype(np.int32))
-        model.endModel()
-        a = fcl.CollisionObject(model, fcl.Transform())
+        def setup_fcl():
+            model = fcl.BVHModel()
+            model.beginModel(len(v), len(f))
+            model.addSubModel(v64, f.astype(np.int32))
+            model.endModel()
+            a = fcl.CollisionObject(model, fcl.Transform())
 
-        def fcl_collide(scale=1.0, distance=False):
-            for i in range(k):
-                b = fcl.CollisionObject(model, fcl.Transform(rot[i], trans[i] * scale))
+            def one(r, t, distance):
+                b = fcl.CollisionObject(model, fcl.Transform(r, t))
                 if distance:
-                    fcl.distance(a, b, fcl.DistanceRequest(), fcl.DistanceResult())
-                else:
-                    fcl.collide(a, b, fcl.CollisionRequest(), fcl.CollisionResult())
+                    res = fcl.DistanceResult()
+                    return fcl.distance(a, b, fcl.DistanceRequest(), res)
+                return fcl.collide(a, b, fcl.CollisionRequest(), fcl.CollisionResult()) > 0
+            c.add("python-fcl collide (loop)", "1",
+                  lambda: np.array([one(rot[i], trans[i], False) for i in range(k)]), bool_)
+            d.add("python-fcl distance (loop)", "1",
+                  lambda: np.array([one(rot[i], 2 * trans[i], True) for i in range(k)]), float_)
+        c.peer("python-fcl", setup_fcl)
+    coal = mods.get("coal")
+    if coal:
+        def setup_coal():
+            model = coal.BVHModelOBBRSS()
+            model.beginModel(len(f), len(v))
+            model.addVertices(v64)
+            model.addTriangles(f.astype(np.int64))
+            model.endModel()
+            identity = coal.Transform3s()
 
-        runs["python-fcl collide (loop)"] = fcl_collide
-        dist_runs["python-fcl distance (loop)"] = lambda: fcl_collide(2.0, True)
-    return _rows("P4c", _time(runs, reps), k) + _rows("P4d", _time(dist_runs, reps), k)
+            def one(r, t, distance):
+                pose = coal.Transform3s(np.ascontiguousarray(r), np.ascontiguousarray(t))
+                if distance:
+                    res = coal.DistanceResult()
+                    coal.distance(model, identity, model, pose, coal.DistanceRequest(), res)
+                    return max(res.min_distance, 0.0)
+                res = coal.CollisionResult()
+                coal.collide(model, identity, model, pose, coal.CollisionRequest(), res)
+                return res.isCollision()
+            c.add("coal collide (loop)", "1",
+                  lambda: np.array([one(rot[i], trans[i], False) for i in range(k)]), bool_)
+            d.add("coal distance (loop)", "1",
+                  lambda: np.array([one(rot[i], 2 * trans[i], True) for i in range(k)]), float_)
+        c.peer("coal", setup_coal)
+
+    def check_collide(answer, reference):
+        return f"same yes/no on {int((answer == reference).sum())}/{len(reference)} poses"
+
+    def check_distance(answer, reference):
+        ref = reference.distance
+        err = np.abs(np.maximum(answer, 0) - ref).max() / diag
+        return f"max |diff| {err:.1e} of the diagonal"
+    return c.measure(reps, check_collide) + d.measure(reps, check_distance)
 
 
-def _show(rows: List[str]) -> None:
-    print("\n".join(rows), flush=True)
+def bool_(r):
+    return np.asarray(r, dtype=bool)
+
+
+def float_(r):
+    return np.asarray(r, dtype=np.float64)
 
 
 def main(argv=None) -> None:
@@ -206,31 +405,49 @@ def main(argv=None) -> None:
     ap.add_argument("--reps", type=int, default=3, help="repetitions (median reported)")
     ap.add_argument("--only", default="P1,P2,P3,P4", help="comma-separated workloads")
     ap.add_argument("--mesh", default="igea.ply", help="mesh file or spec for P1 and P2")
+    ap.add_argument("--big-mesh", default="sphere:subdiv=8,displacement=0.2",
+                    help="the large mesh of P1 (1.3M triangles by default); 'none' skips it")
     ap.add_argument("--sdf-mesh", default="spot.obj", help="closed mesh for P3 (holes are cut)")
     ap.add_argument("--collision-mesh", default="stanford-bunny.obj", help="mesh for P4")
     args = ap.parse_args(argv)
-    mods = {m: _optional(m) for m in ("open3d", "trimesh", "igl", "fcl")}
-    present = [m for m, x in mods.items() if x is not None]
+    mods = {m: _optional(m) for m in ("open3d", "trimesh", "igl", "fcpw", "fcl", "coal")}
+    absent = {m: x for m, x in mods.items() if isinstance(x, Exception)}
+    mods = {m: x for m, x in mods.items() if m not in absent}
     print(f"bvhkit {bvhkit.__version__}; cores {os.cpu_count()}; peers present: "
-          f"{', '.join(present) or 'none'}")
-    v, f = _mesh(args.mesh)
+          f"{', '.join(mods) or 'none'}")
+    for m, e in absent.items():
+        print(f"  {m} not used: {type(e).__name__}: {str(e).splitlines()[0][:100]}")
     s = args.scale
     only = set(args.only.split(","))
-    print("work  library                                 median        rate    peer/bvhkit(1)")
+    print("work      library                                thr     median        rate"
+          "  vs bvhkit  answers")
+
+    def show(rows):
+        print("\n".join(rows), flush=True)
 
     if "P1" in only:
-        _show(p1(v, f, int(1_000_000 * s), args.reps, mods))
+        v, f, name = _mesh(args.mesh)
+        print(f"P1: {name}, {len(f)} triangles")
+        show(p1(v, f, int(1_000_000 * s), args.reps, mods, "scan"))
+        if args.big_mesh != "none":
+            bv, bf, bname = _mesh(args.big_mesh)
+            print(f"P1: {bname}, {len(bf)} triangles")
+            show(p1(bv, bf, int(1_000_000 * s), args.reps, mods, "big"))
     if "P2" in only:
-        _show(p2(v, f, int(1_000_000 * s), args.reps, mods))
+        v, f, name = _mesh(args.mesh)
+        print(f"P2: {name}, {len(f)} triangles")
+        show(p2(v, f, int(1_000_000 * s), args.reps, mods))
     if "P3" in only:
         grid = max(8, int(round(128 * s ** (1 / 3))))
-        sv, sf = _mesh(args.sdf_mesh)
-        _show(p3(sv, sf, grid, args.reps, mods, " closed"))
+        sv, sf, name = _mesh(args.sdf_mesh)
+        print(f"P3: {name}, {len(sf)} triangles, {grid}^3 grid")
+        show(p3(sv, sf, grid, args.reps, mods, "closed"))
         holes = np.random.default_rng(5).random(len(sf)) > 0.01  # drop 1% of the faces
-        _show(p3(sv, sf[holes], grid, args.reps, mods, " holes"))
+        show(p3(sv, sf[holes], grid, args.reps, mods, "holes"))
     if "P4" in only:
-        cv, cf = _mesh(args.collision_mesh)
-        _show(p4(cv, cf, max(10, int(1000 * s)), args.reps, mods))
+        cv, cf, name = _mesh(args.collision_mesh)
+        print(f"P4: {name}, {len(cf)} triangles")
+        show(p4(cv, cf, max(10, int(1000 * s)), args.reps, mods))
 
 
 if __name__ == "__main__":
