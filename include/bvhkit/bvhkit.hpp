@@ -12,6 +12,7 @@
 #include "bvhkit/error.hpp"
 #include "bvhkit/io/ray_files.hpp"
 #include "bvhkit/io/read_mesh.hpp"
+#include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/math/ray.hpp"
 #include "bvhkit/math/transform.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
