@@ -1,9 +1,10 @@
 #pragma once
 // Little-endian bytes for the binary tree files (docs/serialization.md): a writer, a reader that
-// checks every read against the bytes left, and FNV-1a 64, the files' checksum. Values are
-// assembled byte by byte with shifts, so the files are the same on machines of either byte order.
+// checks every read against the bytes left, and FNV-1a 64, the files' checksum. A big-endian
+// machine assembles values byte by byte with shifts, so files are the same on either byte order.
 #include <bit>
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <string>
 #include <string_view>
@@ -29,12 +30,8 @@ inline std::uint64_t fnv1a64(std::span<const std::uint8_t> bytes,
 class ByteWriter {
   public:
     void u8(std::uint8_t v) { bytes_.push_back(v); }
-    void u32(std::uint32_t v) {
-        for (int i = 0; i < 4; ++i) bytes_.push_back(std::uint8_t(v >> (8 * i)));
-    }
-    void u64(std::uint64_t v) {
-        for (int i = 0; i < 8; ++i) bytes_.push_back(std::uint8_t(v >> (8 * i)));
-    }
+    void u32(std::uint32_t v) { put(v); }
+    void u64(std::uint64_t v) { put(v); }
     template <class T>
     void scalar(T v) {
         static_assert(sizeof(T) == 4 || sizeof(T) == 8);
@@ -52,6 +49,17 @@ class ByteWriter {
     std::vector<std::uint8_t>& bytes() { return bytes_; }
 
   private:
+    template <class U>
+    void put(U v) {
+        const std::size_t at = bytes_.size();
+        bytes_.resize(at + sizeof(U));
+        if constexpr (std::endian::native == std::endian::little) {
+            std::memcpy(bytes_.data() + at, &v, sizeof(U));  // the same bytes, faster
+        } else {
+            for (std::size_t i = 0; i < sizeof(U); ++i) bytes_[at + i] = std::uint8_t(v >> (8 * i));
+        }
+    }
+
     std::vector<std::uint8_t> bytes_;
 };
 
@@ -69,18 +77,8 @@ class ByteReader {
         need(1);
         return bytes_[pos_++];
     }
-    std::uint32_t u32() {
-        need(4);
-        std::uint32_t v = 0;
-        for (int i = 0; i < 4; ++i) v |= std::uint32_t(bytes_[pos_++]) << (8 * i);
-        return v;
-    }
-    std::uint64_t u64() {
-        need(8);
-        std::uint64_t v = 0;
-        for (int i = 0; i < 8; ++i) v |= std::uint64_t(bytes_[pos_++]) << (8 * i);
-        return v;
-    }
+    std::uint32_t u32() { return get<std::uint32_t>(); }
+    std::uint64_t u64() { return get<std::uint64_t>(); }
     template <class T>
     T scalar() {
         static_assert(sizeof(T) == 4 || sizeof(T) == 8);
@@ -101,6 +99,18 @@ class ByteReader {
   private:
     void need(std::size_t n) const {
         if (n > remaining()) fail("unexpected end of data");
+    }
+    template <class U>
+    U get() {
+        need(sizeof(U));
+        U v = 0;
+        if constexpr (std::endian::native == std::endian::little) {
+            std::memcpy(&v, bytes_.data() + pos_, sizeof(U));
+        } else {
+            for (std::size_t i = 0; i < sizeof(U); ++i) v |= U(bytes_[pos_ + i]) << (8 * i);
+        }
+        pos_ += sizeof(U);
+        return v;
     }
 
     std::span<const std::uint8_t> bytes_;
