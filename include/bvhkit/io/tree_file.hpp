@@ -21,6 +21,13 @@ namespace bvhkit {
 /// The format version this library writes; it reads this version only.
 inline constexpr std::uint32_t tree_file_version = 1;
 
+struct LoadOptions {
+    /// Run validate() on the loaded tree (each node encloses its children and its triangles, each
+    /// triangle once, finite boxes, skipped triangles absent). When false, the loader still checks
+    /// the tree's shape and every index, so queries stay in range: only the geometry is trusted.
+    bool validate = true;
+};
+
 namespace serial_detail {
 
 // PNG's trick: a 0x1A and a '\n' catch a file mangled by a text-mode transfer.
@@ -29,7 +36,7 @@ inline constexpr std::array<std::uint8_t, 8> tree_file_magic = {'B', 'V', 'H',  
 inline constexpr std::size_t tree_file_header_size = 72;
 inline constexpr std::size_t checksum_offset = 64;  // the checksum covers every byte but its own
 
-enum class FileKind : std::uint32_t { TriangleBvh = 1 };
+enum class FileKind : std::uint32_t { TriangleBvh = 1, ClosestPointMesh = 2 };
 enum class ScalarCode : std::uint8_t { Float32 = 1, Float64 = 2 };
 enum class VolumeCode : std::uint8_t { Aabb3 = 1 };
 

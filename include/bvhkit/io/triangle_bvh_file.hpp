@@ -18,19 +18,12 @@
 #include <string>
 #include <vector>
 
-#include "bvhkit/bvh/validate.hpp"
 #include "bvhkit/io/tree_file.hpp"
+#include "bvhkit/io/tree_sections.hpp"
 #include "bvhkit/io/tree_structure.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 
 namespace bvhkit {
-
-struct LoadOptions {
-    /// Run validate() on the loaded tree (each node encloses its children and its triangles, each
-    /// triangle once, finite boxes, skipped triangles absent). When false, the loader still checks
-    /// the tree's shape and every index, so queries stay in range: only the geometry is trusted.
-    bool validate = true;
-};
 
 namespace serial_detail {
 
@@ -45,27 +38,18 @@ struct TriangleBvhAccess {
         const auto& bvh = tree.bvh_;
         const bool fast = tree.triangle_test_ == TriangleTest::Fast;
         ByteWriter w;
-        w.reserve(bvh.nodes.size() * (6 * sizeof(T) + 8) +
+        w.reserve(bvh.nodes.size() * node_record_bytes<T> +
                   bvh.primitive_indices.size() * (4 + 12 * sizeof(T)) + 32);
-        const auto vec = [&](const Vec<T, 3>& v) {
-            for (std::size_t a = 0; a < 3; ++a) w.scalar(v[a]);
-        };
-        for (const auto& n : bvh.nodes) {
-            vec(n.bounds.min);
-            vec(n.bounds.max);
-            w.u32(n.first);
-            w.u32(n.count);
+        put_nodes(w, bvh);
+        put_u32s(w, bvh.primitive_indices);
+        if (fast) {
+            for (const auto& t : tree.fast_)
+                put_vec(w, t.p0), put_vec(w, t.e1), put_vec(w, t.e2), put_vec(w, t.n);
+            w.pad(8);
+        } else {
+            put_corners<T>(w, tree.exact_);
         }
-        w.pad(8);
-        for (const std::uint32_t p : bvh.primitive_indices) w.u32(p);
-        w.pad(8);
-        if (fast)
-            for (const auto& t : tree.fast_) vec(t.p0), vec(t.e1), vec(t.e2), vec(t.n);
-        else
-            for (const auto& t : tree.exact_) vec(t.p0), vec(t.p1), vec(t.p2);
-        w.pad(8);
-        for (const std::uint32_t p : tree.report_.skipped) w.u32(p);
-        w.pad(8);
+        put_u32s(w, tree.report_.skipped);
         TreeFileHeader h;
         h.kind = FileKind::TriangleBvh;
         h.scalar = scalar_code<T>();
@@ -80,92 +64,46 @@ struct TriangleBvhAccess {
     static TriangleBvh<T> load(std::span<const std::uint8_t> file, const LoadOptions& options) {
         const OpenedTreeFile f = open_tree_file(file, FileKind::TriangleBvh, what);
         const TreeFileHeader& h = f.header;
-        const auto fail = [](const std::string& m) { throw Error(std::string(what) + ": " + m); };
-        if (h.scalar != scalar_code<T>())
-            fail(std::string("the file holds a ") + scalar_name(std::uint8_t(h.scalar)) +
-                 " tree, loaded as " + scalar_name(std::uint8_t(scalar_code<T>())));
-        if (h.volume != VolumeCode::Aabb3)
-            fail("unknown bounding volume " + std::to_string(int(h.volume)));
+        check_scalar_and_volume<T>(h, what);
         const auto layout = TriangleLayout(h.layout);
         if (layout != TriangleLayout::Corners && layout != TriangleLayout::Precomputed)
-            fail("unknown triangle layout " + std::to_string(int(h.layout)));
+            throw Error(std::string(what) + ": unknown triangle layout " +
+                        std::to_string(int(h.layout)));
         const bool fast = layout == TriangleLayout::Precomputed;
+        check_tree_counts(h, node_record_bytes<T>, (fast ? 12 : 9) * sizeof(T), 0, what);
         const auto [node_count, slot_count, skipped_count, triangle_count] = h.counts;
 
-        // Every count against the payload before any allocation; then the exact total.
-        const std::uint64_t limit = h.payload_size;
-        const std::uint64_t expected =
-            section_bytes(node_count, 6 * sizeof(T) + 8, limit, what, "node") +
-            section_bytes(slot_count, 4, limit, what, "slot") +
-            section_bytes(slot_count, (fast ? 12 : 9) * sizeof(T), limit, what, "triangle") +
-            section_bytes(skipped_count, 4, limit, what, "skipped");
-        if (expected != h.payload_size)
-            fail("the counts need " + std::to_string(expected) + " payload bytes, the file has " +
-                 std::to_string(h.payload_size));
-        if (node_count > 0xffffffffu || slot_count > 0xffffffffu)
-            fail("more than 2^32 - 1 nodes or slots");
-        if (triangle_count != slot_count + skipped_count)
-            fail("triangle count " + std::to_string(triangle_count) + " is not slots (" +
-                 std::to_string(slot_count) + ") + skipped (" + std::to_string(skipped_count) +
-                 ")");
-
         ByteReader r(f.payload, what);
-        const auto vec = [&] {
-            Vec<T, 3> v;
-            for (std::size_t a = 0; a < 3; ++a) v[a] = r.scalar<T>();
-            return v;
-        };
         TriangleBvh<T> tree;
         tree.triangle_test_ = fast ? TriangleTest::Fast : TriangleTest::Watertight;
         tree.triangle_count_ = std::size_t(triangle_count);
         auto& bvh = tree.bvh_;
-        bvh.nodes.resize(std::size_t(node_count));
-        for (auto& n : bvh.nodes) {
-            n.bounds.min = vec();
-            n.bounds.max = vec();
-            n.first = r.u32();
-            n.count = r.u32();
-        }
-        r.skip_padding(8);
-        bvh.primitive_indices.resize(std::size_t(slot_count));
-        for (std::uint32_t& p : bvh.primitive_indices) p = r.u32();
-        r.skip_padding(8);
+        get_nodes(r, bvh, node_count);
+        get_u32s(r, bvh.primitive_indices, slot_count);
         if (fast) {
             tree.fast_.resize(std::size_t(slot_count));
-            for (auto& t : tree.fast_) t.p0 = vec(), t.e1 = vec(), t.e2 = vec(), t.n = vec();
+            for (auto& t : tree.fast_)
+                t.p0 = get_vec<T>(r), t.e1 = get_vec<T>(r), t.e2 = get_vec<T>(r),
+                t.n = get_vec<T>(r);
+            r.skip_padding(8);
         } else {
-            tree.exact_.resize(std::size_t(slot_count));
-            for (auto& t : tree.exact_) t.p0 = vec(), t.p1 = vec(), t.p2 = vec();
+            get_corners(r, tree.exact_, slot_count);
         }
-        r.skip_padding(8);
         auto& skipped = tree.report_.skipped;
-        skipped.resize(std::size_t(skipped_count));
-        for (std::uint32_t& p : skipped) p = r.u32();
-        r.skip_padding(8);
+        get_u32s(r, skipped, skipped_count);
 
         check_tree_structure(bvh, triangle_count, what);
-        for (std::size_t i = 0; i < skipped.size(); ++i)
-            if (skipped[i] >= triangle_count || (i && skipped[i] <= skipped[i - 1]))
-                fail("skipped triangles out of range or not ascending");
-        if (options.validate) validate_geometry(tree, fast);
+        check_skipped(skipped, triangle_count, what);
+        // The fast layout keeps no corners (p0 - e1 need not round back to p1): there a
+        // triangle's box is its leaf's, and a leaf's enclosure of its triangles goes unchecked.
+        if (options.validate)
+            validate_loaded(
+                bvh, tree.triangle_count_, skipped,
+                [&](std::uint32_t s, const auto& leaf) {
+                    return fast ? leaf.bounds : tree.exact_[s].bounds();
+                },
+                what);
         return tree;
-    }
-
-    // validate() against each triangle's box. The fast layout keeps no corners (p0 - e1 need not
-    // round back to p1), so there a triangle's box is its leaf's: its own enclosure goes unchecked.
-    template <class T>
-    static void validate_geometry(const TriangleBvh<T>& tree, bool fast) {
-        const auto& bvh = tree.bvh_;
-        std::vector<Aabb<T, 3>> boxes(tree.triangle_count_);  // absent ones stay empty
-        for (const auto& n : bvh.nodes)
-            if (n.is_leaf())
-                for (std::uint32_t s = n.first; s < n.first + n.count; ++s)
-                    boxes[bvh.primitive_indices[s]] = fast ? n.bounds : tree.exact_[s].bounds();
-        try {
-            validate(bvh, boxes, tree.report_.skipped);
-        } catch (const Error& e) {
-            throw Error(std::string(what) + ": " + e.what());
-        }
     }
 };
 
