@@ -11,6 +11,7 @@
 #include "bvhkit/dynamic/dynamic_tree.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/io/ray_files.hpp"
+#include "bvhkit/io/closest_point_mesh_file.hpp"
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/math/ray.hpp"

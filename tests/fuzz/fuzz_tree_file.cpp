@@ -1,11 +1,13 @@
-// libFuzzer target: the TriangleBvh loader on arbitrary bytes, as they come and again with the
-// checksum recomputed (random bytes almost never carry a valid checksum, and the checks behind it
-// are the ones worth fuzzing). A load may throw bvhkit::Error; a tree it accepts, with or without
-// validate(), must answer rays with indices in range (ASan and UBSan watch the traversal).
+// libFuzzer target: the TriangleBvh and ClosestPointMesh loaders on arbitrary bytes, as they come
+// and again with the checksum recomputed (random bytes almost never carry a valid checksum, and the
+// checks behind it are the ones worth fuzzing). A load may throw bvhkit::Error; a structure it
+// accepts, with or without validate(), must answer queries with indices in range (ASan and UBSan
+// watch the walks).
 #include <cstdlib>
 #include <span>
 #include <vector>
 
+#include "bvhkit/io/closest_point_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 
 namespace {
@@ -37,6 +39,28 @@ void load_and_query(std::span<const std::uint8_t> bytes) {
     }
 }
 
+template <class T>
+void load_closest_point_mesh_and_query(std::span<const std::uint8_t> bytes) {
+    for (const bool validate : {true, false}) {
+        try {
+            const bvhkit::ClosestPointMesh<T> mesh =
+                bvhkit::closest_point_mesh_from_bytes<T>(bytes, bvhkit::LoadOptions{validate});
+            bvhkit::NearestScratch<T> scratch;
+            std::vector<bvhkit::MeshPoint<T>> near;
+            const bvhkit::Vec<T, 3> points[] = {{T(-2), T(0.1), T(0.2)}, {T(0.3), T(0.2), T(0.1)}};
+            for (const auto& p : points) {
+                const auto q = mesh.closest_point(p, scratch);
+                if (q && q.triangle >= mesh.triangle_count()) std::abort();
+                mesh.k_nearest(p, 3, near, scratch);
+                mesh.within_radius(p, T(0.5), near);
+                for (const auto& n : near)
+                    if (n.triangle >= mesh.triangle_count()) std::abort();
+            }
+        } catch (const bvhkit::Error&) {
+        }
+    }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -44,10 +68,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     load_and_query<float>(raw);
     std::vector<std::uint8_t> resealed(raw.begin(), raw.end());
     bvhkit::serial_detail::reseal_tree_file(resealed);
-    // Byte 16 is the scalar type: load as the file says, so the fuzzer gets past that check.
-    if (size > 16 && data[16] == 2)
+    // Byte 12 is the kind, byte 16 the scalar type: load as the file says, so the fuzzer gets
+    // past those checks.
+    const bool as_double = size > 16 && data[16] == 2;
+    if (size > 16 && data[12] == 2) {
+        load_closest_point_mesh_and_query<float>(raw);
+        if (as_double)
+            load_closest_point_mesh_and_query<double>(resealed);
+        else
+            load_closest_point_mesh_and_query<float>(resealed);
+    } else if (as_double) {
         load_and_query<double>(resealed);
-    else
+    } else {
         load_and_query<float>(resealed);
+    }
     return 0;
 }

@@ -1,12 +1,13 @@
 // Writes the seed corpus of fuzz_tree_file into the folder given: small saved TriangleBvh files
-// (float and double, both triangle layouts, one with skipped triangles, an empty tree), each a few
-// KB so the fuzzer's mutations land on every section.
+// (float and double, both triangle layouts, one with skipped triangles, an empty tree) and
+// ClosestPointMesh files, each a few KB so the fuzzer's mutations land on every section.
 #include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "bvhkit/io/closest_point_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 
 namespace {
@@ -51,5 +52,8 @@ int main(int argc, char** argv) {
     holes[4].p2[1] = std::numeric_limits<float>::infinity();
     write(dir, "float_skipped.bvh", holes, TriangleTest::Watertight);
     write(dir, "empty.bvh", std::vector<bvhkit::Triangle<float>>{}, TriangleTest::Watertight);
+    bvhkit::save(bvhkit::ClosestPointMesh<float>(grid<float>(3)), dir / "closest_float.bvh");
+    bvhkit::save(bvhkit::ClosestPointMesh<float>(holes), dir / "closest_skipped.bvh");
+    bvhkit::save(bvhkit::ClosestPointMesh<double>(grid<double>(2)), dir / "closest_double.bvh");
     return 0;
 }
