@@ -26,10 +26,11 @@ namespace bvhkit {
 namespace serial_detail {
 
 struct ClosestPointMeshAccess {
-    static constexpr const char* what = "ClosestPointMesh file";
+    static constexpr const char* file_what = "ClosestPointMesh file";
 
+    // The sections into w; the header to seal them with.
     template <class T>
-    static std::vector<std::uint8_t> save(const ClosestPointMesh<T>& mesh) {
+    static TreeFileHeader put(ByteWriter& w, const ClosestPointMesh<T>& mesh) {
         const auto& bvh = mesh.bvh_;
         const std::size_t slots = bvh.primitive_indices.size();
         // The complement of the slot indices: the triangles left out of the tree.
@@ -38,7 +39,6 @@ struct ClosestPointMeshAccess {
         std::vector<std::uint32_t> skipped;
         for (std::size_t i = 0; i < in_tree.size(); ++i)
             if (!in_tree[i]) skipped.push_back(std::uint32_t(i));
-        ByteWriter w;
         w.reserve(bvh.nodes.size() * node_record_bytes<T> + slots * (4 + 9 * sizeof(T)) + 64);
         put_nodes(w, bvh);
         put_u32s(w, bvh.primitive_indices);
@@ -52,21 +52,34 @@ struct ClosestPointMeshAccess {
         h.volume = VolumeCode::Aabb3;
         h.layout = 1;  // corners
         h.counts = {bvh.nodes.size(), slots, skipped.size(), mesh.triangle_count_};
+        return h;
+    }
+
+    template <class T>
+    static std::vector<std::uint8_t> save(const ClosestPointMesh<T>& mesh) {
+        ByteWriter w;
+        const TreeFileHeader h = put(w, mesh);
         return seal_tree_file(h, w.bytes());
     }
 
     template <class T>
     static ClosestPointMesh<T> load(std::span<const std::uint8_t> file,
                                     const LoadOptions& options) {
-        const OpenedTreeFile f = open_tree_file(file, FileKind::ClosestPointMesh, what);
-        const TreeFileHeader& h = f.header;
-        const auto fail = [](const std::string& m) { throw Error(std::string(what) + ": " + m); };
+        const OpenedTreeFile f = open_tree_file(file, FileKind::ClosestPointMesh, file_what);
+        ByteReader r(f.payload, file_what);
+        return get<T>(f.header, r, options, true, file_what);
+    }
+
+    // Reads the sections put() wrote; `whole` says they fill the payload (else more follow).
+    template <class T>
+    static ClosestPointMesh<T> get(const TreeFileHeader& h, ByteReader& r,
+                                   const LoadOptions& options, bool whole, const char* what) {
+        const auto fail = [&](const std::string& m) { throw Error(std::string(what) + ": " + m); };
         check_scalar_and_volume<T>(h, what);
         if (h.layout != 1) fail("unknown triangle layout " + std::to_string(int(h.layout)));
-        check_tree_counts(h, node_record_bytes<T>, 9 * sizeof(T), 8, what);
+        check_tree_counts(h, node_record_bytes<T>, 9 * sizeof(T), 8, what, whole);
         const auto [node_count, slot_count, skipped_count, triangle_count] = h.counts;
 
-        ByteReader r(f.payload, what);
         ClosestPointMesh<T> mesh;
         auto& bvh = mesh.bvh_;
         get_nodes(r, bvh, node_count);

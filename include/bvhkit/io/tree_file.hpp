@@ -36,7 +36,11 @@ inline constexpr std::array<std::uint8_t, 8> tree_file_magic = {'B', 'V', 'H',  
 inline constexpr std::size_t tree_file_header_size = 72;
 inline constexpr std::size_t checksum_offset = 64;  // the checksum covers every byte but its own
 
-enum class FileKind : std::uint32_t { TriangleBvh = 1, ClosestPointMesh = 2 };
+enum class FileKind : std::uint32_t {
+    TriangleBvh = 1,
+    ClosestPointMesh = 2,
+    SignedDistanceMesh = 3
+};
 enum class ScalarCode : std::uint8_t { Float32 = 1, Float64 = 2 };
 enum class VolumeCode : std::uint8_t { Aabb3 = 1 };
 

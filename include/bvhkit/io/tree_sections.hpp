@@ -86,10 +86,11 @@ void check_scalar_and_volume(const TreeFileHeader& h, const char* what) {
 
 /// counts = {nodes, slots, skipped, triangles}: each against the payload before any allocation,
 /// then the sections' total (`triangle_record` bytes per slot, `extra` bytes after the skipped
-/// list) against the payload size, the u32 range, and triangles = slots + skipped.
+/// list) against the payload size (equal, or for `exact` false at most: more sections follow,
+/// checked by their reader), the u32 range, and triangles = slots + skipped.
 inline void check_tree_counts(const TreeFileHeader& h, std::uint64_t node_record,
-                              std::uint64_t triangle_record, std::uint64_t extra,
-                              const char* what) {
+                              std::uint64_t triangle_record, std::uint64_t extra, const char* what,
+                              bool exact = true) {
     const auto [nodes, slots, skipped, triangles] = h.counts;
     const std::uint64_t limit = h.payload_size;
     const std::uint64_t expected = section_bytes(nodes, node_record, limit, what, "node") +
@@ -97,7 +98,7 @@ inline void check_tree_counts(const TreeFileHeader& h, std::uint64_t node_record
                                    section_bytes(slots, triangle_record, limit, what, "triangle") +
                                    section_bytes(skipped, 4, limit, what, "skipped") + extra;
     const auto fail = [&](const std::string& m) { throw Error(std::string(what) + ": " + m); };
-    if (expected != h.payload_size)
+    if (exact ? expected != h.payload_size : expected > h.payload_size)
         fail("the counts need " + std::to_string(expected) + " payload bytes, the file has " +
              std::to_string(h.payload_size));
     if (nodes > 0xffffffffu || slots > 0xffffffffu) fail("more than 2^32 - 1 nodes or slots");
