@@ -13,6 +13,7 @@
 #include "bvhkit/io/ray_files.hpp"
 #include "bvhkit/io/closest_point_mesh_file.hpp"
 #include "bvhkit/io/read_mesh.hpp"
+#include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/math/ray.hpp"
 #include "bvhkit/math/transform.hpp"

@@ -1,6 +1,7 @@
 // Writes the seed corpus of fuzz_tree_file into the folder given: small saved TriangleBvh files
-// (float and double, both triangle layouts, one with skipped triangles, an empty tree) and
-// ClosestPointMesh files, each a few KB so the fuzzer's mutations land on every section.
+// (float and double, both triangle layouts, one with skipped triangles, an empty tree),
+// ClosestPointMesh and SignedDistanceMesh files, each a few KB so the fuzzer's mutations land on
+// every section.
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "bvhkit/io/closest_point_mesh_file.hpp"
+#include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 
 namespace {
@@ -55,5 +57,12 @@ int main(int argc, char** argv) {
     bvhkit::save(bvhkit::ClosestPointMesh<float>(grid<float>(3)), dir / "closest_float.bvh");
     bvhkit::save(bvhkit::ClosestPointMesh<float>(holes), dir / "closest_skipped.bvh");
     bvhkit::save(bvhkit::ClosestPointMesh<double>(grid<double>(2)), dir / "closest_double.bvh");
+    // A closed octahedron, for the signed distance.
+    bvhkit::TriangleMesh octahedron;
+    octahedron.vertices = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    octahedron.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                            {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    bvhkit::save(bvhkit::SignedDistanceMesh<float>(octahedron), dir / "signed_float.bvh");
+    bvhkit::save(bvhkit::SignedDistanceMesh<double>(octahedron), dir / "signed_double.bvh");
     return 0;
 }
