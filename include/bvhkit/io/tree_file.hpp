@@ -39,7 +39,8 @@ inline constexpr std::size_t checksum_offset = 64;  // the checksum covers every
 enum class FileKind : std::uint32_t {
     TriangleBvh = 1,
     ClosestPointMesh = 2,
-    SignedDistanceMesh = 3
+    SignedDistanceMesh = 3,
+    WindingNumberMesh = 4
 };
 enum class ScalarCode : std::uint8_t { Float32 = 1, Float64 = 2 };
 enum class VolumeCode : std::uint8_t { Aabb3 = 1 };
