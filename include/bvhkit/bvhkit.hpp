@@ -15,6 +15,7 @@
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
+#include "bvhkit/io/winding_number_mesh_file.hpp"
 #include "bvhkit/math/ray.hpp"
 #include "bvhkit/math/transform.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"

@@ -1,8 +1,8 @@
-// libFuzzer target: the TriangleBvh, ClosestPointMesh and SignedDistanceMesh loaders on arbitrary
-// bytes, as they come and again with the checksum recomputed (random bytes almost never carry a
-// valid checksum, and the checks behind it are the ones worth fuzzing). A load may throw
-// bvhkit::Error; a structure it accepts, with or without validate(), must answer queries with
-// indices in range (ASan and UBSan watch the walks).
+// libFuzzer target: the TriangleBvh, ClosestPointMesh, SignedDistanceMesh and WindingNumberMesh
+// loaders on arbitrary bytes, as they come and again with the checksum recomputed (random bytes
+// almost never carry a valid checksum, and the checks behind it are the ones worth fuzzing). A
+// load may throw bvhkit::Error; a structure it accepts, with or without validate(), must answer
+// queries with indices in range (ASan and UBSan watch the walks).
 #include <cstdlib>
 #include <span>
 #include <vector>
@@ -10,6 +10,7 @@
 #include "bvhkit/io/closest_point_mesh_file.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
+#include "bvhkit/io/winding_number_mesh_file.hpp"
 
 namespace {
 
@@ -76,6 +77,19 @@ void load_signed_distance_mesh_and_query(std::span<const std::uint8_t> bytes) {
     }
 }
 
+template <class T>
+void load_winding_number_mesh_and_query(std::span<const std::uint8_t> bytes) {
+    for (const bool validate : {true, false}) {
+        try {
+            const bvhkit::WindingNumberMesh<T> mesh =
+                bvhkit::winding_number_mesh_from_bytes<T>(bytes, bvhkit::LoadOptions{validate});
+            const bvhkit::Vec<T, 3> points[] = {{T(-2), T(0.1), T(0.2)}, {T(0.3), T(0.2), T(0.1)}};
+            for (const auto& p : points) (void)mesh.fast(p), (void)mesh.exact(p);
+        } catch (const bvhkit::Error&) {
+        }
+    }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -98,6 +112,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             load_signed_distance_mesh_and_query<double>(resealed);
         else
             load_signed_distance_mesh_and_query<float>(resealed);
+    } else if (size > 16 && data[12] == 4) {
+        load_winding_number_mesh_and_query<float>(raw);
+        if (as_double)
+            load_winding_number_mesh_and_query<double>(resealed);
+        else
+            load_winding_number_mesh_and_query<float>(resealed);
     } else if (as_double) {
         load_and_query<double>(resealed);
     } else {

@@ -1,7 +1,7 @@
 // Writes the seed corpus of fuzz_tree_file into the folder given: small saved TriangleBvh files
 // (float and double, both triangle layouts, one with skipped triangles, an empty tree),
-// ClosestPointMesh and SignedDistanceMesh files, each a few KB so the fuzzer's mutations land on
-// every section.
+// ClosestPointMesh, SignedDistanceMesh and WindingNumberMesh files, each a few KB so the fuzzer's
+// mutations land on every section.
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -11,6 +11,7 @@
 #include "bvhkit/io/closest_point_mesh_file.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
+#include "bvhkit/io/winding_number_mesh_file.hpp"
 
 namespace {
 
@@ -64,5 +65,7 @@ int main(int argc, char** argv) {
                             {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
     bvhkit::save(bvhkit::SignedDistanceMesh<float>(octahedron), dir / "signed_float.bvh");
     bvhkit::save(bvhkit::SignedDistanceMesh<double>(octahedron), dir / "signed_double.bvh");
+    bvhkit::save(bvhkit::WindingNumberMesh<float>(octahedron), dir / "winding_float.bvh");
+    bvhkit::save(bvhkit::WindingNumberMesh<double>(octahedron), dir / "winding_double.bvh");
     return 0;
 }
