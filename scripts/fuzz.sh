@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets for the mesh readers (clang, ASan + UBSan) in build/fuzz and runs
-# each for a bounded time from a small seed corpus written here.
+# Builds the libFuzzer targets for the mesh readers and the tree file loader (clang, ASan + UBSan)
+# in build/fuzz and runs each for a bounded time from a small seed corpus written here (for the
+# loader: small trees saved by tree_file_seeds).
 #   scripts/fuzz.sh [seconds per target, default 20]
 # Exits non-zero if a fuzzer reports a crash, leak, timeout or sanitizer error; the reproducer is
 # left in build/fuzz/artifacts/.
@@ -41,12 +42,13 @@ fi
 CXX=clang++ cmake -S "$repo" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DBVHKIT_BUILD_FUZZ=ON -DBVHKIT_BUILD_TESTS=OFF -DBVHKIT_BUILD_TOOLS=OFF -DBVHKIT_BUILD_BENCH=OFF \
     > "$build.configure.log" 2>&1 || { cat "$build.configure.log"; exit 1; }
-cmake --build "$build" --target fuzz_obj fuzz_ply fuzz_stl
+cmake --build "$build" --target fuzz_obj fuzz_ply fuzz_stl fuzz_tree_file tree_file_seeds
 
 # Seed corpus: one tiny valid file per format (and variant), written fresh each run.
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$work/obj" "$work/ply" "$work/stl"
+"$build/tests/fuzz/tree_file_seeds" "$work/tree_file"
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' > "$work/obj/quad.obj"
 printf '# c\r\nv 0 0 0\r\nvt 0 0\r\nvn 0 0 1\r\nv 1 0 0\r\nv 0 1 0\r\nf -3/1/1 -2/1/1 -1/1/1\r\nf 1//1 2//1 3//1\r\n' \
     > "$work/obj/forms.obj"
@@ -80,7 +82,7 @@ printf 'solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nver
 
 mkdir -p "$build/artifacts"
 failed=()
-for format in obj ply stl; do
+for format in obj ply stl tree_file; do
     echo "== fuzz_$format for ${seconds}s"
     if ! "$build/tests/fuzz/fuzz_$format" "$work/$format" -max_total_time="$seconds" -max_len=4096 \
         -rss_limit_mb=1024 -timeout=5 -print_final_stats=1 \

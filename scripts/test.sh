@@ -3,7 +3,7 @@
 # AddressSanitizer + UndefinedBehaviorSanitizer build and runs every test in both, runs the
 # concurrency tests under ThreadSanitizer, builds the plain configuration a user without any optional
 # package gets, checks that a separate CMake project can find_package(bvhkit) from an install, builds
-# the Python package and runs its tests, and fuzzes each mesh reader briefly. Tests that cannot run here (a mesh or a peer library not found)
+# the Python package and runs its tests, and fuzzes each mesh reader and the tree file loader briefly. Tests that cannot run here (a mesh or a peer library not found)
 # are reported as skipped, with the reason.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -19,6 +19,10 @@
 
 namespace bvhkit {
 
+namespace serial_detail {
+struct TriangleBvhAccess;  // io/triangle_bvh_file.hpp: saves and loads the private arrays
+}
+
 enum class TriangleTest {
     Watertight,  // Woop, Benthin, Wald 2013: never misses through a shared edge (default)
     Fast,        // Moller-Trumbore on precomputed edges: a ray can slip through a shared edge
@@ -132,6 +136,8 @@ class TriangleBvh {
     std::size_t triangle_count() const { return triangle_count_; }
 
   private:
+    friend struct serial_detail::TriangleBvhAccess;
+
     template <class TriangleAt>
     void build(TriangleAt&& triangle, std::size_t count, const BuildOptions& options) {
         std::vector<Aabb<T, 3>> boxes;

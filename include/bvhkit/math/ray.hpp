@@ -113,10 +113,11 @@ struct RaySlabData {
     decltype(auto) dispatch(F& f, std::integer_sequence<unsigned, O...>) const {
         using R = decltype(f(std::integral_constant<unsigned, 0>{}));
         if constexpr (std::is_void_v<R>) {
-            ((octant == O ? (f(std::integral_constant<unsigned, O>{}), true) : false) || ...);
+            (void)((octant == O ? (f(std::integral_constant<unsigned, O>{}), true) : false) || ...);
         } else {
             R r{};
-            ((octant == O ? (r = f(std::integral_constant<unsigned, O>{}), true) : false) || ...);
+            (void)((octant == O ? (r = f(std::integral_constant<unsigned, O>{}), true) : false) ||
+                   ...);
             return r;
         }
     }

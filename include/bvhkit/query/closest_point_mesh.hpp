@@ -34,6 +34,10 @@
 
 namespace bvhkit {
 
+namespace serial_detail {
+struct ClosestPointMeshAccess;  // io/closest_point_mesh_file.hpp: saves and loads the arrays
+}
+
 /// A point on the mesh: triangle == invalid_index when there is none (an empty mesh, or nothing
 /// within the search radius).
 template <class T>
@@ -188,6 +192,8 @@ class ClosestPointMesh {
     std::size_t triangle_count() const { return triangle_count_; }
 
   private:
+    friend struct serial_detail::ClosestPointMeshAccess;
+
     void build(const std::vector<Triangle<T>>& tris, const BuildOptions& options) {
         std::vector<Aabb<T, 3>> boxes(tris.size());
         std::vector<Vec<T, 3>> centroids(tris.size());
@@ -204,15 +210,6 @@ class ClosestPointMesh {
         tris_.push_back(Triangle<T>{});
         triangle_count_ = tris.size();
 
-        wide_ = collapse_to_wide(bvh_);
-        // The packs hold the triangles scaled by a power of two (exact, barring denormals) that
-        // brings the largest coordinate to [1, 2) (for all but meshes within a few binades of
-        // T's range): the pack formula's products of four lengths then neither overflow nor
-        // sink into denormals, for meshes in any unit.
-        const T magnitude =
-            bvh_.empty()
-                ? T(0)
-                : max_component(max(abs(bvh_.root().bounds.min), abs(bvh_.root().bounds.max)));
         // The longest edge, rounded up, for widened(); triangles with a NaN or infinite
         // coordinate are left out of the tree and of this.
         double longest2 = 0;
@@ -224,6 +221,19 @@ class ClosestPointMesh {
             if (std::isfinite(e2)) longest2 = std::max(longest2, e2);
         }
         longest_edge_ = T(std::sqrt(longest2) * (1 + 1e-6));
+        derive_walk_data();
+    }
+    // The wide tree and the packs, from bvh_ and tris_ alone (a loaded file rebuilds them so).
+    void derive_walk_data() {
+        wide_ = collapse_to_wide(bvh_);
+        // The packs hold the triangles scaled by a power of two (exact, barring denormals) that
+        // brings the largest coordinate to [1, 2) (for all but meshes within a few binades of
+        // T's range): the pack formula's products of four lengths then neither overflow nor
+        // sink into denormals, for meshes in any unit.
+        const T magnitude =
+            bvh_.empty()
+                ? T(0)
+                : max_component(max(abs(bvh_.root().bounds.min), abs(bvh_.root().bounds.max)));
         constexpr int max_shift = std::numeric_limits<T>::max_exponent - 8;
         pack_scale_ =
             magnitude > T(0) && std::isfinite(magnitude)

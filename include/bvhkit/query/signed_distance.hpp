@@ -24,6 +24,10 @@
 
 namespace bvhkit {
 
+namespace serial_detail {
+struct SignedDistanceMeshAccess;  // io/signed_distance_mesh_file.hpp: saves and loads the arrays
+}
+
 template <class T>
 struct SignedDistance {
     T distance = 0;  // negative inside
@@ -141,6 +145,9 @@ class SignedDistanceMesh {
     const ClosestPointMesh<T>& closest_point_mesh() const { return closest_; }
 
   private:
+    friend struct serial_detail::SignedDistanceMeshAccess;
+    SignedDistanceMesh() = default;  // for the loader, which fills every member
+
     /// The pseudonormal of the feature (face, edge or vertex) the closest point lies on, told by
     /// which barycentric coordinates vanish (closest_point returns them exactly 0 or 1 in the
     /// vertex and edge regions; the p1-p2 edge's third weight is 1 - u - v, so a tolerance).

@@ -38,6 +38,10 @@
 
 namespace bvhkit {
 
+namespace serial_detail {
+struct WindingNumberMeshAccess;  // io/winding_number_mesh_file.hpp: saves and loads the arrays
+}
+
 /// Solid angle of triangle (a, b, c) seen from q, signed: positive when q sees its back (the side
 /// opposite to (b - a) x (c - a)).
 template <class T>
@@ -65,6 +69,15 @@ class WindingNumberMesh {
         }
         bvh_ = build_bvh<T, 3>(boxes, centroids, options);
         for (std::uint32_t i : bvh_.primitive_indices) tris_.push_back(tris[i]);
+        derive_dipoles();
+    }
+
+  private:
+    friend struct serial_detail::WindingNumberMeshAccess;
+    WindingNumberMesh() = default;  // for the loader, which fills bvh_ and tris_
+
+    // The dipoles from bvh_ and tris_ alone (a loaded file derives them so).
+    void derive_dipoles() {
         // Per node: sum of area-weighted normals, area-weighted centre, the first moment
         // sum(a_i (centroid_i - centre) (x) n_i) and radius, children before parents (reverse
         // array order). Sums in double; a child's moment moves to its parent's centre by
@@ -169,6 +182,7 @@ class WindingNumberMesh {
         }
     }
 
+  public:
     /// The exact winding number: every triangle's solid angle.
     T exact(const Vec<T, 3>& q) const {
         double sum = 0;

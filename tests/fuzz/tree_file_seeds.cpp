@@ -1,0 +1,71 @@
+// Writes the seed corpus of fuzz_tree_file into the folder given: small saved TriangleBvh files
+// (float and double, both triangle layouts, one with skipped triangles, an empty tree),
+// ClosestPointMesh, SignedDistanceMesh and WindingNumberMesh files, each a few KB so the fuzzer's
+// mutations land on every section.
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "bvhkit/io/closest_point_mesh_file.hpp"
+#include "bvhkit/io/signed_distance_mesh_file.hpp"
+#include "bvhkit/io/triangle_bvh_file.hpp"
+#include "bvhkit/io/winding_number_mesh_file.hpp"
+
+namespace {
+
+// A small grid of triangles in the unit square, slightly tilted so boxes are not flat.
+template <class T>
+std::vector<bvhkit::Triangle<T>> grid(int n) {
+    std::vector<bvhkit::Triangle<T>> out;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const T x = T(i) / T(n), y = T(j) / T(n), s = T(1) / T(n), z = T(0.1) * x;
+            out.push_back({{x, y, z}, {x + s, y, z}, {x, y + s, z + s}});
+            out.push_back({{x + s, y, z}, {x + s, y + s, z + s}, {x, y + s, z}});
+        }
+    return out;
+}
+
+template <class T>
+void write(const std::filesystem::path& dir, const std::string& name,
+           const std::vector<bvhkit::Triangle<T>>& tris, bvhkit::TriangleTest test) {
+    bvhkit::TriangleBvhOptions options;
+    options.triangle_test = test;
+    options.max_leaf_size = 2;
+    bvhkit::save(bvhkit::TriangleBvh<T>(tris, options), dir / name);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc != 2) {
+        std::fprintf(stderr, "usage: %s OUTPUT_DIR\n", argv[0]);
+        return 2;
+    }
+    const std::filesystem::path dir = argv[1];
+    std::filesystem::create_directories(dir);
+    using bvhkit::TriangleTest;
+    write(dir, "float_watertight.bvh", grid<float>(4), TriangleTest::Watertight);
+    write(dir, "float_fast.bvh", grid<float>(3), TriangleTest::Fast);
+    write(dir, "double_watertight.bvh", grid<double>(3), TriangleTest::Watertight);
+    auto holes = grid<float>(3);
+    holes[1].p0[0] = std::numeric_limits<float>::quiet_NaN();
+    holes[4].p2[1] = std::numeric_limits<float>::infinity();
+    write(dir, "float_skipped.bvh", holes, TriangleTest::Watertight);
+    write(dir, "empty.bvh", std::vector<bvhkit::Triangle<float>>{}, TriangleTest::Watertight);
+    bvhkit::save(bvhkit::ClosestPointMesh<float>(grid<float>(3)), dir / "closest_float.bvh");
+    bvhkit::save(bvhkit::ClosestPointMesh<float>(holes), dir / "closest_skipped.bvh");
+    bvhkit::save(bvhkit::ClosestPointMesh<double>(grid<double>(2)), dir / "closest_double.bvh");
+    // A closed octahedron, for the signed distance.
+    bvhkit::TriangleMesh octahedron;
+    octahedron.vertices = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    octahedron.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                            {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    bvhkit::save(bvhkit::SignedDistanceMesh<float>(octahedron), dir / "signed_float.bvh");
+    bvhkit::save(bvhkit::SignedDistanceMesh<double>(octahedron), dir / "signed_double.bvh");
+    bvhkit::save(bvhkit::WindingNumberMesh<float>(octahedron), dir / "winding_float.bvh");
+    bvhkit::save(bvhkit::WindingNumberMesh<double>(octahedron), dir / "winding_double.bvh");
+    return 0;
+}
