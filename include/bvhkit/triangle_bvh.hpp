@@ -166,6 +166,12 @@ class TriangleBvh {
             fast_.reserve(order.size());
             for (std::uint32_t i : order) fast_.emplace_back(triangle(i));
         }
+        make_ray_layout();
+    }
+
+    // The wide ray layout (query/ray_wide.hpp), derived from the tree and the triangles: made
+    // after a build, a refit or a load.
+    void make_ray_layout() {
         wide4_ = {};
         wide8_ = {};
 #if defined(__SSE2__)

@@ -42,6 +42,8 @@ void expect_same_tree(const TriangleBvh<T>& got, const TriangleBvh<T>& want) {
     EXPECT_EQ(got.skipped(), want.skipped());
     EXPECT_EQ(got.triangle_count(), want.triangle_count());
     EXPECT_EQ(got.triangle_test(), want.triangle_test());
+    // The wide ray layout is derived on load, as on a build (default RayLayout::Auto).
+    EXPECT_EQ(got.ray_width(), want.ray_width());
 }
 
 // Rays from inside the mesh's box (enlarged) in every direction: most hit.

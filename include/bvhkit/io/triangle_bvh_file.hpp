@@ -103,6 +103,7 @@ struct TriangleBvhAccess {
                     return fast ? leaf.bounds : tree.exact_[s].bounds();
                 },
                 what);
+        tree.make_ray_layout();  // derived, not stored: the structure was checked above
         return tree;
     }
 };
