@@ -52,69 +52,76 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
         const std::vector<Ray3f> r2 = random_rays(bounds, options.random_rays, 1);
 
         // Build: from a mesh in memory to a tree ready to trace, for both libraries. bvhkit's
-        // default traces the four-wide layout; the binary layout is measured beside it.
-        TriangleBvh<float> ours, binary;
-        TriangleBvhOptions binary_options(build_options);
-        binary_options.ray_layout = RayLayout::Binary;
-        const auto build_ours = [&] { ours = TriangleBvh<float>(mesh, build_options); };
-        const auto build_binary = [&] { binary = TriangleBvh<float>(mesh, binary_options); };
+        // default traces the widest layout the CPU runs; the others are measured beside it.
+        struct Layout {
+            const char* name;
+            RayLayout layout;
+        };
+        std::vector<Layout> layouts{{"bvhkit", RayLayout::Auto}};
+        if (cpu_has_avx2()) layouts.push_back({"bvhkit-wide4", RayLayout::Wide4});
+        layouts.push_back({"bvhkit-binary", RayLayout::Binary});
+        std::vector<TriangleBvh<float>> trees(layouts.size());
+        std::vector<std::function<void()>> builds;
+        for (std::size_t i = 0; i < layouts.size(); ++i)
+            builds.push_back([&, i] {
+                TriangleBvhOptions o(build_options);
+                o.ray_layout = layouts[i].layout;
+                trees[i] = TriangleBvh<float>(mesh, o);
+            });
 #if BVHKIT_HAVE_EMBREE
         EmbreeScene embree(mesh, 1);
-        const std::vector<double> build_ms = median_ms_interleaved(
-            options.repetitions, {build_ours, build_binary, [&] { embree.build(mesh); }});
-#else
-        const std::vector<double> build_ms =
-            median_ms_interleaved(options.repetitions, {build_ours, build_binary});
+        builds.push_back([&] { embree.build(mesh); });
 #endif
-        for (int layout = 0; layout < 2; ++layout) {
-            Row row = row_for("build", layout == 0 ? "bvhkit" : "bvhkit-binary");
-            row.set("ms", build_ms[layout]).set("sah_cost", statistics(ours.bvh()).sah_cost);
-            if (build_ms.size() == 3) row.set("speedup", build_ms[2] / build_ms[layout]);
+        const std::vector<double> build_ms = median_ms_interleaved(options.repetitions, builds);
+        const bool peer = build_ms.size() > layouts.size();
+        for (std::size_t i = 0; i < layouts.size(); ++i) {
+            Row row = row_for("build", layouts[i].name);
+            row.set("ms", build_ms[i]).set("sah_cost", statistics(trees[i].bvh()).sah_cost);
+            if (peer) row.set("speedup", build_ms.back() / build_ms[i]);
             rows.push_back(row);
         }
-        if (build_ms.size() == 3)
-            rows.push_back(row_for("build", "embree3").set("ms", build_ms[2]));
+        if (peer) rows.push_back(row_for("build", "embree3").set("ms", build_ms.back()));
 
         for (const Workload& w :
              {Workload{"R1", &r1, false}, Workload{"R2", &r2, false}, Workload{"R3", &r2, true}}) {
             if (progress) std::fprintf(progress, "  %s ...\n", w.name);
-            std::size_t hits[3] = {};
+            std::vector<std::size_t> hits(layouts.size() + 1, 0);
             // In its own file: see ray_timed_calls.cpp.
-            std::vector<std::function<void()>> runs{
-                [&] { hits[0] = trace_rays(ours, *w.rays, w.occlusion); },
-                [&] { hits[1] = trace_rays(binary, *w.rays, w.occlusion); }};
+            std::vector<std::function<void()>> runs;
+            for (std::size_t i = 0; i < layouts.size(); ++i)
+                runs.push_back([&, i] { hits[i] = trace_rays(trees[i], *w.rays, w.occlusion); });
 #if BVHKIT_HAVE_EMBREE
             runs.push_back([&] {
-                hits[2] = 0;
+                std::size_t& n = hits.back();
+                n = 0;
                 for (const auto& r : *w.rays)
-                    hits[2] += w.occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
+                    n += w.occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
             });
 #endif
             const std::vector<double> ms = median_ms_interleaved(options.repetitions, runs);
             const double n = double(w.rays->size());
-            for (int layout = 0; layout < 2; ++layout) {
+            for (std::size_t i = 0; i < layouts.size(); ++i) {
                 // Tree quality per ray, counted in a separate untimed pass.
-                const TriangleBvh<float>& tree = layout == 0 ? ours : binary;
                 TraversalStats traversal;
                 for (const auto& r : *w.rays) {
                     if (w.occlusion)
-                        tree.any_hit(r, traversal);
+                        trees[i].any_hit(r, traversal);
                     else
-                        tree.closest_hit(r, traversal);
+                        trees[i].closest_hit(r, traversal);
                 }
-                Row row = row_for(w.name, layout == 0 ? "bvhkit" : "bvhkit-binary");
-                row.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[layout]);
-                row.set("ms", ms[layout]).set("mrays_per_s", n / ms[layout] / 1e3);
+                Row row = row_for(w.name, layouts[i].name);
+                row.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[i]);
+                row.set("ms", ms[i]).set("mrays_per_s", n / ms[i] / 1e3);
                 row.set("nodes_per_ray", double(traversal.nodes_visited) / n);
                 row.set("tris_per_ray", double(traversal.primitives_tested) / n);
-                if (ms.size() == 3) row.set("speedup", ms[2] / ms[layout]);
+                if (peer) row.set("speedup", ms.back() / ms[i]);
                 rows.push_back(row);
             }
-            if (ms.size() == 3) {
-                Row peer = row_for(w.name, "embree3");
-                peer.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[2]);
-                peer.set("ms", ms[2]).set("mrays_per_s", n / ms[2] / 1e3);
-                rows.push_back(peer);
+            if (peer) {
+                Row p = row_for(w.name, "embree3");
+                p.set("rays", (long long)w.rays->size()).set("hits", (long long)hits.back());
+                p.set("ms", ms.back()).set("mrays_per_s", n / ms.back() / 1e3);
+                rows.push_back(p);
             }
         }
     }
