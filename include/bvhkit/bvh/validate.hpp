@@ -8,13 +8,63 @@
 // once; every primitive with a finite, non-empty box is in the tree and none with a non-finite or
 // empty box is (the builders' rule; a primitive listed as skipped must be absent); each node's box
 // encloses its children's boxes and its primitives' boxes.
+#include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "bvhkit/bvh/bvh.hpp"
 #include "bvhkit/error.hpp"
 
 namespace bvhkit {
+
+/// The tree's shape, whatever its boxes hold: children in range and after their parent, every node
+/// reached exactly once from the root (no cycle, no shared child), depth <= max_bvh_depth, leaf
+/// runs non-empty and tiling the slots exactly. A tree that passes cannot make a walk read out of
+/// range, overflow its stack or loop. fail(message) must throw; on_slot(node, slot) and
+/// on_child(node, child) add the caller's checks. Linear; two bytes per node and per slot.
+template <class Volume, class Fail, class OnSlot, class OnChild>
+void check_structure(const Bvh<Volume>& bvh, Fail&& fail, OnSlot&& on_slot, OnChild&& on_child) {
+    const std::size_t node_count = bvh.nodes.size(), slot_count = bvh.primitive_indices.size();
+    if (node_count == 0) {
+        if (slot_count) fail("no nodes but " + std::to_string(slot_count) + " primitive slots");
+        return;
+    }
+    std::vector<std::uint8_t> node_seen(node_count, 0), slot_seen(slot_count, 0);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0u, 0u}};
+    node_seen[0] = 1;
+    while (!stack.empty()) {
+        const auto [index, depth] = stack.back();
+        stack.pop_back();
+        const auto& node = bvh.nodes[index];
+        const auto name = [&] { return "node " + std::to_string(index); };
+        if (depth > max_bvh_depth)
+            fail(name() + " is deeper than " + std::to_string(max_bvh_depth));
+        if (node.is_leaf()) {
+            if (std::uint64_t(node.first) + node.count > slot_count)
+                fail(name() + ": leaf run out of range");
+            for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+                if (slot_seen[s]++)
+                    fail(name() + ": primitive slot " + std::to_string(s) + " in two leaves");
+                on_slot(node, s);
+            }
+            continue;
+        }
+        // first > index keeps every path going forward, so no cycle; node_seen forbids sharing.
+        if (node.first <= index || std::uint64_t(node.first) + 1 >= node_count)
+            fail(name() + ": children " + std::to_string(node.first) + " out of order or range");
+        for (const std::uint32_t c : {node.left(), node.right()}) {
+            if (node_seen[c]++) fail("node " + std::to_string(c) + " has two parents");
+            on_child(node, c);
+            stack.emplace_back(c, depth + 1);
+        }
+    }
+    for (std::size_t i = 0; i < node_count; ++i)
+        if (!node_seen[i]) fail("node " + std::to_string(i) + " is unreachable");
+    for (std::size_t s = 0; s < slot_count; ++s)
+        if (!slot_seen[s]) fail("primitive slot " + std::to_string(s) + " is in no leaf");
+}
 
 /// `skipped`: the primitives the build left out (BuildReport::skipped, TriangleBvh::skipped()),
 /// which must be absent whatever `primitive_boxes` says of them (a box computed elsewhere may have
@@ -24,7 +74,6 @@ template <class T, std::size_t N>
 void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
               std::span<const std::uint32_t> skipped) {
     auto fail = [](const std::string& what) { throw Error("Bvh::validate: " + what); };
-    const std::size_t slot_count = bvh.primitive_indices.size();
     std::vector<std::uint8_t> primitive_seen(primitive_boxes.size(), 0);
     const auto usable = [&](std::size_t p) {
         return primitive_boxes[p].is_finite() && !primitive_boxes[p].is_empty();
@@ -50,45 +99,18 @@ void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_
         if (!primitive_seen[p] && !listed[p] && usable(p))
             fail("primitive " + std::to_string(p) + " is missing from the tree");
 
-    if (bvh.nodes.empty()) {
-        if (slot_count) fail("no nodes but " + std::to_string(slot_count) + " primitive slots");
-        return;
-    }
-    std::vector<std::uint8_t> node_seen(bvh.nodes.size(), 0);
-    std::vector<std::uint8_t> slot_seen(slot_count, 0);
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0u, 0u}};
-    node_seen[0] = 1;
-    while (!stack.empty()) {
-        const auto [index, depth] = stack.back();
-        stack.pop_back();
-        const auto& node = bvh.nodes[index];
-        const std::string name = "node " + std::to_string(index);
-        if (depth > max_bvh_depth) fail(name + " is deeper than " + std::to_string(max_bvh_depth));
-        if (node.is_leaf()) {
-            if (std::size_t(node.first) + node.count > slot_count)
-                fail(name + ": leaf run out of range");
-            for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-                if (slot_seen[s]++)
-                    fail(name + ": primitive slot " + std::to_string(s) + " in two leaves");
-                if (!node.bounds.contains(primitive_boxes[bvh.primitive_indices[s]]))
-                    fail(name + " does not enclose primitive " +
-                         std::to_string(bvh.primitive_indices[s]));
-            }
-            continue;
-        }
-        if (node.first <= index || std::size_t(node.first) + 1 >= bvh.nodes.size())
-            fail(name + ": children " + std::to_string(node.first) + " out of order or range");
-        for (std::uint32_t c : {node.left(), node.right()}) {
-            if (node_seen[c]++) fail("node " + std::to_string(c) + " has two parents");
+    check_structure(
+        bvh, fail,
+        [&](const auto& leaf, std::uint32_t s) {
+            if (!leaf.bounds.contains(primitive_boxes[bvh.primitive_indices[s]]))
+                fail("node " + std::to_string(&leaf - bvh.nodes.data()) +
+                     " does not enclose primitive " + std::to_string(bvh.primitive_indices[s]));
+        },
+        [&](const auto& node, std::uint32_t c) {
             if (!node.bounds.contains(bvh.nodes[c].bounds))
-                fail(name + " does not enclose its child " + std::to_string(c));
-            stack.emplace_back(c, depth + 1);
-        }
-    }
-    for (std::size_t i = 0; i < node_seen.size(); ++i)
-        if (!node_seen[i]) fail("node " + std::to_string(i) + " is unreachable");
-    for (std::size_t s = 0; s < slot_count; ++s)
-        if (!slot_seen[s]) fail("primitive slot " + std::to_string(s) + " is in no leaf");
+                fail("node " + std::to_string(&node - bvh.nodes.data()) +
+                     " does not enclose its child " + std::to_string(c));
+        });
 }
 
 template <class T, std::size_t N>

@@ -139,12 +139,9 @@ ClosestPointMesh<T> closest_point_mesh_from_bytes(std::span<const std::uint8_t> 
 template <class T>
 ClosestPointMesh<T> load_closest_point_mesh(const std::filesystem::path& path,
                                             const LoadOptions& options = {}) {
-    const std::vector<std::uint8_t> bytes = serial_detail::read_file_bytes(path);
-    try {
+    return serial_detail::load_file(path, [&](std::span<const std::uint8_t> bytes) {
         return closest_point_mesh_from_bytes<T>(bytes, options);
-    } catch (const Error& e) {
-        throw Error(path.string() + ": " + e.what());
-    }
+    });
 }
 
 }  // namespace bvhkit

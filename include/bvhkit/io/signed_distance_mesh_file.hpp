@@ -102,12 +102,9 @@ SignedDistanceMesh<T> signed_distance_mesh_from_bytes(std::span<const std::uint8
 template <class T>
 SignedDistanceMesh<T> load_signed_distance_mesh(const std::filesystem::path& path,
                                                 const LoadOptions& options = {}) {
-    const std::vector<std::uint8_t> bytes = serial_detail::read_file_bytes(path);
-    try {
+    return serial_detail::load_file(path, [&](std::span<const std::uint8_t> bytes) {
         return signed_distance_mesh_from_bytes<T>(bytes, options);
-    } catch (const Error& e) {
-        throw Error(path.string() + ": " + e.what());
-    }
+    });
 }
 
 }  // namespace bvhkit

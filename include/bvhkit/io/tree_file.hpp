@@ -161,6 +161,17 @@ inline std::vector<std::uint8_t> read_file_bytes(const std::filesystem::path& pa
     return bytes;
 }
 
+/// The structure from_bytes(bytes) makes of the file at `path`; an Error names the file.
+template <class FromBytes>
+auto load_file(const std::filesystem::path& path, FromBytes&& from_bytes) {
+    const std::vector<std::uint8_t> bytes = read_file_bytes(path);
+    try {
+        return from_bytes(std::span<const std::uint8_t>(bytes));
+    } catch (const Error& e) {
+        throw Error(path.string() + ": " + e.what());
+    }
+}
+
 inline void write_file_bytes(const std::filesystem::path& path,
                              std::span<const std::uint8_t> bytes) {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -131,12 +131,9 @@ TriangleBvh<T> triangle_bvh_from_bytes(std::span<const std::uint8_t> bytes,
 template <class T>
 TriangleBvh<T> load_triangle_bvh(const std::filesystem::path& path,
                                  const LoadOptions& options = {}) {
-    const std::vector<std::uint8_t> bytes = serial_detail::read_file_bytes(path);
-    try {
+    return serial_detail::load_file(path, [&](std::span<const std::uint8_t> bytes) {
         return triangle_bvh_from_bytes<T>(bytes, options);
-    } catch (const Error& e) {
-        throw Error(path.string() + ": " + e.what());
-    }
+    });
 }
 
 }  // namespace bvhkit

@@ -102,12 +102,9 @@ WindingNumberMesh<T> winding_number_mesh_from_bytes(std::span<const std::uint8_t
 template <class T>
 WindingNumberMesh<T> load_winding_number_mesh(const std::filesystem::path& path,
                                               const LoadOptions& options = {}) {
-    const std::vector<std::uint8_t> bytes = serial_detail::read_file_bytes(path);
-    try {
+    return serial_detail::load_file(path, [&](std::span<const std::uint8_t> bytes) {
         return winding_number_mesh_from_bytes<T>(bytes, options);
-    } catch (const Error& e) {
-        throw Error(path.string() + ": " + e.what());
-    }
+    });
 }
 
 }  // namespace bvhkit

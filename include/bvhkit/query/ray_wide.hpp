@@ -218,6 +218,9 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
 }
 
 #if BVHKIT_RAY_AVX2
+// walk4 in AVX registers. It is written out again because its AVX intrinsics must sit in a function
+// that carries the target attribute itself (GCC will not inline them into a lambda or a generic
+// helper of the default target), and walk4 must not carry it.
 template <unsigned O, class OnLeaf, class Stats>
 [[gnu::target("avx2")]] void walk8(const WideRayBvh<8>& tree, Ray<float, 3>& ray,
                                    const SlabConstants& k, WideEntry* stack, OnLeaf& on_leaf,
