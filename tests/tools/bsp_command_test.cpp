@@ -8,6 +8,8 @@
 #include <fstream>
 #include <string>
 
+#include "run_cli.hpp"
+
 #include "bvhkit/io/ray_files.hpp"
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/query/ray_sets.hpp"
@@ -15,24 +17,9 @@
 
 namespace {
 
-struct Result {
-    int status;
-    std::string output;  // stdout and stderr together
-};
+using Result = test::CliOutcome;
 
-Result run_cli(const std::string& args) {
-    static int counter = 0;
-    const auto log =
-        std::filesystem::temp_directory_path() / ("bvhkit_bsp_test_" + std::to_string(::getpid()) +
-                                                  "_" + std::to_string(counter++) + ".txt");
-    const std::string command =
-        std::string(BVHKIT_CLI) + " " + args + " > " + log.string() + " 2>&1";
-    const int raw = std::system(command.c_str());
-    std::ifstream in(log);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::filesystem::remove(log);
-    return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, text};
-}
+using test::run_cli;
 
 Result run_bsp(const std::string& args) {
     return run_cli("bsp " + args);

@@ -7,25 +7,14 @@
 #include <fstream>
 #include <string>
 
+#include "run_cli.hpp"
+
 namespace {
 
-struct Outcome {
-    int status;
-    std::string output;  // stdout and stderr together
-};
+using Outcome = test::CliOutcome;
 
 Outcome run(const std::string& args) {
-    static int counter = 0;
-    const auto log =
-        std::filesystem::temp_directory_path() / ("bvhkit_cli_test_" + std::to_string(::getpid()) +
-                                                  "_" + std::to_string(counter++) + ".txt");
-    const std::string command =
-        std::string(BVHKIT_CLI) + " " + args + " > " + log.string() + " 2>&1";
-    const int raw = std::system(command.c_str());
-    std::ifstream in(log);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::filesystem::remove(log);
-    return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, text};
+    return test::run_cli(args);
 }
 
 std::filesystem::path temp_file(const std::string& name) {
