@@ -35,7 +35,8 @@ void check_structure(const Bvh<Volume>& bvh, Fail&& fail, OnSlot&& on_slot, OnCh
     std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0u, 0u}};
     node_seen[0] = 1;
     while (!stack.empty()) {
-        const auto [index, depth] = stack.back();
+        // Plain variables, not a structured binding: clang 14 cannot capture one in a lambda.
+        const std::uint32_t index = stack.back().first, depth = stack.back().second;
         stack.pop_back();
         const auto& node = bvh.nodes[index];
         const auto name = [&] { return "node " + std::to_string(index); };
