@@ -89,7 +89,9 @@ class TriangleBvh {
         return bvhkit::closest_hit(bvh_, ray, FastTest{fast_.data()}, stats);
     }
 
-    bool any_hit(const Ray<T, 3>& ray) const { return any_hit(ray, NoStats{}); }
+    bool any_hit(const Ray<T, 3>& ray) const {
+        return any_hit(ray, NoStats{});
+    }
     template <class Stats>
     bool any_hit(const Ray<T, 3>& ray, Stats&& stats) const {
 #if defined(__SSE2__)
@@ -112,10 +114,16 @@ class TriangleBvh {
             bvhkit::all_hits(bvh_, ray, FastTest{fast_.data()}, on_hit, stats);
     }
 
-    TriangleTest triangle_test() const { return triangle_test_; }
+    TriangleTest triangle_test() const {
+        return triangle_test_;
+    }
     /// The width of the tree rays walk: 8 or 4 (a wide layout), or 2 (the binary tree).
-    int ray_width() const { return !wide8_.empty() ? 8 : !wide4_.empty() ? 4 : 2; }
-    bool traces_wide() const { return ray_width() > 2; }
+    int ray_width() const {
+        return !wide8_.empty() ? 8 : !wide4_.empty() ? 4 : 2;
+    }
+    bool traces_wide() const {
+        return ray_width() > 2;
+    }
 
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
     template <IndexedTriangleMesh M>
@@ -130,10 +138,16 @@ class TriangleBvh {
         lay_out(triangle);
     }
 
-    const AabbBvh<T, 3>& bvh() const { return bvh_; }
+    const AabbBvh<T, 3>& bvh() const {
+        return bvh_;
+    }
     /// Triangles left out of the tree for non-finite coordinates, by mesh index.
-    const std::vector<std::uint32_t>& skipped() const { return report_.skipped; }
-    std::size_t triangle_count() const { return triangle_count_; }
+    const std::vector<std::uint32_t>& skipped() const {
+        return report_.skipped;
+    }
+    std::size_t triangle_count() const {
+        return triangle_count_;
+    }
 
   private:
     friend struct serial_detail::TriangleBvhAccess;
