@@ -10,6 +10,7 @@
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/math/random.hpp"
 #include "bvhkit/mesh/procedural.hpp"
+#include "byte_flips.hpp"
 #include "random_geometry.hpp"
 #include "test_support.hpp"
 
@@ -72,10 +73,7 @@ TEST(TriangleBvhFileMalformed, RandomByteFlipsAreCaughtByTheChecksum) {
     SplitMix64 rng(1);
     const std::size_t rounds = flip_count();
     for (std::size_t round = 0; round < rounds; ++round) {
-        std::vector<std::uint8_t> bad = file;
-        const std::uint32_t flips = 1 + rng.below(4);
-        for (std::uint32_t f = 0; f < flips; ++f)
-            bad[rng.below(std::uint32_t(bad.size()))] ^= std::uint8_t(1 + rng.below(255));
+        std::vector<std::uint8_t> bad = test::with_byte_flips(file, rng);
         if (bad == file) continue;
         ASSERT_THROW((void)triangle_bvh_from_bytes<float>(bad), Error) << "round " << round;
     }

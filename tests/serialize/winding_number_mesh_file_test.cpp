@@ -10,6 +10,7 @@
 #include "bvhkit/io/winding_number_mesh_file.hpp"
 #include "bvhkit/math/random.hpp"
 #include "bvhkit/mesh/procedural.hpp"
+#include "byte_flips.hpp"
 #include "random_geometry.hpp"
 #include "test_support.hpp"
 
@@ -72,10 +73,7 @@ TEST(WindingNumberMeshFile, MalformedFilesAreErrors) {
     const std::size_t rounds = full_scale() ? 100000 : scaled(10000, 10);
     std::size_t loaded = 0;
     for (std::size_t round = 0; round < rounds; ++round) {
-        std::vector<std::uint8_t> bad = file;
-        const std::uint32_t flips = 1 + rng.below(4);
-        for (std::uint32_t f = 0; f < flips; ++f)
-            bad[rng.below(std::uint32_t(bad.size()))] ^= std::uint8_t(1 + rng.below(255));
+        std::vector<std::uint8_t> bad = test::with_byte_flips(file, rng);
         if (bad == file) continue;
         ASSERT_THROW((void)winding_number_mesh_from_bytes<float>(bad), Error) << round;
         serial_detail::reseal_tree_file(bad);
