@@ -9,18 +9,14 @@
 //   tree.query(box, [](ProxyId id) { return true; });         // also query_point, ray_cast,
 //   tree.destroy(id);                                         // box_cast, query_tree
 //
-// Layout: all nodes live in one array (a pool with a free list) and refer to each other by index,
-// so the pool can grow without invalidating anything. Each proxy has a stable id into a second
-// table holding its tight box, its user data (UserData, a std::uint64_t unless chosen otherwise: an
-// index, a handle or a pointer cast to an integer) and its leaf node.
-//
-// Fat boxes: a leaf stores the proxy's box grown by a margin and stretched along the predicted
-// displacement, so a small motion stays inside it and move() only updates the tight box.
-//
-// Insertion (tree_insertion.hpp): the sibling that minimizes the SAH cost increase, found by branch
-// and bound (or the greedy descent of the classic dynamic AABB trees), then a walk up to the root
-// refitting each ancestor and applying the best of the four rotations. Removal replaces the leaf's
-// parent by its sibling and walks up alike.
+// Two layers. The tree below is a LinkedTree (bvh/linked_tree.hpp): leaves with a fat box and a
+// proxy id, inserted next to the sibling that raises the SAH cost least and rotated on the way up.
+// This class is the broadphase above it: each proxy has a stable id into a table holding its tight
+// box, its user data (UserData, a std::uint64_t unless chosen otherwise: an index, a handle or a
+// pointer cast to an integer) and its leaf; it computes the fat boxes (fat_box.hpp: the box grown
+// by a margin and stretched along the predicted displacement, so a small motion stays inside it and
+// move() only updates the tight box), keeps the move buffer and finds the pairs (tree_pairs.hpp).
+// Queries report a proxy when its tight box passes; the fat boxes only steer the descent.
 //
 // Callbacks: while a query, cast, for_each_node or pair callback of a tree runs, the calls that
 // change its structure (create, destroy, move, enlarge, rebuild, optimize, clear, shift_origin,
@@ -33,11 +29,12 @@
 #include <string>
 #include <vector>
 
+#include "bvhkit/build/build.hpp"
+#include "bvhkit/bvh/linked_tree.hpp"
+#include "bvhkit/dynamic/fat_box.hpp"
 #include "bvhkit/dynamic/small_stack.hpp"
-#include "bvhkit/dynamic/tree_insertion.hpp"
 #include "bvhkit/dynamic/tree_pairs.hpp"
 #include "bvhkit/dynamic/tree_queries.hpp"
-#include "bvhkit/dynamic/tree_rebuild.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
 #include "bvhkit/dynamic/tree_validate.hpp"
 #include "bvhkit/error.hpp"
@@ -56,7 +53,7 @@ class DynamicTree {
     static constexpr std::size_t dimension = N;
 
     explicit DynamicTree(const Options& options = {}) : options_(options) {
-        check_options(options);
+        dynamic_detail::check_options(options);
     }
 
     // ---------------------------------------------------------------- proxies
@@ -67,18 +64,12 @@ class DynamicTree {
         check_not_walking("DynamicTree::create");
         dynamic_detail::check_box(box, "DynamicTree::create");
         const ProxyId id = alloc_proxy();
-        const std::int32_t leaf = alloc_node();
-        Node& n = nodes_[leaf];
-        n.box = fat_box(box, VecT{});
-        n.parent = n.child1 = dynamic_detail::kNullNode;
-        n.child2 = id;
-        n.height = 0;
-        n.enlarged = 0;
+        const std::int32_t leaf = tree_.make_leaf(fat_box(box, VecT{}), id);
         Proxy& p = proxies_[id];
         p.box = box;
         p.user_data = user_data;
         p.node = leaf;
-        insert_leaf(leaf);
+        tree_.insert(leaf, insertion());
         buffer_move(id);
         return id;
     }
@@ -87,8 +78,8 @@ class DynamicTree {
         check_not_walking("DynamicTree::destroy");
         check_id(id, "DynamicTree::destroy");
         Proxy& p = proxies_[id];
-        remove_leaf(p.node);
-        free_node(p.node);
+        tree_.detach(p.node, options_.rotate);
+        tree_.free_leaf(p.node);
         p.node = dynamic_detail::kNullNode;
         p.moved = false;  // find_pairs() skips its buffer entry
         p.ended = true;   // update_pairs() ends its pairs
@@ -112,18 +103,11 @@ class DynamicTree {
         buffer_move(id);
         const std::int32_t leaf = p.node;
         const Box fat = fat_box(box, displacement);
-        const Box& current = nodes_[leaf].box;
-        if (current.contains(box)) {
-            // Still inside; keep it unless it is much too large (say after a fast move that
-            // stopped): the limit is the fresh fat box grown by three more margins and predictions.
-            const VecT slack = VecT(T(3) * margin(box)) +
-                               abs(displacement) * (T(3) * options_.displacement_multiplier);
-            if (Box(fat.min - slack, fat.max + slack).contains(current)) return false;
-        }
-        remove_leaf(leaf);
-        nodes_[leaf].box = fat;
-        nodes_[leaf].enlarged = 0;
-        insert_leaf(leaf);
+        if (dynamic_detail::keeps_fat_box(options_, tree_.node(leaf).box, box, fat, displacement))
+            return false;
+        tree_.detach(leaf, options_.rotate);
+        tree_.set_leaf_box(leaf, fat);
+        tree_.insert(leaf, insertion());
         return true;
     }
 
@@ -138,20 +122,8 @@ class DynamicTree {
         Proxy& p = proxies_[id];
         p.box = box;
         buffer_move(id);
-        std::int32_t i = p.node;
-        if (nodes_[i].box.contains(box)) return false;
-        const Box fat = fat_box(box, displacement);
-        nodes_[i].box = fat;
-        nodes_[i].enlarged = 1;
-        // Grow the ancestors and mark them. Invariant: the parent of an enlarged node is enlarged,
-        // so the walk can stop at the first ancestor that was enlarged already and contains the new
-        // box.
-        for (i = nodes_[i].parent; i != dynamic_detail::kNullNode; i = nodes_[i].parent) {
-            Node& n = nodes_[i];
-            if (n.enlarged && n.box.contains(fat)) break;
-            n.box.grow(fat);
-            n.enlarged = 1;
-        }
+        if (tree_.node(p.node).box.contains(box)) return false;
+        tree_.enlarge(p.node, fat_box(box, displacement));
         return true;
     }
 
@@ -159,27 +131,17 @@ class DynamicTree {
     /// leaves that enlarge() touched, keeping every untouched subtree as it is.
     void rebuild(bool full = true) {
         check_not_walking("DynamicTree::rebuild");
-        if (root_ == dynamic_detail::kNullNode) return;
-        auto& items = build_.items;
-        items.clear();
-        dynamic_detail::SmallStack<std::int32_t> stack;
-        stack.push(root_);
-        while (!stack.empty()) {
-            const std::int32_t i = stack.pop();
-            Node& n = nodes_[i];
-            if (n.is_leaf() || (!full && !n.enlarged)) {
-                n.enlarged = 0;
-                items.push_back({dynamic_detail::safe_centroid(n.box), i});
-            } else {
-                stack.push(n.child1);
-                stack.push(n.child2);
-                free_node(i);
-            }
-        }
-        // The freed internal nodes are exactly as many as the build needs, so alloc never grows the
-        // pool.
-        root_ = dynamic_detail::build_binned_sah(nodes_.data(), build_,
-                                                 [this] { return alloc_node(); });
+        tree_.rebuild(full, [this](std::span<const Box> boxes) {
+            // The library's top-down core with binned SAH, one subtree per leaf.
+            auto& centroids = rebuild_centroids_;
+            centroids.resize(boxes.size());
+            for (std::size_t k = 0; k < boxes.size(); ++k) centroids[k] = safe_centroid(boxes[k]);
+            BuildOptions o;
+            o.builder = Builder::BinnedSah;
+            o.max_leaf_size = 1;
+            o.threads = 1;
+            return build_bvh(boxes, std::span<const VecT>(centroids), o);
+        });
     }
 
     /// Incremental optimization: removes and re-inserts the (at most) `max_reinsertions` leaves
@@ -192,10 +154,10 @@ class DynamicTree {
         cand.clear();
         for (std::int32_t id = 0; id < static_cast<std::int32_t>(proxies_.size()); ++id) {
             const std::int32_t leaf = proxies_[id].node;
-            if (leaf == dynamic_detail::kNullNode || leaf == root_) continue;
-            const double own = std::max(dynamic_detail::box_area(nodes_[leaf].box),
+            if (leaf == dynamic_detail::kNullNode || leaf == tree_.root()) continue;
+            const double own = std::max(linked::box_area(tree_.node(leaf).box),
                                         double(std::numeric_limits<T>::min()));
-            const double ratio = dynamic_detail::box_area(nodes_[nodes_[leaf].parent].box) / own;
+            const double ratio = linked::box_area(tree_.node(tree_.node(leaf).parent).box) / own;
             cand.push_back({ratio == ratio ? ratio : 0.0, leaf});  // inf / inf: not a candidate
         }
         const std::size_t k =
@@ -207,8 +169,8 @@ class DynamicTree {
                          cand.end(), worse);
         std::sort(cand.begin(), cand.begin() + static_cast<std::ptrdiff_t>(k), worse);
         for (std::size_t i = 0; i < k; ++i) {
-            remove_leaf(cand[i].second);
-            insert_leaf(cand[i].second);
+            tree_.detach(cand[i].second, options_.rotate);
+            tree_.insert(cand[i].second, insertion());
         }
         return static_cast<int>(k);
     }
@@ -216,15 +178,15 @@ class DynamicTree {
     /// Removes every proxy and returns all memory (memory_bytes() is 0 afterwards).
     void clear() {
         check_not_walking("DynamicTree::clear");
-        release(nodes_);
+        tree_.clear();
         release(proxies_);
         release(move_buffer_);
         release(pairs_);
         release(pending_ends_);
         pairs_valid_ = true;
         release_scratch();
-        root_ = free_node_ = free_proxy_ = dynamic_detail::kNullNode;
-        node_count_ = proxy_count_ = 0;
+        free_proxy_ = dynamic_detail::kNullNode;
+        proxy_count_ = 0;
     }
 
     /// Returns unused memory: the node pool is repacked (depth first) to exactly the nodes in use,
@@ -255,12 +217,7 @@ class DynamicTree {
                     proxies_[id].next_free = free_proxy_, free_proxy_ = std::int32_t(id);
         }
         proxies_.shrink_to_fit();
-        std::vector<Node> packed;
-        packed.reserve(node_count_);
-        root_ = dynamic_detail::compact_nodes(
-            nodes_, root_, packed, [this](ProxyId p, int leaf) { proxies_[p].node = leaf; });
-        nodes_.swap(packed);
-        free_node_ = dynamic_detail::kNullNode;
+        tree_.shrink_to_fit([this](ProxyId p, std::int32_t leaf) { proxies_[p].node = leaf; });
         move_buffer_.shrink_to_fit();
         pairs_.shrink_to_fit();
         release_scratch();
@@ -272,7 +229,7 @@ class DynamicTree {
     }
     const Box& box(ProxyId id) const { return proxies_[checked(id, "DynamicTree::box")].box; }
     const Box& fat_box(ProxyId id) const {
-        return nodes_[proxies_[checked(id, "DynamicTree::fat_box")].node].box;
+        return tree_.node(proxies_[checked(id, "DynamicTree::fat_box")].node).box;
     }
     const UserData& user_data(ProxyId id) const {
         return proxies_[checked(id, "DynamicTree::user_data")].user_data;
@@ -288,7 +245,7 @@ class DynamicTree {
     const Options& options() const { return options_; }
     /// New options apply to later inserts and moves; the present fat boxes stay until they move.
     void set_options(const Options& o) {
-        check_options(o);
+        dynamic_detail::check_options(o);
         options_ = o;
     }
 
@@ -341,7 +298,7 @@ class DynamicTree {
         dynamic_detail::check_vector(translation, "translation", "DynamicTree::box_cast");
         check_fraction(max_fraction, "DynamicTree::box_cast");
         const Guard guard(walks_);
-        const VecT centre = dynamic_detail::safe_centroid(box);
+        const VecT centre = safe_centroid(box);
         dynamic_detail::cast(
             view(), dynamic_detail::Segment<T, N>(centre, translation),
             CastInput<T, N>{centre, translation, box.max * T(0.5) - box.min * T(0.5), max_fraction},
@@ -418,33 +375,28 @@ class DynamicTree {
 
     /// Checks every invariant; throws bvhkit::Error naming the first one broken.
     void validate() const {
-        dynamic_detail::validate_tree(dynamic_detail::TreeParts<T, N, UserData>{
-            nodes_, proxies_, move_buffer_, root_, free_node_, free_proxy_, node_count_,
-            proxy_count_});
+        const std::size_t leaves = tree_.validate(
+            "DynamicTree::validate",
+            [this](std::int32_t i, const Node& n) { dynamic_detail::check_leaf(n, i, proxies_); });
+        dynamic_detail::validate_proxies(dynamic_detail::ProxyParts<T, N, UserData>{
+            tree_, proxies_, move_buffer_, free_proxy_, proxy_count_, leaves});
     }
-    int height() const { return root_ == dynamic_detail::kNullNode ? 0 : nodes_[root_].height; }
+    int height() const { return tree_.height(); }
     /// Sum of the areas (perimeters in 2D) of the internal nodes.
-    double sah_cost() const {
-        double s = 0;
-        for (const Node& n : nodes_)
-            if (n.height > 0) s += dynamic_detail::box_area(n.box);
-        return s;
-    }
+    double sah_cost() const { return tree_.sah_cost(); }
     /// sah_cost() over the root's area: how much larger than the root the internal nodes are in
     /// all.
     double area_ratio() const {
-        if (root_ == dynamic_detail::kNullNode || nodes_[root_].is_leaf()) return 0;
-        const double root_area = dynamic_detail::box_area(nodes_[root_].box);
+        if (tree_.root() == dynamic_detail::kNullNode || tree_.node(tree_.root()).is_leaf())
+            return 0;
+        const double root_area = linked::box_area(tree_.node(tree_.root()).box);
         return root_area > 0 ? sah_cost() / root_area : 0;
     }
     std::size_t memory_bytes() const {
-        return nodes_.capacity() * sizeof(Node) + proxies_.capacity() * sizeof(Proxy) +
-               move_buffer_.capacity() * sizeof(ProxyId) + heap_.capacity() * sizeof(heap_[0]) +
-               float_heap_.capacity() * sizeof(float_heap_[0]) +
+        return tree_.memory_bytes() + proxies_.capacity() * sizeof(Proxy) +
+               move_buffer_.capacity() * sizeof(ProxyId) +
                pair_scratch_.capacity() * sizeof(ProxyPair) +
-               build_.items.capacity() * sizeof(build_.items[0]) +
-               build_.tasks.capacity() * sizeof(build_.tasks[0]) +
-               build_.created.capacity() * sizeof(std::int32_t) +
+               rebuild_centroids_.capacity() * sizeof(VecT) +
                optimize_scratch_.capacity() * sizeof(optimize_scratch_[0]) +
                (pairs_.capacity() + pending_ends_.capacity() + pair_next_.capacity() +
                 pair_ends_.capacity() + pair_begins_.capacity()) *
@@ -453,8 +405,8 @@ class DynamicTree {
     TreeStats stats() const {
         TreeStats s;
         s.proxies = proxy_count_;
-        s.nodes = node_count_;
-        s.node_capacity = nodes_.size();
+        s.nodes = tree_.node_count();
+        s.node_capacity = tree_.capacity();
         s.height = height();
         s.sah_cost = sah_cost();
         s.area_ratio = area_ratio();
@@ -479,10 +431,10 @@ class DynamicTree {
                                 "'s box outside the finite range");
         }
         constexpr T big = std::numeric_limits<T>::max();
-        for (Node& n : nodes_)
-            if (n.height >= 0)
-                n.box = Box(bvhkit::max(n.box.min - new_origin, VecT(-big)),
-                            bvhkit::min(n.box.max - new_origin, VecT(big)));
+        tree_.update_boxes([&](Box& b) {
+            b = Box(bvhkit::max(b.min - new_origin, VecT(-big)),
+                    bvhkit::min(b.max - new_origin, VecT(big)));
+        });
         for (Proxy& p : proxies_)
             if (p.node != dynamic_detail::kNullNode)
                 p.box = Box(p.box.min - new_origin, p.box.max - new_origin);
@@ -492,17 +444,17 @@ class DynamicTree {
     /// drawing and debugging; depth 0 is the root).
     template <class F>
     void for_each_node(F&& visitor) const {
-        if (root_ == dynamic_detail::kNullNode) return;
+        if (tree_.root() == dynamic_detail::kNullNode) return;
         const Guard guard(walks_);
         struct Item {
             std::int32_t node, depth;
         };
         dynamic_detail::SmallStack<Item> stack;
-        stack.push({root_, 0});
+        stack.push({tree_.root(), 0});
         while (!stack.empty()) {
             const Item it = stack.pop();
-            const Node& n = nodes_[it.node];
-            visitor(n.box, int(it.depth), n.is_leaf(), n.is_leaf() ? n.proxy() : kNullProxy);
+            const Node& n = tree_.node(it.node);
+            visitor(n.box, int(it.depth), n.is_leaf(), n.is_leaf() ? n.value() : kNullProxy);
             if (!n.is_leaf()) {
                 stack.push({n.child2, it.depth + 1});
                 stack.push({n.child1, it.depth + 1});
@@ -518,55 +470,17 @@ class DynamicTree {
     using Guard = dynamic_detail::WalkCounter::Guard;
 
     dynamic_detail::TreeView<T, N, UserData> view() const {
-        return {nodes_.data(), proxies_.data(), root_};
+        return {tree_.nodes(), proxies_.data(), tree_.root()};
     }
 
-    static void check_options(const Options& o) {
-        const auto bad = [](const char* name, T v) {
-            return Error(std::string("DynamicTree options: ") + name + " = " +
-                         dynamic_detail::format_value(double(v)) + " (must be finite and >= 0)");
-        };
-        if (!(std::isfinite(o.margin_absolute) && o.margin_absolute >= 0))
-            throw bad("margin_absolute", o.margin_absolute);
-        if (!(std::isfinite(o.margin_relative) && o.margin_relative >= 0))
-            throw bad("margin_relative", o.margin_relative);
-        if (!(std::isfinite(o.displacement_multiplier) && o.displacement_multiplier >= 0))
-            throw bad("displacement_multiplier", o.displacement_multiplier);
-    }
-
-    static VecT abs(const VecT& v) {
-        VecT r;
-        for (std::size_t i = 0; i < N; ++i) r[i] = std::abs(v[i]);
-        return r;
-    }
-    /// The fat margin of a box: may be inf (the extent of a box spanning +-FLT_MAX overflows) but
-    /// never NaN, since a zero relative margin is not multiplied by that extent.
-    T margin(const Box& box) const {
-        T m = options_.margin_absolute;
-        if (options_.margin_relative > T(0)) {
-            T e = T(0);
-            for (std::size_t i = 0; i < N; ++i) e = std::max(e, box.max[i] - box.min[i]);
-            m += options_.margin_relative * e;
-        }
-        return m;
-    }
-    /// The box grown by the margin on every side, then stretched along the predicted displacement,
-    /// then clamped to the finite range: any finite box gets a finite fat box that contains it.
     Box fat_box(const Box& box, const VecT& displacement) const {
-        constexpr T big = std::numeric_limits<T>::max();
-        const T m = margin(box);
-        Box fat;
-        for (std::size_t i = 0; i < N; ++i) {
-            T lo = box.min[i] - m, hi = box.max[i] + m;
-            const T s = options_.displacement_multiplier * displacement[i];  // +-inf, never NaN
-            if (s < 0)
-                lo += s;
-            else
-                hi += s;
-            fat.min[i] = std::max(lo, -big);
-            fat.max[i] = std::min(hi, big);
-        }
-        return fat;
+        return dynamic_detail::fat_box(options_, box, displacement);
+    }
+    InsertionOptions insertion() const {
+        InsertionOptions o;
+        o.strategy = options_.insertion;
+        o.rotate = options_.rotate;
+        return o;
     }
 
     /// The structural calls throw while a walk of this tree runs (they would reallocate or relink
@@ -600,12 +514,9 @@ class DynamicTree {
         V().swap(v);
     }
     void release_scratch() {
-        release(heap_);
-        release(float_heap_);
+        tree_.release_scratch();
         release(pair_scratch_);
-        release(build_.items);
-        release(build_.tasks);
-        release(build_.created);
+        release(rebuild_centroids_);
         release(optimize_scratch_);
         release(pair_next_);
         release(pair_ends_);
@@ -631,31 +542,6 @@ class DynamicTree {
 
     // ---- pools
 
-    std::int32_t alloc_node() {
-        if (free_node_ == dynamic_detail::kNullNode) {
-            // Grow the pool and chain the new nodes into the free list (indices stay valid).
-            const std::size_t old = nodes_.size();
-            const std::size_t cap = std::max<std::size_t>(16, old * 2);
-            if (cap > std::size_t(INT32_MAX)) throw Error("DynamicTree: more than 2^31 nodes");
-            nodes_.resize(cap);
-            for (std::size_t i = old; i < cap; ++i) {
-                nodes_[i].height = -1;
-                nodes_[i].parent = i + 1 < cap ? std::int32_t(i + 1) : dynamic_detail::kNullNode;
-            }
-            free_node_ = std::int32_t(old);
-        }
-        const std::int32_t i = free_node_;
-        free_node_ = nodes_[i].parent;
-        ++node_count_;
-        return i;
-    }
-    void free_node(std::int32_t i) {
-        nodes_[i].height = -1;
-        nodes_[i].enlarged = 0;
-        nodes_[i].parent = free_node_;
-        free_node_ = i;
-        --node_count_;
-    }
     ProxyId alloc_proxy() {
         ProxyId id = free_proxy_;
         if (id == dynamic_detail::kNullNode) {
@@ -672,118 +558,15 @@ class DynamicTree {
         return id;
     }
 
-    // ---- structure
-
-    /// Puts the (detached) leaf into the tree next to the best sibling, then walks up.
-    void insert_leaf(std::int32_t leaf) {
-        if (root_ == dynamic_detail::kNullNode) {
-            root_ = leaf;
-            nodes_[leaf].parent = dynamic_detail::kNullNode;
-            return;
-        }
-        const std::int32_t parent = alloc_node();  // first: it may grow (move) the pool
-        const Box box = nodes_[leaf].box;
-        const bool float_costs = dynamic_detail::float_costs_fit(unite(nodes_[root_].box, box));
-        const std::int32_t sibling =
-            float_costs ? find_sibling<float>(box) : find_sibling<double>(box);
-        const std::int32_t old_parent = nodes_[sibling].parent;
-        Node& p = nodes_[parent];
-        p.parent = old_parent;
-        p.child1 = sibling;
-        p.child2 = leaf;
-        p.enlarged = 0;
-        nodes_[sibling].parent = parent;
-        nodes_[leaf].parent = parent;
-        dynamic_detail::refit(nodes_.data(), parent);
-        if (old_parent == dynamic_detail::kNullNode) {
-            root_ = parent;
-            return;
-        }
-        Node& op = nodes_[old_parent];
-        (op.child1 == sibling ? op.child1 : op.child2) = parent;
-        walk_up(old_parent, float_costs);
-    }
-
-    template <class Cost>
-    std::int32_t find_sibling(const Box& box) {
-        if (options_.insertion == InsertionStrategy::Greedy)
-            return dynamic_detail::find_sibling_greedy<Cost>(nodes_.data(), root_, box);
-        if (options_.insertion == InsertionStrategy::Guided)
-            return dynamic_detail::find_sibling_guided<Cost>(nodes_.data(), root_, box);
-        if constexpr (std::is_same_v<Cost, float>) {
-            return dynamic_detail::find_sibling_branch_and_bound<Cost>(nodes_.data(), root_, box,
-                                                                       float_heap_);
-        } else {
-            return dynamic_detail::find_sibling_branch_and_bound<Cost>(nodes_.data(), root_, box,
-                                                                       heap_);
-        }
-    }
-
-    /// Takes the leaf out of the tree (the node stays allocated): its parent is freed and replaced
-    /// by the leaf's sibling, then the ancestors are refitted and rotated.
-    void remove_leaf(std::int32_t leaf) {
-        if (leaf == root_) {
-            root_ = dynamic_detail::kNullNode;
-            return;
-        }
-        const std::int32_t parent = nodes_[leaf].parent;
-        const std::int32_t grand = nodes_[parent].parent;
-        const std::int32_t sibling =
-            nodes_[parent].child1 == leaf ? nodes_[parent].child2 : nodes_[parent].child1;
-        free_node(parent);
-        nodes_[leaf].parent = dynamic_detail::kNullNode;
-        nodes_[sibling].parent = grand;
-        if (grand == dynamic_detail::kNullNode) {
-            root_ = sibling;
-            return;
-        }
-        Node& g = nodes_[grand];
-        (g.child1 == parent ? g.child1 : g.child2) = sibling;
-        walk_up(grand, dynamic_detail::float_costs_fit(nodes_[root_].box));
-    }
-
-    /// Refit (and rotate, when enabled) the nodes from i up: to the root, or to the first node
-    /// above i whose box, height and enlarged flag stay and that does not rotate, since nothing
-    /// above it changes then but the rotations that its unchanged subtree would offer (a heuristic
-    /// either way; stopping there halves the cost of a move in a crowd). `float_costs`: every box
-    /// on the way lies in bounds for which float_costs_fit() holds.
-    void walk_up(std::int32_t i, bool float_costs) {
-        Node* nodes = nodes_.data();
-        for (const std::int32_t first = i; i != dynamic_detail::kNullNode; i = nodes[i].parent) {
-            Node& n = nodes[i];
-            const Box before = n.box;
-            const std::int32_t child1 = n.child1, child2 = n.child2;
-            const std::int32_t height = n.height;
-            const std::uint32_t enlarged = n.enlarged;
-            dynamic_detail::refit(nodes, i);
-            if (options_.rotate) {
-                if (float_costs) {
-                    dynamic_detail::rotate<float>(nodes, i);
-                } else {
-                    dynamic_detail::rotate<double>(nodes, i);
-                }
-            }
-            if (i != first && n.child1 == child1 && n.child2 == child2 && n.height == height &&
-                n.enlarged == enlarged && n.box == before)
-                break;
-        }
-    }
-
     Options options_;
-    std::vector<Node> nodes_;
+    LinkedTree<T, N> tree_;  // leaves: the fat boxes, valued by proxy id
     std::vector<Proxy> proxies_;
     std::vector<ProxyId> move_buffer_;
-    std::int32_t root_ = dynamic_detail::kNullNode;
-    std::int32_t free_node_ = dynamic_detail::kNullNode;
     std::int32_t free_proxy_ = dynamic_detail::kNullNode;
-    std::size_t node_count_ = 0;
     std::size_t proxy_count_ = 0;
     // Scratch storage kept between calls so that steady use allocates nothing.
-    std::vector<dynamic_detail::SiblingCandidate<double>>
-        heap_;  // insertion scratch, per cost type
-    std::vector<dynamic_detail::SiblingCandidate<float>> float_heap_;
     std::vector<ProxyPair> pair_scratch_;
-    dynamic_detail::BuildScratch<T, N> build_;
+    std::vector<VecT> rebuild_centroids_;
     std::vector<std::pair<double, std::int32_t>> optimize_scratch_;
     // update_pairs(): the persistent pair set, whether it is current (find_pairs() makes it
     // stale), ends owed for ids shrink_to_fit() dropped, and scratch.

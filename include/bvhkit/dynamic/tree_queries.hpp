@@ -27,7 +27,7 @@ template <class T, std::size_t N, class U>
 inline void prefetch_next(const TreeView<T, N, U>& t, const Node<T, N>& n) {
 #if defined(__GNUC__)
     if (n.is_leaf()) {
-        __builtin_prefetch(&t.proxies[n.proxy()]);
+        __builtin_prefetch(&t.proxies[n.value()]);
     } else {
         __builtin_prefetch(&t.nodes[n.child1]);
         __builtin_prefetch(&t.nodes[n.child2]);
@@ -53,7 +53,7 @@ void query_box(const TreeView<T, N, U>& t, const Aabb<T, N>& box, F&& callback, 
         const Node<T, N>& n = t.nodes[stack.pop()];
         if (n.is_leaf()) {
             ++tested;
-            if (t.proxies[n.proxy()].box.overlaps(box) && !callback(n.proxy())) break;
+            if (t.proxies[n.value()].box.overlaps(box) && !callback(n.value())) break;
             continue;
         }
         visited += 2;
@@ -113,12 +113,12 @@ void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, CastInput<T, N> 
         if (seg.entry(n.box, pad, max_fraction) < T(0)) continue;
         if (n.is_leaf()) {
             ++tested;
-            if (seg.entry(t.proxies[n.proxy()].box, pad, max_fraction) < T(0)) continue;
+            if (seg.entry(t.proxies[n.value()].box, pad, max_fraction) < T(0)) continue;
             T value;
             if constexpr (std::is_invocable_v<F&, const CastInput<T, N>&, ProxyId>)
-                value = callback(std::as_const(in), n.proxy());
+                value = callback(std::as_const(in), n.value());
             else
-                value = callback(n.proxy(), max_fraction);
+                value = callback(n.value(), max_fraction);
             if (value == T(0)) break;
             if (value > T(0)) max_fraction = value;
         } else {
@@ -151,8 +151,8 @@ void query_tree(const TreeView<T, N, U>& a, const TreeView<T, N, V>& b, F&& call
         const bool leaf_a = na.is_leaf(), leaf_b = nb.is_leaf();
         if (leaf_a && leaf_b) {
             ++tested;
-            if (a.proxies[na.proxy()].box.overlaps(b.proxies[nb.proxy()].box) &&
-                !callback(na.proxy(), nb.proxy()))
+            if (a.proxies[na.value()].box.overlaps(b.proxies[nb.value()].box) &&
+                !callback(na.value(), nb.value()))
                 break;
         } else if (leaf_b || (!leaf_a && na.box.area() >= nb.box.area())) {
             stack.push({na.child2, p.b});

@@ -1,12 +1,12 @@
 #pragma once
-// The small types shared by the dynamic tree's parts: ids, the node and proxy records, the options
-// (fat margins, insertion strategy) and the statistics a query or the whole tree can report.
+// The small types shared by the dynamic tree's parts: ids, the proxy record, the options (fat
+// margins, insertion strategy) and the statistics a query or the whole tree can report.
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
 
-#include "bvhkit/math/aabb.hpp"
+#include "bvhkit/bvh/linked_tree.hpp"
 
 namespace bvhkit {
 
@@ -14,21 +14,6 @@ namespace bvhkit {
 /// is destroyed, whatever happens to the tree: growth of the node pool, rotations, rebuilds.
 using ProxyId = std::int32_t;
 inline constexpr ProxyId kNullProxy = -1;
-
-/// How insert() picks the sibling of a new leaf.
-enum class InsertionStrategy : std::uint8_t {
-    /// The classic descent: at each node go to the child whose union with the new box is smaller,
-    /// and stop where staying is cheapest. Fast, but it only ever looks at one path and stops
-    /// early.
-    Greedy,
-    /// Exact best sibling for the SAH insertion cost, found by branch and bound over the whole tree
-    /// (Bittner, Hapala, Havran 2013). The cheapest trees; each insertion may visit many nodes.
-    BranchAndBound,
-    /// One path guided by lower bounds on the insertion cost (Catto, GDC 2019): the cost of the
-    /// greedy descent, trees within a few percent of BranchAndBound's (2-10% on the D1/D2 crowds,
-    /// where it halves move()'s time). The default.
-    Guided,
-};
 
 /// Options of a DynamicTree. The fat box of a leaf is its box grown on every side by
 /// `margin_absolute + margin_relative * (largest extent of the box)`, then stretched along
@@ -85,25 +70,9 @@ struct TreeStats {
 
 namespace dynamic_detail {
 
-inline constexpr std::int32_t kNullNode = -1;
-
-/// One node of the pool. 32 bytes for 2D float, 40 for 3D float. A leaf has child1 == kNullNode and
-/// keeps its proxy id in child2; a free node keeps the next free index in parent. The height has 31
-/// bits: a tree of 2^31 nodes (the pool's limit) cannot be taller than that, so no input (say tens
-/// of thousands of nested boxes with rotations off) can overflow it.
+inline constexpr std::int32_t kNullNode = linked::null;
 template <class T, std::size_t N>
-struct Node {
-    Aabb<T, N> box;  // fat box for a leaf, union of the children for an internal node
-    std::int32_t parent = kNullNode;  // or the next free node
-    std::int32_t child1 = kNullNode;
-    std::int32_t child2 = kNullNode;  // a leaf's proxy id
-    std::int32_t height : 31 = 0;     // leaf 0, free -1
-    std::uint32_t enlarged : 1 = 0;   // set by enlarge(), cleared by rebuild()
-
-    bool is_leaf() const { return child1 == kNullNode; }
-    ProxyId proxy() const { return child2; }
-};
-static_assert(sizeof(Node<float, 2>) == 32 && sizeof(Node<float, 3>) == 40);
+using Node = linked::Node<T, N>;
 
 /// What the tree keeps per proxy. A free slot has node == kNullNode and the next free id in
 /// next_free.

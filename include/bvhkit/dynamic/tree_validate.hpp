@@ -1,6 +1,7 @@
 #pragma once
-// DynamicTree::validate() and the input checks: every invariant of the node pool and the proxy
-// table, checked from scratch, with a bvhkit::Error that names the first broken one.
+// DynamicTree::validate() and the input checks: every invariant of the proxy table and the move
+// buffer (the tree's own are LinkedTree::validate's), checked from scratch, with a bvhkit::Error
+// that names the first broken one.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -55,120 +56,61 @@ void check_not_nan(const Vec<T, N>& v, const char* what, const char* where) {
                         "] is nan (a query must not hold NaN)");
 }
 
-/// Everything validate() needs to see of a tree.
+/// DynamicTree::validate()'s check of one leaf of the tree: it names a proxy whose leaf it is and
+/// whose tight box its fat box contains.
 template <class T, std::size_t N, class U>
-struct TreeParts {
-    const std::vector<Node<T, N>>& nodes;
-    const std::vector<Proxy<T, N, U>>& proxies;
-    const std::vector<ProxyId>& move_buffer;
-    std::int32_t root;
-    std::int32_t free_node;
-    std::int32_t free_proxy;
-    std::size_t node_count;
-    std::size_t proxy_count;
-};
-
-[[noreturn]] inline void broken(const std::string& what) {
-    throw Error("DynamicTree::validate: " + what);
+void check_leaf(const Node<T, N>& n, std::int32_t i, const std::vector<Proxy<T, N, U>>& proxies) {
+    const auto broken = [](const std::string& what) {
+        throw Error("DynamicTree::validate: " + what);
+    };
+    const ProxyId p = n.value();
+    const std::string leaf = "leaf node " + std::to_string(i);
+    if (p < 0 || std::size_t(p) >= proxies.size())
+        broken(leaf + " has proxy id " + std::to_string(p) + " out of range");
+    if (proxies[std::size_t(p)].node != i)
+        broken("proxy table: " + leaf + " names proxy " + std::to_string(p) + " whose node is " +
+               std::to_string(proxies[std::size_t(p)].node));
+    if (!n.box.contains(proxies[std::size_t(p)].box))
+        broken("fat box of " + leaf + " does not contain proxy " + std::to_string(p) + "'s box");
 }
 
+/// Everything the proxy side of DynamicTree::validate() needs to see.
 template <class T, std::size_t N, class U>
-void validate_tree(const TreeParts<T, N, U>& t) {
-    const auto cap = static_cast<std::int64_t>(t.nodes.size());
+struct ProxyParts {
+    const LinkedTree<T, N>& tree;
+    const std::vector<Proxy<T, N, U>>& proxies;
+    const std::vector<ProxyId>& move_buffer;
+    std::int32_t free_proxy;
+    std::size_t proxy_count;
+    std::size_t leaves;  // leaves in the tree (LinkedTree::validate)
+};
+
+/// The proxy table, its free list and the move buffer: live proxies point at leaves naming them
+/// back, free slots form one list, every moved proxy is buffered once.
+template <class T, std::size_t N, class U>
+void validate_proxies(const ProxyParts<T, N, U>& t) {
+    const auto broken = [](const std::string& what) {
+        throw Error("DynamicTree::validate: " + what);
+    };
+    const auto cap = static_cast<std::int64_t>(t.tree.capacity());
     const auto pcap = static_cast<std::int64_t>(t.proxies.size());
-    const auto node_name = [](std::int64_t i) { return "node " + std::to_string(i); };
-
-    // Structure: walk down from the root; every reached node is in range, in use, reached once.
-    std::vector<std::uint8_t> seen(t.nodes.size(), 0);
-    std::size_t reached = 0, leaves = 0;
-    if (t.root != kNullNode) {
-        if (t.root < 0 || t.root >= cap)
-            broken("root index " + std::to_string(t.root) + " out of range");
-        if (t.nodes[t.root].parent != kNullNode)
-            broken("root " + node_name(t.root) + " has a parent");
-        std::vector<std::int32_t> stack{t.root};
-        while (!stack.empty()) {
-            const std::int32_t i = stack.back();
-            stack.pop_back();
-            if (i < 0 || i >= cap) broken("child index " + std::to_string(i) + " out of range");
-            if (seen[i]) broken(node_name(i) + " is reached twice (the structure is not a tree)");
-            seen[i] = 1;
-            ++reached;
-            const Node<T, N>& n = t.nodes[i];
-            if (n.height < 0) broken(node_name(i) + " is in the tree but marked free");
-            if (n.is_leaf()) {
-                ++leaves;
-                const ProxyId p = n.proxy();
-                if (p < 0 || p >= pcap)
-                    broken("leaf " + node_name(i) + " has proxy id " + std::to_string(p) +
-                           " out of range");
-                if (t.proxies[p].node != i)
-                    broken("proxy table: leaf " + node_name(i) + " names proxy " +
-                           std::to_string(p) + " whose node is " +
-                           std::to_string(t.proxies[p].node));
-                if (n.height != 0)
-                    broken("leaf " + node_name(i) + " has height " + std::to_string(n.height));
-                if (!n.box.contains(t.proxies[p].box))
-                    broken("fat box of leaf " + node_name(i) + " does not contain proxy " +
-                           std::to_string(p) + "'s box");
-                continue;
-            }
-            for (const std::int32_t c : {n.child1, n.child2}) {
-                if (c < 0 || c >= cap)
-                    broken(node_name(i) + " has child index " + std::to_string(c) +
-                           " out of range");
-                const Node<T, N>& cn = t.nodes[c];
-                if (cn.parent != i)
-                    broken("parent link: " + node_name(c) + " is a child of " + std::to_string(i) +
-                           " but its parent is " + std::to_string(cn.parent));
-                if (!n.box.contains(cn.box))
-                    broken("box of internal " + node_name(i) + " does not enclose its child " +
-                           std::to_string(c));
-                if (cn.enlarged && !n.enlarged)
-                    broken(node_name(c) + " is marked enlarged but its parent " +
-                           std::to_string(i) + " is not");
-                stack.push_back(c);
-            }
-            if (n.child1 == n.child2) broken(node_name(i) + " has the same child twice");
-            const int h = 1 + std::max<int>(t.nodes[n.child1].height, t.nodes[n.child2].height);
-            if (n.height != h)
-                broken(node_name(i) + " has height " + std::to_string(n.height) + ", expected " +
-                       std::to_string(h));
-        }
-    }
-    if (reached != t.node_count)
-        broken("node count: " + std::to_string(reached) + " nodes reachable from the root, " +
-               std::to_string(t.node_count) + " in use");
-    if (leaves != t.proxy_count)
-        broken("leaf count: " + std::to_string(leaves) + " leaves, " +
+    if (t.leaves != t.proxy_count)
+        broken("leaf count: " + std::to_string(t.leaves) + " leaves, " +
                std::to_string(t.proxy_count) + " proxies");
-
-    // Free list: every node not in the tree is on it exactly once, marked free.
-    std::size_t free_nodes = 0;
-    for (std::int32_t i = t.free_node; i != kNullNode; i = t.nodes[i].parent) {
-        if (i < 0 || i >= cap) broken("free list: index " + std::to_string(i) + " out of range");
-        if (seen[i]) broken("free list: " + node_name(i) + " is also in the tree or listed twice");
-        seen[i] = 1;
-        if (t.nodes[i].height != -1) broken("free list: " + node_name(i) + " is not marked free");
-        ++free_nodes;
-    }
-    if (free_nodes + t.node_count != t.nodes.size())
-        broken("free list: " + std::to_string(free_nodes) + " free + " +
-               std::to_string(t.node_count) + " used != pool size " +
-               std::to_string(t.nodes.size()));
-
-    // Proxy table: live proxies point at leaves naming them back; free slots form one list.
+    if (t.tree.node_count() != (t.leaves == 0 ? 0 : 2 * t.leaves - 1))
+        broken("node count: " + std::to_string(t.tree.node_count()) + " nodes in use for " +
+               std::to_string(t.leaves) + " leaves");
     std::size_t live = 0;
     for (std::int64_t p = 0; p < pcap; ++p) {
-        const auto& px = t.proxies[p];
+        const auto& px = t.proxies[std::size_t(p)];
         if (px.node == kNullNode) {
             if (px.moved)
                 broken("proxy table: free proxy " + std::to_string(p) + " is marked moved");
             continue;
         }
         ++live;
-        if (px.node < 0 || px.node >= cap || t.nodes[px.node].height != 0 ||
-            !t.nodes[px.node].is_leaf() || t.nodes[px.node].proxy() != p)
+        if (px.node < 0 || px.node >= cap || t.tree.node(px.node).height != 0 ||
+            !t.tree.node(px.node).is_leaf() || t.tree.node(px.node).value() != p)
             broken("proxy table: proxy " + std::to_string(p) + " names node " +
                    std::to_string(px.node) + " which is not its leaf");
     }
@@ -176,13 +118,17 @@ void validate_tree(const TreeParts<T, N, U>& t) {
         broken("proxy table: " + std::to_string(live) + " live proxies, count says " +
                std::to_string(t.proxy_count));
     std::size_t free_proxies = 0;
-    for (std::int32_t p = t.free_proxy; p != kNullNode; p = t.proxies[p].next_free) {
+    for (std::int32_t p = t.free_proxy; p != kNullNode; p = t.proxies[std::size_t(p)].next_free) {
         if (p < 0 || p >= pcap)
             broken("proxy free list: id " + std::to_string(p) + " out of range");
-        if (t.proxies[p].node != kNullNode)
+        if (t.proxies[std::size_t(p)].node != kNullNode)
             broken("proxy free list: proxy " + std::to_string(p) + " is live");
         if (++free_proxies > t.proxies.size()) broken("proxy free list has a cycle");
     }
+    if (free_proxies + t.proxy_count != t.proxies.size())
+        broken("proxy free list: " + std::to_string(free_proxies) + " free + " +
+               std::to_string(t.proxy_count) + " live != table size " +
+               std::to_string(t.proxies.size()));
     // Move buffer: each id in range, flagged, and there once; every moved proxy is in it.
     std::size_t flagged = 0;
     for (const auto& px : t.proxies) {
@@ -190,15 +136,11 @@ void validate_tree(const TreeParts<T, N, U>& t) {
         if (px.moved && !px.buffered) broken("move buffer: a moved proxy is not in it");
     }
     for (const ProxyId id : t.move_buffer)
-        if (id < 0 || id >= pcap || !t.proxies[id].buffered)
+        if (id < 0 || id >= pcap || !t.proxies[std::size_t(id)].buffered)
             broken("move buffer: id " + std::to_string(id) + " is out of range or not flagged");
     if (flagged != t.move_buffer.size())
         broken("move buffer: " + std::to_string(t.move_buffer.size()) + " entries, " +
                std::to_string(flagged) + " proxies flagged (an id is listed twice)");
-    if (free_proxies + t.proxy_count != t.proxies.size())
-        broken("proxy free list: " + std::to_string(free_proxies) + " free + " +
-               std::to_string(t.proxy_count) + " live != table size " +
-               std::to_string(t.proxies.size()));
 }
 
 }  // namespace bvhkit::dynamic_detail

@@ -1,6 +1,8 @@
 #pragma once
-// The SAH pieces of the dynamic tree that work on its node pool: choosing the sibling of a new leaf
-// (greedy descent or exact branch and bound), refitting a node, and the four tree rotations.
+// The node of a linked tree (bvh/linked_tree.hpp) and the SAH algorithms that work on an array of
+// them: choosing the sibling of a new leaf or subtree (greedy descent, guided descent, exact branch
+// and bound), refitting a node, and the four tree rotations. The dynamic tree, the insertion
+// builder and the reinsertion optimizer all run these.
 //
 // Cost model (MacDonald and Booth's SAH): the cost of a tree is the sum of the areas of
 // its internal nodes ("area" = perimeter in 2D, surface area in 3D). The root and the leaves are
@@ -17,9 +19,35 @@
 #include <type_traits>
 #include <vector>
 
-#include "bvhkit/dynamic/tree_types.hpp"
+#include "bvhkit/math/aabb.hpp"
 
-namespace bvhkit::dynamic_detail {
+namespace bvhkit::linked {
+
+/// The index that links to nothing: no parent (the root), no child (a leaf), end of the free list.
+inline constexpr std::int32_t null = -1;
+
+/// One node of a linked tree's pool, linked to its parent and children by index. 32 bytes for 2D
+/// float, 40 for 3D float. The fields by kind of node:
+///   internal: parent, child1, child2;
+///   leaf:     parent, child1 == null, and the owner's number for the leaf (value()) in child2;
+///   free:     height -1, the next free node in parent.
+/// The height has 31 bits: a pool of at most 2^31 nodes cannot be taller, whatever the input.
+template <class T, std::size_t N>
+struct Node {
+    Aabb<T, N> box;  // the leaf's box; an internal node's: the union of its children's
+    std::int32_t parent = null;
+    std::int32_t child1 = null;
+    std::int32_t child2 = null;
+    std::int32_t height : 31 = 0;    // leaf 0, free -1
+    std::uint32_t enlarged : 1 = 0;  // grown in place (LinkedTree::enlarge), not yet rebuilt
+
+    bool is_leaf() const { return child1 == null; }
+    bool is_free() const { return height < 0; }
+    /// A leaf's number, chosen by the tree's owner (a proxy id, a primitive's position).
+    std::int32_t value() const { return child2; }
+    std::int32_t next_free() const { return parent; }
+};
+static_assert(sizeof(Node<float, 2>) == 32 && sizeof(Node<float, 3>) == 40);
 
 /// Areas and SAH costs are computed in `Cost`, double by default: for a float tree every extent (up
 /// to 2 * FLT_MAX) and every area (up to ~1e78) is then finite, so costs never overflow to inf and
@@ -27,9 +55,6 @@ namespace bvhkit::dynamic_detail {
 /// below ~1e150; past that it stays correct but may lose balance. A float tree whose boxes are all
 /// small enough (float_costs_fit) computes them in float: the conversions cost ~20% of an
 /// insertion.
-/// The cost type of the rebuild's binned SAH and of sah_cost(): always double.
-using Cost = double;
-
 template <class Cost, std::size_t N>
 inline Cost area_of_extents(const Cost (&e)[N]) {
     if constexpr (N == 2) {
@@ -300,4 +325,4 @@ void rotate(Node<T, N>* nodes, std::int32_t a) {
     refit(nodes, a);
 }
 
-}  // namespace bvhkit::dynamic_detail
+}  // namespace bvhkit::linked
