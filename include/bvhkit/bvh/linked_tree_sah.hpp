@@ -255,6 +255,21 @@ std::int32_t find_sibling_branch_and_bound(
     return descend_ties<Cost>(nodes, best, box, best_cost);
 }
 
+/// One rotation at node a: its child in `slot` (1 or 2) trades places with the child in
+/// `nephew_slot` of a's other child, which is then refitted.
+template <class T, std::size_t N>
+void swap_with_nephew(Node<T, N>* nodes, std::int32_t a, int slot, int nephew_slot) {
+    Node<T, N>& na = nodes[a];
+    std::int32_t& down = slot == 1 ? na.child1 : na.child2;
+    const std::int32_t other = slot == 1 ? na.child2 : na.child1;
+    Node<T, N>& no = nodes[other];
+    std::int32_t& up = nephew_slot == 1 ? no.child1 : no.child2;
+    std::swap(down, up);
+    nodes[down].parent = a;
+    nodes[up].parent = other;
+    refit(nodes, other);
+}
+
 /// The four rotations at node A (Kopta et al. 2012 "Fast, effective BVH updates for
 /// animated scenes"). A has children B and C. If B is internal with children D and E, swapping C
 /// with one of B's children changes only B's box:
@@ -290,38 +305,9 @@ void rotate(Node<T, N>* nodes, std::int32_t a) {
         if (d3 < best_delta) best_delta = d3, best = 3;
         if (d4 < best_delta) best_delta = d4, best = 4;
     }
-    switch (best) {
-        case 1: {  // C <-> D
-            const std::int32_t d = nb.child1;
-            na.child2 = d, nodes[d].parent = a;
-            nb.child1 = c, nc.parent = b;
-            refit(nodes, b);
-            break;
-        }
-        case 2: {  // C <-> E
-            const std::int32_t e = nb.child2;
-            na.child2 = e, nodes[e].parent = a;
-            nb.child2 = c, nc.parent = b;
-            refit(nodes, b);
-            break;
-        }
-        case 3: {  // B <-> F
-            const std::int32_t f = nc.child1;
-            na.child1 = f, nodes[f].parent = a;
-            nc.child1 = b, nb.parent = c;
-            refit(nodes, c);
-            break;
-        }
-        case 4: {  // B <-> G
-            const std::int32_t g = nc.child2;
-            na.child1 = g, nodes[g].parent = a;
-            nc.child2 = b, nb.parent = c;
-            refit(nodes, c);
-            break;
-        }
-        default:
-            return;
-    }
+    if (best == 0) return;
+    // 1: C <-> D, 2: C <-> E (C is a's child 2); 3: B <-> F, 4: B <-> G (B is a's child 1).
+    swap_with_nephew(nodes, a, best <= 2 ? 2 : 1, best % 2 == 1 ? 1 : 2);
     refit(nodes, a);
 }
 

@@ -94,13 +94,7 @@ class DynamicTree {
     /// restructured (remove + insert) only when the box leaves the fat box, or when the fat box has
     /// become far larger than a fresh one would be; returns whether that happened.
     bool move(ProxyId id, const Box& box, const VecT& displacement = VecT{}) {
-        check_not_walking("DynamicTree::move");
-        check_id(id, "DynamicTree::move");
-        dynamic_detail::check_box(box, "DynamicTree::move");
-        dynamic_detail::check_vector(displacement, "displacement", "DynamicTree::move");
-        Proxy& p = proxies_[id];
-        p.box = box;
-        buffer_move(id);
+        const Proxy& p = set_box(id, box, displacement, "DynamicTree::move");
         const std::int32_t leaf = p.node;
         const Box fat = fat_box(box, displacement);
         if (dynamic_detail::keeps_fat_box(options_, tree_.node(leaf).box, box, fat, displacement))
@@ -115,13 +109,7 @@ class DynamicTree {
     /// are grown in place, without restructuring (cheap, for many moves in a row; quality suffers
     /// until rebuild(false) rebuilds the grown part). Returns whether anything was grown.
     bool enlarge(ProxyId id, const Box& box, const VecT& displacement = VecT{}) {
-        check_not_walking("DynamicTree::enlarge");
-        check_id(id, "DynamicTree::enlarge");
-        dynamic_detail::check_box(box, "DynamicTree::enlarge");
-        dynamic_detail::check_vector(displacement, "displacement", "DynamicTree::enlarge");
-        Proxy& p = proxies_[id];
-        p.box = box;
-        buffer_move(id);
+        const Proxy& p = set_box(id, box, displacement, "DynamicTree::enlarge");
         if (tree_.node(p.node).box.contains(box)) return false;
         tree_.enlarge(p.node, fat_box(box, displacement));
         return true;
@@ -530,6 +518,17 @@ class DynamicTree {
             p.moved = p.buffered = p.ended = false;
         }
         move_buffer_.clear();
+    }
+
+    /// The first step of move() and enlarge(): the checks, the new tight box, the move buffer.
+    const Proxy& set_box(ProxyId id, const Box& box, const VecT& displacement, const char* where) {
+        check_not_walking(where);
+        check_id(id, where);
+        dynamic_detail::check_box(box, where);
+        dynamic_detail::check_vector(displacement, "displacement", where);
+        proxies_[id].box = box;
+        buffer_move(id);
+        return proxies_[id];
     }
 
     void buffer_move(ProxyId id) {
