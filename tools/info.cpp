@@ -3,10 +3,10 @@
 
 #include "args.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
-#include "bvhkit/query/ray_sets.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "commands.hpp"
 #include "output.hpp"
+#include "ray_sets.hpp"
 #include "report.hpp"
 
 namespace bvhkit::tools {

@@ -10,10 +10,10 @@
 #include "bvhkit/bsp/bsp_tree.hpp"
 #include "bvhkit/bsp/ray.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
-#include "bvhkit/query/ray_sets.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "commands.hpp"
 #include "image.hpp"
+#include "ray_sets.hpp"
 
 namespace bvhkit::tools {
 namespace {

@@ -5,8 +5,8 @@
 #include <filesystem>
 
 #include "bvhkit/mesh/load_mesh.hpp"
-#include "bvhkit/query/ray_sets.hpp"
 #include "bvhkit/triangle_bvh.hpp"
+#include "ray_sets.hpp"
 
 namespace {
 

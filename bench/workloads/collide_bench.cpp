@@ -8,13 +8,13 @@
 
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/distance.hpp"
-#include "bvhkit/query/pairs_poses.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
 #include "bvhkit/volumes/obb_rss.hpp"
 #include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
+#include "random_rigid_poses.hpp"
 
 #if BVHKIT_HAVE_FCL
 #include <fcl/geometry/bvh/BVH_model.h>

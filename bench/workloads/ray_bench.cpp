@@ -2,9 +2,9 @@
 
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
-#include "bvhkit/query/ray_sets.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "embree_scene.hpp"
+#include "ray_sets.hpp"
 
 namespace bvhkit::bench {
 

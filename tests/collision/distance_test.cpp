@@ -5,13 +5,13 @@
 
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/query/distance.hpp"
-#include "bvhkit/query/pairs_poses.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
 #include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
 #include "collision_support.hpp"
+#include "random_rigid_poses.hpp"
 #include "test_support.hpp"
 
 namespace bvhkit::test {

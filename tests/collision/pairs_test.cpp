@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include "bvhkit/io/read_mesh.hpp"
-#include "bvhkit/query/pairs_poses.hpp"
 #include "bvhkit/query/self_collision.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/kdop.hpp"
@@ -12,6 +11,7 @@
 #include "bvhkit/volumes/rss.hpp"
 #include "bvhkit/volumes/sphere.hpp"
 #include "collision_support.hpp"
+#include "random_rigid_poses.hpp"
 #include "test_support.hpp"
 
 namespace bvhkit::test {

@@ -8,7 +8,7 @@
 #include "brute_force.hpp"
 #include "bvhkit/bvh/validate.hpp"
 #include "bvhkit/io/read_mesh.hpp"
-#include "bvhkit/query/ray_sets.hpp"
+#include "ray_sets.hpp"
 #include "test_support.hpp"
 
 using namespace bvhkit;

@@ -123,8 +123,9 @@ TEST(DynamicTree, InputErrorsNameTheValue) {
     EXPECT_THROW((DynamicTree<float, 2>{bad}), bvhkit::Error);
 }
 
-// Seed 000's warning: boxes inserted in sorted order along a line turn a tree without rotations
-// into a list. With rotations (and either strategy) the height must stay logarithmic.
+// The known worst case of incremental insertion: boxes inserted in sorted order along a line turn
+// a tree without rotations into a list. With rotations (Kopta et al. 2012) and either strategy the
+// height must stay logarithmic.
 class SortedLine : public ::testing::TestWithParam<InsertionStrategy> {};
 
 TEST_P(SortedLine, HeightStaysLogarithmic) {

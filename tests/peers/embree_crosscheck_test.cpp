@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 
 #include "bvhkit/io/read_mesh.hpp"
-#include "bvhkit/query/ray_sets.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "embree_scene.hpp"
+#include "ray_sets.hpp"
 #include "test_support.hpp"
 
 using namespace bvhkit;

@@ -12,7 +12,7 @@
 
 #include "bvhkit/io/ray_files.hpp"
 #include "bvhkit/io/read_mesh.hpp"
-#include "bvhkit/query/ray_sets.hpp"
+#include "ray_sets.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -1,6 +1,6 @@
-// End to end: `bvhkit trace` on ray files in the docs/workloads.md format must write the brute-force
-// hits (closest hit over every triangle) for workload R1 and R2 rays on every shared mesh; and the
-// command's errors must be clear.
+// End to end: `bvhkit trace` on ray files in the docs/workloads.md format must write the
+// brute-force hits (closest hit over every triangle) for workload R1 and R2 rays on every shared
+// mesh; and the command's errors must be clear.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -10,7 +10,7 @@
 #include "brute_force.hpp"
 #include "bvhkit/io/ray_files.hpp"
 #include "bvhkit/io/read_mesh.hpp"
-#include "bvhkit/query/ray_sets.hpp"
+#include "ray_sets.hpp"
 #include "test_support.hpp"
 
 using namespace bvhkit;

@@ -2,7 +2,8 @@
 // The random rigid poses of workload C1 (docs/workloads.md): a rotation uniform over SO(3)
 // (a unit quaternion by Shoemake's method, "Uniform random rotations", 1992)
 // about the centre c of the mesh's box, then an offset uniform in a cube of side one box diagonal
-// centred on c. A pose maps x to R (x - c) + c + offset. Deterministic for a seed.
+// centred on c. A pose maps x to R (x - c) + c + offset. Deterministic for a seed. A benchmark
+// input, not part of the library: bench/, tools/ and the tests link it as bvhkit_workload_inputs.
 #include <numbers>
 #include <vector>
 

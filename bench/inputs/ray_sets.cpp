@@ -1,4 +1,4 @@
-#include "bvhkit/query/ray_sets.hpp"
+#include "ray_sets.hpp"
 
 #include <cmath>
 

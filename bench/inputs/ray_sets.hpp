@@ -1,6 +1,7 @@
 #pragma once
 // The ray sets of workload R (docs/workloads.md), deterministic so every library and every
-// run traces the same rays.
+// run traces the same rays. A benchmark input, not part of the library: bench/, tools/ and the
+// tests link it as bvhkit_workload_inputs (bench/CMakeLists.txt).
 #include <cstdint>
 #include <vector>
 

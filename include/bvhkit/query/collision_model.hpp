@@ -1,0 +1,101 @@
+#pragma once
+// CollisionModel<V>: a triangle mesh ready for collision and distance queries with any bounding
+// volume type V (Aabb<T, 3>, Sphere<T>, Obb<T>, Kdop<T, K>). The tree's shape comes from the AABB
+// builders (build_bvh); its volumes are fitted per node (build/fit_volumes.hpp). The triangles are
+// kept in leaf-slot order, so a leaf's triangles are contiguous. The queries on two models are in
+// query/pairs_model.hpp (collide, collides) and query/distance.hpp.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "bvhkit/build/build.hpp"
+#include "bvhkit/build/fit_volumes.hpp"
+#include "bvhkit/error.hpp"
+#include "bvhkit/primitives/triangle_mesh.hpp"
+
+namespace bvhkit {
+
+/// Build options for collision trees: small leaves, as a leaf pair costs count_a * count_b
+/// triangle tests.
+inline BuildOptions collision_build_options() {
+    BuildOptions o;
+    o.max_leaf_size = 2;
+    return o;
+}
+
+template <BoundingVolume V>
+class CollisionModel {
+  public:
+    using T = typename V::Scalar;
+    using Volume = V;
+
+    CollisionModel() = default;
+    template <IndexedTriangleMesh M>
+    explicit CollisionModel(const M& mesh,
+                            const BuildOptions& options = collision_build_options()) {
+        check_triangle_indices(mesh);
+        std::vector<Aabb<T, 3>> boxes(mesh.triangle_count());
+        std::vector<Vec<T, 3>> centroids(mesh.triangle_count());
+        for (std::size_t i = 0; i < boxes.size(); ++i) {
+            boxes[i] = triangle_at<T>(mesh, i).bounds();
+            centroids[i] = boxes[i].centroid();
+        }
+        const AabbBvh<T, 3> topology = build_bvh<T, 3>(boxes, centroids, options, &report_);
+        triangle_count_ = mesh.triangle_count();
+        lay_out(mesh, topology.primitive_indices);
+        bvh_ = fit_volumes<V>(topology, std::span<const Triangle<T>>(slot_triangles_));
+    }
+
+    /// After the mesh's vertices moved (same triangles in the same order): new triangles, every
+    /// volume refitted in one pass, same tree shape.
+    template <IndexedTriangleMesh M>
+    void refit(const M& mesh) {
+        if (mesh.triangle_count() != triangle_count_)
+            throw Error("CollisionModel::refit: the mesh has " +
+                        std::to_string(mesh.triangle_count()) +
+                        " triangles, the model was built over " + std::to_string(triangle_count_));
+        check_triangle_indices(mesh);
+        lay_out(mesh, bvh_.primitive_indices);
+        refit_volumes(bvh_, std::span<const Triangle<T>>(slot_triangles_));
+    }
+
+    const Bvh<V>& bvh() const { return bvh_; }
+    /// Triangle in leaf slot s; its index in the mesh is bvh().primitive_indices[s].
+    std::span<const Triangle<T>> slot_triangles() const { return slot_triangles_; }
+    std::span<const std::array<std::uint32_t, 3>> slot_vertex_ids() const {
+        return slot_vertex_ids_;
+    }
+    std::uint32_t triangle_id(std::uint32_t slot) const { return bvh_.primitive_indices[slot]; }
+    std::size_t triangle_count() const { return triangle_count_; }
+    /// Triangles left out for non-finite coordinates.
+    const std::vector<std::uint32_t>& skipped() const { return report_.skipped; }
+    /// Largest |coordinate| of the model plus its box diagonal: the scale of its rounding errors.
+    T scale() const { return scale_; }
+
+  private:
+    template <IndexedTriangleMesh M>
+    void lay_out(const M& mesh, const std::vector<std::uint32_t>& order) {
+        slot_triangles_.resize(order.size());
+        slot_vertex_ids_.resize(order.size());
+        Aabb<T, 3> box;
+        for (std::size_t s = 0; s < order.size(); ++s) {
+            slot_triangles_[s] = triangle_at<T>(mesh, order[s]);
+            slot_vertex_ids_[s] = mesh.triangle(order[s]);
+            box.grow(slot_triangles_[s].p0).grow(slot_triangles_[s].p1).grow(slot_triangles_[s].p2);
+        }
+        scale_ = box.is_empty()
+                     ? T(0)
+                     : max_component(bvhkit::max(box.max, -box.min)) + length(box.max - box.min);
+    }
+
+    Bvh<V> bvh_;
+    std::vector<Triangle<T>> slot_triangles_;
+    std::vector<std::array<std::uint32_t, 3>> slot_vertex_ids_;
+    BuildReport report_;
+    std::size_t triangle_count_ = 0;
+    T scale_ = 0;
+};
+
+}  // namespace bvhkit
