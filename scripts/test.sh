@@ -11,18 +11,28 @@ scripts/install-deps.sh
 jobs=$(nproc 2>/dev/null || echo 2)
 logs=build/test-logs
 mkdir -p "$logs"
+# Each stage's wall time, printed at the end (CI's budget is kept by looking at these).
+timings=()
+stage_start=$SECONDS
+stage_name=""
+stage() {
+    if [ -n "$stage_name" ]; then timings+=("$(printf '%5ds  %s' $((SECONDS - stage_start)) "$stage_name")"); fi
+    stage_name="$1"
+    stage_start=$SECONDS
+    if [ -n "$1" ]; then echo "== $1"; fi
+}
 
-echo "== Release build and tests"
+stage "Release build and tests"
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$jobs"
 ctest --preset release 2>&1 | tee "$logs/release.log"
 
-echo "== Sanitizer build (ASan + UBSan) and tests"
+stage "Sanitizer build (ASan + UBSan) and tests"
 cmake --preset debug-asan >/dev/null
 cmake --build --preset debug-asan -j "$jobs"
 ctest --preset debug-asan 2>&1 | tee "$logs/asan.log"
 
-echo "== ThreadSanitizer: const queries from many threads"
+stage "ThreadSanitizer: const queries from many threads"
 # oneTBB is left out here (its own worker pool is not instrumented); the threads are the test's own.
 cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBVHKIT_WERROR=ON \
     -DBVHKIT_BUILD_TESTS=ON -DBVHKIT_BUILD_TOOLS=OFF -DBVHKIT_BUILD_EXAMPLES=OFF -DBVHKIT_WITH_TBB=OFF \
@@ -30,7 +40,7 @@ cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DBVHKIT_WER
 cmake --build build/tsan --target bvhkit_tests_concurrency -j "$jobs"
 TSAN_OPTIONS="halt_on_error=1" build/tsan/tests/bvhkit_tests_concurrency
 
-echo "== Plain build without any optional package (cmake -B build && cmake --build build)"
+stage "Plain build without any optional package (cmake -B build && cmake --build build)"
 disabled=()
 for package in embree box2d PkgConfig CGAL TBB PNG GTest benchmark; do
     disabled+=("-DCMAKE_DISABLE_FIND_PACKAGE_${package}=ON")
@@ -43,20 +53,20 @@ build/bare/tools/bvhkit info sphere:subdiv=5
 build/bare/tools/bvhkit bench rays sphere:subdiv=5 --rays 20000 --size 128 --reps 1
 build/bare/examples/bvhkit_example_quickstart
 
-echo "== Install and consume with find_package(bvhkit)"
+stage "Install and consume with find_package(bvhkit)"
 rm -rf build/install build/consumer
 cmake --install build/release --prefix build/install >/dev/null
 cmake -S tests/consumer -B build/consumer -G Ninja -DCMAKE_PREFIX_PATH="$PWD/build/install" >/dev/null
 cmake --build build/consumer
 build/consumer/consumer
 
-echo "== Python package (pip install into build/python-venv) and its tests"
+stage "Python package (pip install into build/python-venv) and its tests"
 scripts/test-python.sh
 
-echo "== Fuzzing the mesh readers"
+stage "Fuzzing the mesh readers"
 scripts/fuzz.sh "${BVHKIT_FUZZ_SECONDS:-15}"
 
-echo "== Skipped tests (not run here, and why)"
+stage "Skipped tests (not run here, and why)"
 for run in release asan; do
     skipped=$(grep -c "(Skipped)" "$logs/$run.log" || true)
     echo "$run: $skipped skipped"
@@ -66,4 +76,6 @@ grep -h -A1 ": Skipped$" build/release/Testing/Temporary/LastTest.log build/asan
     grep -v -e ": Skipped$" -e "^--" |
     sort | uniq -c | sort -rn | head -20 || true
 
-echo "== All tests passed"
+stage ""
+printf '%s\n' "${timings[@]}"
+echo "== All tests passed in $((SECONDS / 60)) min $((SECONDS % 60)) s"
