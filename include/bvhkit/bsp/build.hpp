@@ -65,7 +65,6 @@ class Builder {
         s.input_triangles = input_triangles;
         s.dropped_degenerate = dropped;
         s.epsilon = double(eps_);
-        std::vector<Vec<T, N>> f_part, b_part;
         while (!stack.empty()) {
             Task task = std::move(stack.back());
             stack.pop_back();
@@ -76,33 +75,8 @@ class Builder {
                 task.list.size() <= options_.leaf_size || task.depth >= options_.max_depth;
             Candidate<T, N> best;
             if (!task.list.empty() && !halt && choose(task.list, best)) {
-                std::vector<std::uint32_t> front, back, facing_back;
-                for (const std::uint32_t i : task.list) {
-                    const auto v = pool_.vertices_of(i);
-                    switch (classify_polygon(v, best.plane, eps_)) {
-                        case Side::Front:
-                            front.push_back(i);
-                            break;
-                        case Side::Back:
-                            back.push_back(i);
-                            break;
-                        case Side::Coplanar:
-                            if (dot(pool_.plane_of(i).normal, best.plane.normal) >= T(0))
-                                emit(out.polygons, i), ++node.front_facing;
-                            else
-                                facing_back.push_back(i);
-                            break;
-                        case Side::Spanning: {
-                            split_polygon(v, best.plane, eps_, f_part, b_part);
-                            const std::uint32_t src = pool_.polygons[i].source;
-                            front.push_back(pool_.add(f_part, src));
-                            back.push_back(pool_.add(b_part, src));
-                            ++s.splits;
-                            break;
-                        }
-                    }
-                }
-                for (const std::uint32_t i : facing_back) emit(out.polygons, i);
+                std::vector<std::uint32_t> front, back;
+                sort_by_plane(task.list, best.plane, out.polygons, node, front, back, s.splits);
                 node.count = std::uint32_t(out.polygons.size()) - node.first;
                 node.plane = best.plane;
                 node.axis_aligned = best.axis;
@@ -129,6 +103,49 @@ class Builder {
             }
             out.nodes[task.node] = node;
         }
+        finish_statistics(out);
+        return out;
+    }
+
+  private:
+    /// Sorts `list` by `plane`: front and back lists (a spanning polygon split into one part each),
+    /// coplanar polygons emitted at `node`, those facing the plane's way first.
+    void sort_by_plane(const std::vector<std::uint32_t>& list, const Plane<T, N>& plane,
+                       PolygonPool<T, N>& emitted, BspNode<T, N>& node,
+                       std::vector<std::uint32_t>& front, std::vector<std::uint32_t>& back,
+                       std::size_t& splits) {
+        std::vector<std::uint32_t> facing_back;
+        for (const std::uint32_t i : list) {
+            const auto v = pool_.vertices_of(i);
+            switch (classify_polygon(v, plane, eps_)) {
+                case Side::Front:
+                    front.push_back(i);
+                    break;
+                case Side::Back:
+                    back.push_back(i);
+                    break;
+                case Side::Coplanar:
+                    if (dot(pool_.plane_of(i).normal, plane.normal) >= T(0))
+                        emit(emitted, i), ++node.front_facing;
+                    else
+                        facing_back.push_back(i);
+                    break;
+                case Side::Spanning: {
+                    split_polygon(v, plane, eps_, f_part_, b_part_);
+                    const std::uint32_t src = pool_.polygons[i].source;
+                    front.push_back(pool_.add(f_part_, src));
+                    back.push_back(pool_.add(b_part_, src));
+                    ++splits;
+                    break;
+                }
+            }
+        }
+        for (const std::uint32_t i : facing_back) emit(emitted, i);
+    }
+
+    /// The statistics that are read off the finished tree.
+    static void finish_statistics(BspBuildResult<T, N>& out) {
+        BspStatistics& s = out.stats;
         s.nodes = out.nodes.size();
         s.polygons = out.polygons.size();
         s.vertices = out.polygons.vertices.size();
@@ -139,10 +156,8 @@ class Builder {
                          out.polygons.polygons.size() * sizeof(BspPolygon) +
                          out.polygons.vertices.size() * sizeof(Vec<T, N>) +
                          out.polygons.source_planes.size() * sizeof(Plane<T, N>);
-        return out;
     }
 
-  private:
     void emit(PolygonPool<T, N>& to, std::uint32_t i) {
         to.add(pool_.vertices_of(i), pool_.polygons[i].source);
     }
@@ -225,6 +240,7 @@ class Builder {
     PolygonPool<T, N> pool_;
     BspOptions options_;
     T eps_;
+    std::vector<Vec<T, N>> f_part_, b_part_;  // split_polygon's output, reused
 };
 
 }  // namespace bsp_detail

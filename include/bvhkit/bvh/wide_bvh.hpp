@@ -49,51 +49,80 @@ using WideNode4 = WideNode<T, 4>;
 template <class T>
 using WideBvh4 = WideBvh<T, 4>;
 
+namespace wide_detail {
+
+/// Primitives under each binary node.
+template <class T>
+std::vector<std::uint32_t> primitives_under(const Bvh<Aabb<T, 3>>& bvh) {
+    const auto& nodes = bvh.nodes;
+    std::vector<std::uint32_t> under(nodes.size(), 0);
+    // Children come after their parents: a reverse pass sees both children first.
+    for (std::size_t i = nodes.size(); i-- > 0;)
+        under[i] =
+            nodes[i].is_leaf() ? nodes[i].count : under[nodes[i].left()] + under[nodes[i].right()];
+    return under;
+}
+
+/// The children a wide node takes for binary node b (which opens): its two children, then, while
+/// fewer than W, the one of largest area among those that open is replaced by its two children.
+/// Returns how many lanes were filled.
+template <int W, class T, class Opens>
+int pick_lanes(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t b, Opens&& opens,
+               std::uint32_t (&lanes)[W]) {
+    const auto& nodes = bvh.nodes;
+    lanes[0] = nodes[b].left(), lanes[1] = nodes[b].right();
+    int size = 2;
+    while (size < W) {
+        int pick = -1;
+        for (int c = 0; c < size; ++c)
+            if (opens(lanes[c]) &&
+                (pick < 0 || nodes[lanes[c]].bounds.area() > nodes[lanes[pick]].bounds.area()))
+                pick = c;
+        if (pick < 0) break;
+        const std::uint32_t opened = lanes[pick];
+        lanes[pick] = nodes[opened].left();
+        lanes[size++] = nodes[opened].right();
+    }
+    return size;
+}
+
+/// Appends the slots of every binary leaf under n to `group_slots`, padded to a group of four;
+/// sets the leaf child's first group and group count. `todo` is scratch.
+template <class T>
+void append_leaf_groups(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t n,
+                        std::vector<std::uint32_t>& group_slots, std::vector<std::uint32_t>& todo,
+                        std::uint32_t& first, std::uint32_t& groups) {
+    first = std::uint32_t(group_slots.size() / 4);
+    todo.assign(1, n);
+    while (!todo.empty()) {
+        const auto& b = bvh.nodes[todo.back()];
+        todo.pop_back();
+        if (b.is_leaf()) {
+            for (std::uint32_t s = b.first; s < b.first + b.count; ++s) group_slots.push_back(s);
+        } else {
+            todo.insert(todo.end(), {b.right(), b.left()});
+        }
+    }
+    while (group_slots.size() % 4) group_slots.push_back(invalid_index);
+    groups = std::uint32_t(group_slots.size() / 4) - first;
+}
+
+}  // namespace wide_detail
+
 /// Collapses `bvh` into a WideBvh<T, W>. An inner binary node takes up to W children by opening,
-/// of its children and grandchildren, the one of largest area until W or none is left to open.
+/// of its children and grandchildren, the one of largest area until W or none is left to open;
+/// a subtree of at most `leaf_limit` primitives becomes one leaf child.
 template <class T, int W = 4>
 WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4) {
     WideBvh<T, W> out;
     if (bvh.empty()) return out;
     const auto& nodes = bvh.nodes;
-
-    // Primitives under each binary node, children before parents (a reverse preorder).
-    std::vector<std::uint32_t> preorder, under(nodes.size(), 0), stack{0};
-    preorder.reserve(nodes.size());
-    out.group_slots.reserve(bvh.primitive_indices.size() + bvh.primitive_indices.size() / 2);
-    while (!stack.empty()) {
-        const std::uint32_t n = stack.back();
-        stack.pop_back();
-        preorder.push_back(n);
-        if (!nodes[n].is_leaf()) stack.insert(stack.end(), {nodes[n].left(), nodes[n].right()});
-    }
-    for (auto it = preorder.rbegin(); it != preorder.rend(); ++it) {
-        const auto& n = nodes[*it];
-        under[*it] = n.is_leaf() ? n.count : under[n.left()] + under[n.right()];
-    }
+    const std::vector<std::uint32_t> under = wide_detail::primitives_under(bvh);
     const auto opens = [&](std::uint32_t n) {
         return !nodes[n].is_leaf() && under[n] > leaf_limit;
     };
-
-    // A leaf child: the slots of every binary leaf under n, in groups of four.
+    out.group_slots.reserve(bvh.primitive_indices.size() + bvh.primitive_indices.size() / 2);
     std::vector<std::uint32_t> todo;
-    const auto append_leaf = [&](std::uint32_t n, std::uint32_t& first, std::uint32_t& groups) {
-        first = std::uint32_t(out.group_slots.size() / 4);
-        todo.assign(1, n);
-        while (!todo.empty()) {
-            const auto& b = nodes[todo.back()];
-            todo.pop_back();
-            if (b.is_leaf()) {
-                for (std::uint32_t s = b.first; s < b.first + b.count; ++s)
-                    out.group_slots.push_back(s);
-            } else {
-                todo.insert(todo.end(), {b.right(), b.left()});
-            }
-        }
-        while (out.group_slots.size() % 4) out.group_slots.push_back(invalid_index);
-        groups = std::uint32_t(out.group_slots.size() / 4) - first;
-    };
-
     // Work items: (binary node, wide node to fill). Preorder, so a parent precedes its children.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> work{{0, 0}};
     out.nodes.reserve(nodes.size() / 3 + 1);
@@ -103,21 +132,7 @@ WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_li
         work.pop_back();
         std::uint32_t lanes[W];
         lanes[0] = b;
-        int size = 1;
-        if (opens(b)) {
-            lanes[0] = nodes[b].left(), lanes[1] = nodes[b].right(), size = 2;
-            while (size < W) {
-                int pick = -1;
-                for (int c = 0; c < size; ++c)
-                    if (opens(lanes[c]) && (pick < 0 || nodes[lanes[c]].bounds.area() >
-                                                            nodes[lanes[pick]].bounds.area()))
-                        pick = c;
-                if (pick < 0) break;
-                const std::uint32_t opened = lanes[pick];
-                lanes[pick] = nodes[opened].left();
-                lanes[size++] = nodes[opened].right();
-            }
-        }
+        const int size = opens(b) ? wide_detail::pick_lanes<W>(bvh, b, opens, lanes) : 1;
         WideNode<T, W> node{};
         for (int c = 0; c < W; ++c) {
             node.child[c] = invalid_index;
@@ -132,7 +147,8 @@ WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_li
                 out.nodes.emplace_back();
                 work.emplace_back(n, node.child[c]);
             } else {
-                append_leaf(n, node.child[c], node.groups[c]);
+                wide_detail::append_leaf_groups(bvh, n, out.group_slots, todo, node.child[c],
+                                                node.groups[c]);
             }
         }
         out.nodes[w] = node;
