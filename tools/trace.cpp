@@ -18,7 +18,7 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: bvhkit trace MESH --rays FILE --out FILE [--any-hit] [--builder NAME]
-                    [--structure bvh|bsp]
+                    [--structure bvh|bsp] [--threads N]
 
 Traces every ray of FILE (8 float32 per ray: origin xyz, direction xyz, tmin, tmax) through MESH and
 writes, per ray, float32 t (+inf on a miss) and uint32 triangle index (0xFFFFFFFF on a miss); the
@@ -27,6 +27,8 @@ With --any-hit each ray stops at the first triangle found (an occlusion query): 
 a hit within [tmin, tmax], not necessarily the closest.
 --structure bsp traces through a BSP tree (docs/bsp.md; in double, default options) instead of the
 BVH; its --any-hit answer is the closest hit, and --builder does not apply.
+--threads 0 (the default) traces on every core when bvhkit has oneTBB, 1 on one thread; the hits
+are the same for every thread count (the BSP traces on one thread).
 )";
 
 // The same through a BSP tree: rays and t in double, written as float32.
@@ -57,7 +59,8 @@ int trace_bsp(const TriangleMesh& mesh, const std::vector<Ray3f>& rays, const st
 }  // namespace
 
 int trace_command(int argc, char** argv) {
-    const Args args(argc, argv, {"--rays", "--out", "--builder", "--structure"}, {"--any-hit"});
+    const Args args(argc, argv, {"--rays", "--out", "--builder", "--structure", "--threads"},
+                    {"--any-hit"});
     if (args.help()) {
         std::fputs(kHelp, stdout);
         return 0;
@@ -70,24 +73,31 @@ int trace_command(int argc, char** argv) {
         throw Error("option --structure: '" + structure + "' is not one of bvh, bsp");
     if (structure == "bsp" && args.has("--builder"))
         throw Error("--builder applies to --structure bvh only");
+    const auto threads = unsigned(args.integer("--threads", 0, 0, 1024));
     const TriangleMesh mesh = load_mesh(args.positional()[0]);
     const std::vector<Ray3f> rays = read_rays(args.value("--rays"));
     if (structure == "bsp") return trace_bsp(mesh, rays, args.value("--out"));
     const TriangleBvh<float> bvh(mesh, parse_builder(args.value("--builder", "binned-sah")));
     const bool any = args.flag("--any-hit");
+    std::vector<Hit<float>> found(rays.size());
+    const auto start = std::chrono::steady_clock::now();
+    if (any) {
+        // The first triangle found will do, and its index is written: all_hits, stopped at once.
+        parallel_for(rays.size(), TriangleBvh<float>::batch_grain, threads,
+                     [&](std::size_t b, std::size_t e) {
+                         for (std::size_t i = b; i < e; ++i)
+                             bvh.all_hits(rays[i], [&](const Hit<float>& h) {
+                                 found[i] = h;
+                                 return false;
+                             });
+                     });
+    } else {
+        bvh.trace(rays, found, threads);
+    }
     std::vector<FileHit> hits(rays.size());
     std::size_t hit_count = 0;
-    const auto start = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < rays.size(); ++i) {
-        Hit<float> h;
-        if (any) {
-            bvh.all_hits(rays[i], [&](const Hit<float>& found) {
-                h = found;
-                return false;  // the first one will do
-            });
-        } else {
-            h = bvh.closest_hit(rays[i]);
-        }
+        const Hit<float>& h = found[i];
         hits[i] = h ? FileHit{h.t, h.primitive}
                     : FileHit{std::numeric_limits<float>::infinity(), invalid_index};
         hit_count += bool(h);

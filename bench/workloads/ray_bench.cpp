@@ -1,5 +1,7 @@
 #include "ray_bench.hpp"
 
+#include <functional>
+
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/triangle_bvh.hpp"
@@ -28,6 +30,54 @@ struct Workload {
     const std::vector<Ray3f>* rays;
     bool occlusion;
 };
+
+/// A peer's answer for one ray (hit or occluded); empty without a peer.
+using PeerRay = std::function<bool(const Ray3f&, bool occlusion)>;
+
+/// R2-mt and R3-mt: the batch API (trace, occluded) on every core against the peer's one-ray calls
+/// (Embree's rtcIntersect1 and rtcOccluded1) made from the same chunks on every core.
+template <class RowFor>
+void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
+                    const std::vector<Ray3f>& rays, RowFor&& row_for, int repetitions,
+                    const PeerRay& peer) {
+    for (const Workload& w : {Workload{"R2-mt", &rays, false}, Workload{"R3-mt", &rays, true}}) {
+        std::vector<Hit<float>> hits(rays.size());
+        std::vector<std::uint8_t> flags(rays.size()), peer_flags(rays.size());
+        std::vector<std::function<void()>> runs{[&] {
+            if (w.occlusion)
+                tree.occluded(rays, flags, 0);
+            else
+                tree.trace(rays, hits, 0);
+        }};
+        if (peer)
+            runs.push_back([&] {
+                parallel_for(rays.size(), TriangleBvh<float>::batch_grain, 0,
+                             [&](std::size_t b, std::size_t e) {
+                                 for (std::size_t i = b; i < e; ++i)
+                                     peer_flags[i] = peer(rays[i], w.occlusion);
+                             });
+            });
+        const std::vector<double> ms = median_ms_interleaved(repetitions, runs);
+        long long found = 0, peer_found = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            found += w.occlusion ? flags[i] : bool(hits[i]);
+            peer_found += peer_flags[i];
+        }
+        const double n = double(rays.size());
+        const long long threads = have_parallel() ? (long long)hardware_threads() : 1;
+        Row row = row_for(w.name, "bvhkit");
+        row.set("rays", (long long)rays.size()).set("hits", found).set("threads", threads);
+        row.set("ms", ms[0]).set("mrays_per_s", n / ms[0] / 1e3);
+        if (peer) row.set("speedup", ms[1] / ms[0]);
+        rows.push_back(row);
+        if (peer) {
+            Row p = row_for(w.name, "embree3");
+            p.set("rays", (long long)rays.size()).set("hits", peer_found).set("threads", threads);
+            p.set("ms", ms[1]).set("mrays_per_s", n / ms[1] / 1e3);
+            rows.push_back(p);
+        }
+    }
+}
 
 }  // namespace
 
@@ -124,6 +174,13 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
                 rows.push_back(p);
             }
         }
+        PeerRay peer_ray;
+#if BVHKIT_HAVE_EMBREE
+        peer_ray = [&embree](const Ray3f& r, bool occlusion) {
+            return occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
+        };
+#endif
+        add_batch_rows(rows, trees[0], r2, row_for, options.repetitions, peer_ray);
     }
     return rows;
 }

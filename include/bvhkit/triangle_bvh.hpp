@@ -8,10 +8,15 @@
 // BuildReport / skipped()); degenerate (zero-area) triangles stay in the tree and are never hit.
 // A ray with a NaN or infinite component or a zero direction misses without walking the tree.
 //
+// Batches of rays: trace() and occluded() over spans, on every core with oneTBB.
+//
 // The triangle test is TriangleBvhOptions::triangle_test: watertight by default (no ray slips
 // through a shared edge or vertex of a closed mesh), or the fast Moller-Trumbore test, which can
 // (see primitives/triangle.hpp).
+#include <span>
+
 #include "bvhkit/build/build.hpp"
+#include "bvhkit/build/parallel.hpp"
 #include "bvhkit/build/refit.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/ray.hpp"
@@ -114,6 +119,29 @@ class TriangleBvh {
             bvhkit::all_hits(bvh_, ray, FastTest{fast_.data()}, on_hit, stats);
     }
 
+    /// Batch tracing: hits[i] = closest_hit(rays[i]), on `threads` threads (0 = every core, 1 =
+    /// the calling thread; several only when bvhkit has oneTBB). Rays go in fixed chunks of
+    /// batch_grain and each answer is its ray's alone, so the answers equal the one-by-one calls
+    /// for any thread count. Throws Error when the spans differ in length.
+    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
+               unsigned threads = 0) const {
+        check_batch(rays.size(), hits.size(), "TriangleBvh::trace: hits");
+        parallel_for(rays.size(), batch_grain, threads, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) hits[i] = closest_hit(rays[i]);
+        });
+    }
+    /// Batch occlusion: occluded[i] = any_hit(rays[i]) (1 or 0), as trace() runs.
+    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
+                  unsigned threads = 0) const {
+        check_batch(rays.size(), occluded.size(), "TriangleBvh::occluded: occluded");
+        parallel_for(rays.size(), batch_grain, threads, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) occluded[i] = any_hit(rays[i]) ? 1 : 0;
+        });
+    }
+    /// Rays per task of the batch calls: large enough to pay for a task, small enough to balance
+    /// incoherent rays over the cores.
+    static constexpr std::size_t batch_grain = 256;
+
     TriangleTest triangle_test() const {
         return triangle_test_;
     }
@@ -151,6 +179,12 @@ class TriangleBvh {
 
   private:
     friend struct serial_detail::TriangleBvhAccess;
+
+    static void check_batch(std::size_t rays, std::size_t out, const char* what) {
+        if (rays != out)
+            throw Error(std::string(what) + " holds " + std::to_string(out) + " entries for " +
+                        std::to_string(rays) + " rays");
+    }
 
     template <class TriangleAt>
     void build(TriangleAt&& triangle, std::size_t count, const BuildOptions& options) {

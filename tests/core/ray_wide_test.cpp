@@ -238,3 +238,56 @@ TEST(WideRays, FourAbreastTestEqualsTheScalarTest) {
     }
     EXPECT_GT(hits, n / 4);
 }
+
+// The batch calls: trace() and occluded() on 1, 2 and every thread equal the one-by-one calls, hit
+// for hit, for every layout and both float and double; mismatched spans are an error.
+TEST(BatchRays, EqualTheOneByOneCallsOnEveryThreadCount) {
+    const auto tris = placed(make_sphere(4), 1, 1e3);
+    const auto rays = rays_for(tris, test::scaled(30000, 3), 5);
+    for (const RayLayout layout : {RayLayout::Binary, RayLayout::Wide4, RayLayout::Wide8}) {
+        TriangleBvhOptions options;
+        options.ray_layout = layout;
+        const TriangleBvh<float> bvh(tris, options);
+        SCOPED_TRACE(bvh.ray_width());
+        for (const unsigned threads : {1u, 2u, 0u}) {
+            std::vector<Hit<float>> hits(rays.size());
+            std::vector<std::uint8_t> blocked(rays.size(), 7);
+            bvh.trace(rays, hits, threads);
+            bvh.occluded(rays, blocked, threads);
+            std::size_t hit_count = 0;
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                const Hit<float> one = bvh.closest_hit(rays[i]);
+                ASSERT_EQ(bool(hits[i]), bool(one)) << i;
+                if (one) {
+                    EXPECT_EQ(hits[i].t, one.t);
+                    EXPECT_EQ(hits[i].primitive, one.primitive);
+                }
+                EXPECT_EQ(blocked[i], bvh.any_hit(rays[i]) ? 1 : 0) << i;
+                hit_count += bool(one);
+            }
+            EXPECT_GT(hit_count, rays.size() / 10);  // the rays do reach the sphere
+        }
+    }
+    std::vector<Ray<double, 3>> drays;
+    for (const auto& r : rays)
+        drays.emplace_back(Vec<double, 3>(r.origin), Vec<double, 3>(r.direction));
+    std::vector<Triangle<double>> dtris;
+    for (const auto& t : tris)
+        dtris.push_back({Vec<double, 3>(t.p0), Vec<double, 3>(t.p1), Vec<double, 3>(t.p2)});
+    const TriangleBvh<double> dbvh(dtris);
+    std::vector<Hit<double>> dhits(drays.size());
+    dbvh.trace(drays, dhits, 2);
+    for (std::size_t i = 0; i < drays.size(); i += 7) {
+        const Hit<double> one = dbvh.closest_hit(drays[i]);
+        ASSERT_EQ(bool(dhits[i]), bool(one));
+        if (one) {
+            EXPECT_EQ(dhits[i].t, one.t);
+        }
+    }
+    const TriangleBvh<float> bvh(tris);
+    std::vector<Hit<float>> short_hits(rays.size() - 1);
+    EXPECT_THROW(bvh.trace(rays, short_hits), Error);
+    std::vector<std::uint8_t> short_flags(3);
+    EXPECT_THROW(bvh.occluded(rays, short_flags), Error);
+    bvh.trace(std::span<const Ray3f>(), std::span<Hit<float>>());  // empty: nothing to do
+}

@@ -10,6 +10,7 @@
 #include "brute_force.hpp"
 #include "bvhkit/io/ray_files.hpp"
 #include "bvhkit/io/read_mesh.hpp"
+#include "bvhkit/mesh/load_mesh.hpp"
 #include "ray_sets.hpp"
 #include "test_support.hpp"
 
@@ -99,4 +100,34 @@ TEST(TraceCommandErrors, BadInputGivesAClearErrorAndNonZeroExit) {
     EXPECT_EQ(run("info --help", log), 0);
     std::filesystem::remove(log);
     std::filesystem::remove(bad_rays);
+}
+
+// --threads: one thread and several write the same file, byte for byte, for closest and any hit.
+TEST(TraceCommandThreads, SameFileForEveryThreadCount) {
+    const TriangleMesh mesh = load_mesh("sphere:subdiv=5");
+    const auto rays = random_rays(mesh.bounds(), test::scaled(40000, 4), 3);
+    const auto ray_file = temp_path("threads_rays.bin"), log = temp_path("threads_log.txt");
+    write_rays(ray_file, rays);
+    for (const std::string mode : {"", " --any-hit"}) {
+        std::string bytes[2];
+        for (int k = 0; k < 2; ++k) {
+            const auto out = temp_path("threads_hits" + std::to_string(k) + ".bin");
+            ASSERT_EQ(run("trace sphere:subdiv=5 --rays " + ray_file.string() + " --out " +
+                              out.string() + mode + (k == 0 ? " --threads 1" : " --threads 2"),
+                          log),
+                      0)
+                << read_text(log);
+            std::ifstream in(out, std::ios::binary);
+            bytes[k].assign(std::istreambuf_iterator<char>(in), {});
+            std::filesystem::remove(out);
+        }
+        EXPECT_EQ(bytes[0].size(), rays.size() * 8) << mode;
+        EXPECT_TRUE(bytes[0] == bytes[1]) << mode;
+    }
+    EXPECT_NE(run("trace sphere:subdiv=2 --rays " + ray_file.string() + " --out " +
+                      temp_path("x.bin").string() + " --threads -1",
+                  log),
+              0);
+    EXPECT_NE(read_text(log).find("--threads"), std::string::npos) << read_text(log);
+    std::filesystem::remove(ray_file);
 }
