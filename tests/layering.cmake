@@ -4,7 +4,7 @@
 #
 # Layers, lowest first (a folder may include its own layer's folders only where listed as allowed):
 #   0 error.hpp version.hpp
-#   1 math
+#   1 math exec
 #   2 primitives
 #   3 volumes
 #   4 bvh bsp
@@ -16,6 +16,7 @@
 set(rank_error.hpp 0)
 set(rank_version.hpp 0)
 set(rank_math 1)
+set(rank_exec 1)
 set(rank_primitives 2)
 set(rank_volumes 3)
 set(rank_bvh 4)

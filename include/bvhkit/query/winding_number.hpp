@@ -32,8 +32,8 @@
 #include <string>
 
 #include "bvhkit/build/build.hpp"
-#include "bvhkit/build/parallel.hpp"
 #include "bvhkit/error.hpp"
+#include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 
 namespace bvhkit {
@@ -239,12 +239,17 @@ class WindingNumberMesh {
     /// fast() for many points (in parallel with oneTBB; the same values as serial).
     void fast(std::span<const Vec<T, 3>> points, std::span<T> out, T beta = T(2),
               unsigned threads = 0, int order = 3) const {
+        fast(points, out, beta, Executor(threads), order);
+    }
+    /// fast() for many points, on `exec`.
+    void fast(std::span<const Vec<T, 3>> points, std::span<T> out, T beta, const Executor& exec,
+              int order = 3) const {
         check_beta(beta);
         check_order(order);
         if (out.size() < points.size())
             throw Error("WindingNumberMesh::fast: " + std::to_string(points.size()) +
                         " points but room for " + std::to_string(out.size()));
-        parallel_for(points.size(), 512, threads, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(points.size(), 512, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) out[i] = fast(points[i], beta, order);
         });
     }
