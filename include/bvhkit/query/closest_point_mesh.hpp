@@ -168,8 +168,8 @@ class ClosestPointMesh {
     /// particular order. A negative or NaN radius finds nothing.
     void within_radius(const Vec<T, 3>& p, T radius, std::vector<MeshPoint<T>>& out) const {
         out.clear();
-        bvhkit::within_radius(bvh_, p, radius, distance(), [&](std::uint32_t s, T) {
-            out.push_back(point_of(s, p));
+        bvhkit::within_radius(bvh_, p, radius, distance(), [&](LeafSlot s, T) {
+            out.push_back(point_of(s.value, p));
             return true;
         });
     }

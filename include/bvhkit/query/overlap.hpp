@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/traverse.hpp"
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/query/stats.hpp"
 
@@ -25,35 +26,19 @@ template <class T, std::size_t N, class NodeTest, class PrimTest, class OnHit,
           class Stats = NoStats>
 bool overlap_walk(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
                   NodeTest&& node_test, PrimTest&& prim_test, OnHit&& on_hit, Stats&& stats = {}) {
-    if (bvh.empty()) return true;
-    const auto* nodes = bvh.nodes.data();
-    stats.node();
-    if (!node_test(nodes[0].bounds)) return true;
-    std::uint32_t stack[max_bvh_depth];
-    std::uint32_t size = 0;
-    std::uint32_t current = 0;
-    while (true) {
-        const auto& node = nodes[current];
-        if (node.is_leaf()) {
-            for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-                const std::uint32_t p = bvh.primitive_indices[s];
-                stats.primitive();
-                if (prim_test(primitive_boxes[p]) && !on_hit(p)) return false;
-            }
-        } else {
-            const std::uint32_t l = node.left();
-            stats.node();
-            stats.node();
-            const bool hl = node_test(nodes[l].bounds), hr = node_test(nodes[l + 1].bounds);
-            if (hl || hr) {
-                if (hl && hr) stack[size++] = l + 1;
-                current = hl ? l : l + 1;
-                continue;
-            }
+    const auto enter = [&](std::uint32_t, const BvhNode<Aabb<T, N>>& node) {
+        stats.node();
+        return node_test(node.bounds);
+    };
+    const auto on_leaf = [&](const BvhNode<Aabb<T, N>>& leaf) {
+        for (const LeafSlot s : leaf_slots(leaf)) {
+            const std::uint32_t p = bvh.primitive_indices[s.value];
+            stats.primitive();
+            if (prim_test(primitive_boxes[p]) && !on_hit(p)) return false;
         }
-        if (size == 0) return true;
-        current = stack[--size];
-    }
+        return true;
+    };
+    return traverse_depth_first(bvh, enter, on_leaf);
 }
 
 /// Primitives whose box overlaps `box`.
