@@ -89,6 +89,65 @@ struct Header {
     std::size_t data_line = 0;    // line number of that byte (ascii messages)
 };
 
+// The header's statements, one function each; `line` is the statement's line (for messages).
+
+Format parse_format(io_detail::TextCursor& tokens, std::string_view name, std::size_t line) {
+    const std::string_view f = tokens.next();
+    Format format = Format::ascii;
+    if (f == "ascii") {
+        format = Format::ascii;
+    } else if (f == "binary_little_endian") {
+        format = Format::binary_le;
+    } else if (f == "binary_big_endian") {
+        format = Format::binary_be;
+    } else {
+        fail_at_line(name, line,
+                     "unknown format " + quote_token(f) +
+                         " (known: ascii, binary_little_endian, binary_big_endian)");
+    }
+    if (tokens.next().empty()) fail_at_line(name, line, "the format has no version");
+    return format;
+}
+
+Element parse_element(io_detail::TextCursor& tokens, const std::vector<Element>& before,
+                      std::string_view name, std::size_t line) {
+    Element e;
+    e.name = std::string(tokens.next());
+    const std::string_view count = tokens.next();
+    std::int64_t n = 0;
+    if (e.name.empty() || !io_detail::parse_int(count, n) || n < 0)
+        fail_at_line(name, line,
+                     "element " + quote_token(e.name) + " has a bad count " + quote_token(count));
+    e.count = static_cast<std::uint64_t>(n);
+    e.header_line = line;
+    for (const Element& other : before)
+        if (other.name == e.name)
+            fail_at_line(name, line, "element " + quote_token(e.name) + " appears twice");
+    return e;
+}
+
+Property parse_property(io_detail::TextCursor& tokens, std::string_view name, std::size_t line) {
+    Property p;
+    std::string_view type = tokens.next();
+    if (type == "list") {
+        p.is_list = true;
+        const std::string_view count_type = tokens.next();
+        const auto c = scalar_from_name(count_type);
+        if (!c) fail_at_line(name, line, "unknown list count type " + quote_token(count_type));
+        if (!is_integer(*c))
+            fail_at_line(name, line,
+                         "list count type " + quote_token(count_type) + " is not an integer");
+        p.count_type = *c;
+        type = tokens.next();
+    }
+    const auto t = scalar_from_name(type);
+    if (!t) fail_at_line(name, line, "unknown property type " + quote_token(type));
+    p.type = *t;
+    p.name = std::string(tokens.next());
+    if (p.name.empty()) fail_at_line(name, line, "property without a name");
+    return p;
+}
+
 Header parse_header(std::string_view bytes, std::string_view name) {
     Header h;
     bool have_format = false;
@@ -114,59 +173,14 @@ Header parse_header(std::string_view bytes, std::string_view name) {
         if (keyword.empty() || keyword == "comment" || keyword == "obj_info") continue;
         if (keyword == "end_header") break;
         if (keyword == "format") {
-            const std::string_view f = tokens.next();
-            if (f == "ascii") {
-                h.format = Format::ascii;
-            } else if (f == "binary_little_endian") {
-                h.format = Format::binary_le;
-            } else if (f == "binary_big_endian") {
-                h.format = Format::binary_be;
-            } else {
-                fail_at_line(name, line,
-                             "unknown format " + quote_token(f) +
-                                 " (known: ascii, binary_little_endian, binary_big_endian)");
-            }
-            if (tokens.next().empty()) fail_at_line(name, line, "the format has no version");
+            h.format = parse_format(tokens, name, line);
             have_format = true;
         } else if (keyword == "element") {
             if (!have_format) fail_at_line(name, line, "element before the format line");
-            Element e;
-            e.name = std::string(tokens.next());
-            const std::string_view count = tokens.next();
-            std::int64_t n = 0;
-            if (e.name.empty() || !io_detail::parse_int(count, n) || n < 0)
-                fail_at_line(
-                    name, line,
-                    "element " + quote_token(e.name) + " has a bad count " + quote_token(count));
-            e.count = static_cast<std::uint64_t>(n);
-            e.header_line = line;
-            for (const Element& other : h.elements)
-                if (other.name == e.name)
-                    fail_at_line(name, line, "element " + quote_token(e.name) + " appears twice");
-            h.elements.push_back(std::move(e));
+            h.elements.push_back(parse_element(tokens, h.elements, name, line));
         } else if (keyword == "property") {
             if (h.elements.empty()) fail_at_line(name, line, "property before any element");
-            Property p;
-            std::string_view type = tokens.next();
-            if (type == "list") {
-                p.is_list = true;
-                const std::string_view count_type = tokens.next();
-                const auto c = scalar_from_name(count_type);
-                if (!c)
-                    fail_at_line(name, line, "unknown list count type " + quote_token(count_type));
-                if (!is_integer(*c))
-                    fail_at_line(
-                        name, line,
-                        "list count type " + quote_token(count_type) + " is not an integer");
-                p.count_type = *c;
-                type = tokens.next();
-            }
-            const auto t = scalar_from_name(type);
-            if (!t) fail_at_line(name, line, "unknown property type " + quote_token(type));
-            p.type = *t;
-            p.name = std::string(tokens.next());
-            if (p.name.empty()) fail_at_line(name, line, "property without a name");
-            h.elements.back().properties.push_back(std::move(p));
+            h.elements.back().properties.push_back(parse_property(tokens, name, line));
         } else {
             fail_at_line(name, line, "unknown header statement " + quote_token(keyword));
         }
