@@ -83,14 +83,14 @@ int trace_command(int argc, char** argv) {
     const auto start = std::chrono::steady_clock::now();
     if (any) {
         // The first triangle found will do, and its index is written: all_hits, stopped at once.
-        parallel_for(rays.size(), TriangleBvh<float>::batch_grain, threads,
-                     [&](std::size_t b, std::size_t e) {
-                         for (std::size_t i = b; i < e; ++i)
-                             bvh.all_hits(rays[i], [&](const Hit<float>& h) {
-                                 found[i] = h;
-                                 return false;
-                             });
-                     });
+        Executor(threads).parallel_for(rays.size(), TriangleBvh<float>::batch_grain,
+                                       [&](std::size_t b, std::size_t e) {
+                                           for (std::size_t i = b; i < e; ++i)
+                                               bvh.all_hits(rays[i], [&](const Hit<float>& h) {
+                                                   found[i] = h;
+                                                   return false;
+                                               });
+                                       });
     } else {
         bvh.trace(rays, found, threads);
     }

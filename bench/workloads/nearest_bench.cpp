@@ -3,7 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "bvhkit/build/parallel.hpp"
+#include "bvhkit/exec/parallel.hpp"
 #include "bvhkit/math/random.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/closest_point_mesh.hpp"

@@ -40,22 +40,23 @@ template <class RowFor>
 void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
                     const std::vector<Ray3f>& rays, RowFor&& row_for, int repetitions,
                     const PeerRay& peer) {
+    const Executor every_core(0);
     for (const Workload& w : {Workload{"R2-mt", &rays, false}, Workload{"R3-mt", &rays, true}}) {
         std::vector<Hit<float>> hits(rays.size());
         std::vector<std::uint8_t> flags(rays.size()), peer_flags(rays.size());
         std::vector<std::function<void()>> runs{[&] {
             if (w.occlusion)
-                tree.occluded(rays, flags, 0);
+                tree.occluded(rays, flags, every_core);
             else
-                tree.trace(rays, hits, 0);
+                tree.trace(rays, hits, every_core);
         }};
         if (peer)
             runs.push_back([&] {
-                parallel_for(rays.size(), TriangleBvh<float>::batch_grain, 0,
-                             [&](std::size_t b, std::size_t e) {
-                                 for (std::size_t i = b; i < e; ++i)
-                                     peer_flags[i] = peer(rays[i], w.occlusion);
-                             });
+                every_core.parallel_for(rays.size(), TriangleBvh<float>::batch_grain,
+                                        [&](std::size_t b, std::size_t e) {
+                                            for (std::size_t i = b; i < e; ++i)
+                                                peer_flags[i] = peer(rays[i], w.occlusion);
+                                        });
             });
         const std::vector<double> ms = median_ms_interleaved(repetitions, runs);
         long long found = 0, peer_found = 0;

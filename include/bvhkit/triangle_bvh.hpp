@@ -16,8 +16,8 @@
 #include <span>
 
 #include "bvhkit/build/build.hpp"
-#include "bvhkit/build/parallel.hpp"
 #include "bvhkit/build/refit.hpp"
+#include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/ray.hpp"
 #include "bvhkit/query/ray_wide.hpp"
@@ -125,16 +125,24 @@ class TriangleBvh {
     /// for any thread count. Throws Error when the spans differ in length.
     void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
                unsigned threads = 0) const {
+        trace(rays, hits, Executor(threads));
+    }
+    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
+               const Executor& exec) const {
         check_batch(rays.size(), hits.size(), "TriangleBvh::trace: hits");
-        parallel_for(rays.size(), batch_grain, threads, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(rays.size(), batch_grain, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) hits[i] = closest_hit(rays[i]);
         });
     }
     /// Batch occlusion: occluded[i] = any_hit(rays[i]) (1 or 0), as trace() runs.
     void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
                   unsigned threads = 0) const {
+        this->occluded(rays, occluded, Executor(threads));
+    }
+    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
+                  const Executor& exec) const {
         check_batch(rays.size(), occluded.size(), "TriangleBvh::occluded: occluded");
-        parallel_for(rays.size(), batch_grain, threads, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(rays.size(), batch_grain, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) occluded[i] = any_hit(rays[i]) ? 1 : 0;
         });
     }

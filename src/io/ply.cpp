@@ -89,14 +89,18 @@ struct Header {
     std::size_t data_line = 0;    // line number of that byte (ascii messages)
 };
 
+// The header's statements, one function each; `line` is the statement's line (for messages).
+
 Format parse_format(io_detail::TextCursor& tokens, std::string_view name, std::size_t line) {
     const std::string_view f = tokens.next();
     Format format = Format::ascii;
-    if (f == "binary_little_endian") {
+    if (f == "ascii") {
+        format = Format::ascii;
+    } else if (f == "binary_little_endian") {
         format = Format::binary_le;
     } else if (f == "binary_big_endian") {
         format = Format::binary_be;
-    } else if (f != "ascii") {
+    } else {
         fail_at_line(name, line,
                      "unknown format " + quote_token(f) +
                          " (known: ascii, binary_little_endian, binary_big_endian)");
@@ -105,8 +109,8 @@ Format parse_format(io_detail::TextCursor& tokens, std::string_view name, std::s
     return format;
 }
 
-Element parse_element(io_detail::TextCursor& tokens, const Header& h, std::string_view name,
-                      std::size_t line) {
+Element parse_element(io_detail::TextCursor& tokens, const std::vector<Element>& before,
+                      std::string_view name, std::size_t line) {
     Element e;
     e.name = std::string(tokens.next());
     const std::string_view count = tokens.next();
@@ -116,7 +120,7 @@ Element parse_element(io_detail::TextCursor& tokens, const Header& h, std::strin
                      "element " + quote_token(e.name) + " has a bad count " + quote_token(count));
     e.count = static_cast<std::uint64_t>(n);
     e.header_line = line;
-    for (const Element& other : h.elements)
+    for (const Element& other : before)
         if (other.name == e.name)
             fail_at_line(name, line, "element " + quote_token(e.name) + " appears twice");
     return e;
@@ -173,7 +177,7 @@ Header parse_header(std::string_view bytes, std::string_view name) {
             have_format = true;
         } else if (keyword == "element") {
             if (!have_format) fail_at_line(name, line, "element before the format line");
-            h.elements.push_back(parse_element(tokens, h, name, line));
+            h.elements.push_back(parse_element(tokens, h.elements, name, line));
         } else if (keyword == "property") {
             if (h.elements.empty()) fail_at_line(name, line, "property before any element");
             h.elements.back().properties.push_back(parse_property(tokens, name, line));

@@ -107,11 +107,10 @@ class Bumps {
 
 namespace {
 
-/// The vertex numbering of a geodesic sphere of frequency f, without a lookup table: the 12
-/// corners, then f-1 points per edge (counted from the edge's lower-numbered corner), then
-/// (f-1)(f-2)/2 points inside each face. Lattice point (i, j) of a face (A, B, C) is
-/// A + i/f (B - A) + j/f (C - A).
-struct GeodesicLattice {
+// Vertex numbering of the geodesic sphere without a lookup table: the 12 corners, then f-1 points
+// per edge (counted from the edge's lower-numbered corner), then (f-1)(f-2)/2 points inside each
+// face. Lattice point (i, j) of a face (A, B, C) is A + i/f (B - A) + j/f (C - A).
+struct GeodesicNumbering {
     const Icosahedron& ico;
     std::uint64_t f;
     std::uint64_t edge_base = 12;
@@ -119,16 +118,17 @@ struct GeodesicLattice {
     std::uint64_t per_face = (f - 1) * (f - 2) / 2;
     std::uint64_t vertex_count = face_base + 20 * per_face;
 
-    std::uint64_t interior_index(std::uint64_t face, std::uint64_t i, std::uint64_t j) const {
+    std::uint64_t on_edge_id(std::uint64_t e, std::uint64_t t) const {
+        return edge_base + e * (f - 1) + (t - 1);
+    }
+    std::uint64_t interior(std::uint64_t face, std::uint64_t i, std::uint64_t j) const {
         const std::uint64_t row_start = (i - 1) * (f - 1) - (i - 1) * i / 2;
         return face_base + face * per_face + row_start + (j - 1);
     }
-    std::uint64_t edge_index(int e, std::uint64_t t) const {
-        return edge_base + static_cast<std::uint64_t>(e) * (f - 1) + (t - 1);
-    }
     std::uint64_t on_edge(int from, int to, std::uint64_t steps_from_first) const {
         const int e = ico.edge_id[from][to];
-        return edge_index(e, from < to ? steps_from_first : f - steps_from_first);
+        const std::uint64_t t = from < to ? steps_from_first : f - steps_from_first;
+        return on_edge_id(static_cast<std::uint64_t>(e), t);
     }
     std::uint32_t lattice(int face, std::uint64_t i, std::uint64_t j) const {
         const auto [a, b, c] = ico.faces[face];
@@ -146,50 +146,63 @@ struct GeodesicLattice {
         } else if (i + j == f) {
             id = on_edge(b, c, j);
         } else {
-            id = interior_index(static_cast<std::uint64_t>(face), i, j);
+            id = interior(static_cast<std::uint64_t>(face), i, j);
         }
         return static_cast<std::uint32_t>(id);
     }
-
-    /// Calls place(id, point on the icosahedron) for every vertex.
-    template <class Place>
-    void for_each_vertex(Place&& place) const {
-        for (int c = 0; c < 12; ++c) place(static_cast<std::uint64_t>(c), ico.corners[c]);
-        for (int e = 0; e < 30; ++e) {
-            const Vec3d& a = ico.corners[ico.edges[e][0]];
-            const Vec3d& b = ico.corners[ico.edges[e][1]];
-            for (std::uint64_t t = 1; t < f; ++t)
-                place(edge_index(e, t),
-                      a + (b - a) * (static_cast<double>(t) / static_cast<double>(f)));
-        }
-        for (int face = 0; face < 20; ++face) {
-            const auto [ia, ib, ic] = ico.faces[face];
-            const Vec3d &a = ico.corners[ia], &b = ico.corners[ib], &c = ico.corners[ic];
-            for (std::uint64_t i = 1; i + 1 < f; ++i)
-                for (std::uint64_t j = 1; i + j < f; ++j) {
-                    const double u = static_cast<double>(i) / static_cast<double>(f);
-                    const double w = static_cast<double>(j) / static_cast<double>(f);
-                    place(interior_index(static_cast<std::uint64_t>(face), i, j),
-                          a + (b - a) * u + (c - a) * w);
-                }
-        }
-    }
-
-    /// The f * f triangles of each face; both small triangles of a lattice cell keep the face's
-    /// winding (counter-clockwise from outside).
-    void add_triangles(std::vector<std::array<std::uint32_t, 3>>& out) const {
-        out.reserve(20 * f * f);
-        for (int face = 0; face < 20; ++face)
-            for (std::uint64_t i = 0; i < f; ++i)
-                for (std::uint64_t j = 0; i + j < f; ++j) {
-                    out.push_back(
-                        {lattice(face, i, j), lattice(face, i + 1, j), lattice(face, i, j + 1)});
-                    if (i + j + 2 <= f)
-                        out.push_back({lattice(face, i + 1, j), lattice(face, i + 1, j + 1),
-                                       lattice(face, i, j + 1)});
-                }
-    }
 };
+
+/// Every vertex, projected to the unit sphere and pushed out by the bumps. Radial displacement
+/// keeps the surface star-shaped about the centre (radius stays positive), so it stays closed, free
+/// of self-intersections and outward-facing.
+void place_geodesic_vertices(TriangleMesh& mesh, const GeodesicNumbering& n, float displacement,
+                             std::uint64_t seed) {
+    const Icosahedron& ico = n.ico;
+    const std::uint64_t f = n.f;
+    mesh.vertices.resize(n.vertex_count);
+    const Bumps bumps(seed);
+    auto place = [&](std::uint64_t id, const Vec3d& on_plane) {
+        const Vec3d unit = normalize(on_plane);
+        const double radius = displacement > 0.0f ? 1.0 + displacement * bumps(unit) : 1.0;
+        mesh.vertices[id] = to_float(unit * radius);
+    };
+    for (int c = 0; c < 12; ++c) place(static_cast<std::uint64_t>(c), ico.corners[c]);
+    for (int e = 0; e < 30; ++e) {
+        const Vec3d& a = ico.corners[ico.edges[e][0]];
+        const Vec3d& b = ico.corners[ico.edges[e][1]];
+        for (std::uint64_t t = 1; t < f; ++t)
+            place(n.on_edge_id(static_cast<std::uint64_t>(e), t),
+                  a + (b - a) * (static_cast<double>(t) / static_cast<double>(f)));
+    }
+    for (int face = 0; face < 20; ++face) {
+        const auto [ia, ib, ic] = ico.faces[face];
+        const Vec3d &a = ico.corners[ia], &b = ico.corners[ib], &c = ico.corners[ic];
+        for (std::uint64_t i = 1; i + 1 < f; ++i)
+            for (std::uint64_t j = 1; i + j < f; ++j) {
+                const double u = static_cast<double>(i) / static_cast<double>(f);
+                const double w = static_cast<double>(j) / static_cast<double>(f);
+                place(n.interior(static_cast<std::uint64_t>(face), i, j),
+                      a + (b - a) * u + (c - a) * w);
+            }
+    }
+}
+
+/// The f^2 small triangles of each face; both small triangles of a lattice cell keep the face's
+/// winding (counter-clockwise from outside).
+void add_geodesic_triangles(TriangleMesh& mesh, const GeodesicNumbering& n) {
+    const std::uint64_t f = n.f;
+    mesh.triangles.reserve(20 * f * f);
+    for (int face = 0; face < 20; ++face)
+        for (std::uint64_t i = 0; i < f; ++i)
+            for (std::uint64_t j = 0; i + j < f; ++j) {
+                mesh.triangles.push_back(
+                    {n.lattice(face, i, j), n.lattice(face, i + 1, j), n.lattice(face, i, j + 1)});
+                if (i + j + 2 <= f)
+                    mesh.triangles.push_back({n.lattice(face, i + 1, j),
+                                              n.lattice(face, i + 1, j + 1),
+                                              n.lattice(face, i, j + 1)});
+            }
+}
 
 }  // namespace
 
@@ -197,20 +210,13 @@ TriangleMesh make_geodesic_sphere(std::uint32_t frequency, float displacement, s
     if (frequency < 1) throw Error("sphere frequency must be at least 1");
     if (!(displacement >= 0.0f && displacement < 1.0f))
         throw Error("sphere displacement must be in [0, 1), got " + std::to_string(displacement));
-    check_size(20 * std::uint64_t(frequency) * frequency, "the sphere");
+    const std::uint64_t f = frequency;
+    check_size(20 * f * f, "the sphere");
     const Icosahedron ico = make_icosahedron();
-    const GeodesicLattice grid{ico, frequency};
+    const GeodesicNumbering numbering{ico, f};
     TriangleMesh mesh;
-    // Radial displacement keeps the surface star-shaped about the centre (radius stays positive),
-    // so it stays closed, free of self-intersections and outward-facing.
-    mesh.vertices.resize(grid.vertex_count);
-    const Bumps bumps(seed);
-    grid.for_each_vertex([&](std::uint64_t id, const Vec3d& on_plane) {
-        const Vec3d unit = normalize(on_plane);
-        const double radius = displacement > 0.0f ? 1.0 + displacement * bumps(unit) : 1.0;
-        mesh.vertices[id] = to_float(unit * radius);
-    });
-    grid.add_triangles(mesh.triangles);
+    place_geodesic_vertices(mesh, numbering, displacement, seed);
+    add_geodesic_triangles(mesh, numbering);
     return mesh;
 }
 

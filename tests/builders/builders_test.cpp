@@ -5,8 +5,8 @@
 
 #include "brute_force.hpp"
 #include "bvhkit/build/build.hpp"
-#include "bvhkit/build/parallel.hpp"
 #include "bvhkit/bvh/validate.hpp"
+#include "bvhkit/exec/parallel.hpp"
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/mesh/procedural.hpp"
 #include "random_geometry.hpp"

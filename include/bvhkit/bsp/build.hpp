@@ -53,12 +53,6 @@ class Builder {
         out.nodes.emplace_back();
         std::vector<std::uint32_t> all(pool_.size());
         for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
-        struct Task {
-            std::uint32_t node;
-            std::uint32_t depth;
-            BspCell cell_if_empty;
-            std::vector<std::uint32_t> list;
-        };
         std::vector<Task> stack;
         stack.push_back({0, 0, BspCell::Outside, std::move(all)});
         BspStatistics& s = out.stats;
@@ -74,33 +68,10 @@ class Builder {
             const bool halt =
                 task.list.size() <= options_.leaf_size || task.depth >= options_.max_depth;
             Candidate<T, N> best;
-            if (!task.list.empty() && !halt && choose(task.list, best)) {
-                std::vector<std::uint32_t> front, back;
-                sort_by_plane(task.list, best.plane, out.polygons, node, front, back, s.splits);
-                node.count = std::uint32_t(out.polygons.size()) - node.first;
-                node.plane = best.plane;
-                node.axis_aligned = best.axis;
-                s.polygons_at_nodes += node.count;
-                ++s.interior_nodes;
-                node.front = std::uint32_t(out.nodes.size());
-                node.back = node.front + 1;
-                out.nodes.emplace_back();
-                out.nodes.emplace_back();
-                // The cells beside an axis-aligned plane are not known to be in or out.
-                const BspCell fc = best.axis ? BspCell::Unknown : BspCell::Outside;
-                const BspCell bc = best.axis ? BspCell::Unknown : BspCell::Inside;
-                task.list.clear();
-                task.list.shrink_to_fit();
-                stack.push_back({node.back, task.depth + 1, bc, std::move(back)});
-                stack.push_back({node.front, task.depth + 1, fc, std::move(front)});
-            } else {
-                for (const std::uint32_t i : task.list) emit(out.polygons, i);
-                node.count = std::uint32_t(task.list.size());
-                node.cell = node.count == 0 ? task.cell_if_empty : BspCell::Unknown;
-                s.polygons_in_leaves += node.count;
-                ++s.leaves;
-                if (node.count == 0) ++s.empty_leaves;
-            }
+            if (!task.list.empty() && !halt && choose(task.list, best))
+                split(task, best, node, out, stack);
+            else
+                make_leaf(task, node, out);
             out.nodes[task.node] = node;
         }
         finish_statistics(out);
@@ -108,16 +79,24 @@ class Builder {
     }
 
   private:
-    /// Sorts `list` by `plane`: front and back lists (a spanning polygon split into one part each),
-    /// coplanar polygons emitted at `node`, those facing the plane's way first.
-    void sort_by_plane(const std::vector<std::uint32_t>& list, const Plane<T, N>& plane,
-                       PolygonPool<T, N>& emitted, BspNode<T, N>& node,
-                       std::vector<std::uint32_t>& front, std::vector<std::uint32_t>& back,
-                       std::size_t& splits) {
-        std::vector<std::uint32_t> facing_back;
-        for (const std::uint32_t i : list) {
+    /// A node waiting to be built, with the polygons that reach it.
+    struct Task {
+        std::uint32_t node;
+        std::uint32_t depth;
+        BspCell cell_if_empty;
+        std::vector<std::uint32_t> list;
+    };
+
+    /// Makes `node` an interior node on `best`: its coplanar polygons stay at the node (those
+    /// facing the plane's way first), the others go to the front or back child (spanning ones
+    /// split in two), and both children are pushed, front on top.
+    void split(Task& task, const Candidate<T, N>& best, BspNode<T, N>& node,
+               BspBuildResult<T, N>& out, std::vector<Task>& stack) {
+        BspStatistics& s = out.stats;
+        std::vector<std::uint32_t> front, back, facing_back;
+        for (const std::uint32_t i : task.list) {
             const auto v = pool_.vertices_of(i);
-            switch (classify_polygon(v, plane, eps_)) {
+            switch (classify_polygon(v, best.plane, eps_)) {
                 case Side::Front:
                     front.push_back(i);
                     break;
@@ -125,25 +104,53 @@ class Builder {
                     back.push_back(i);
                     break;
                 case Side::Coplanar:
-                    if (dot(pool_.plane_of(i).normal, plane.normal) >= T(0))
-                        emit(emitted, i), ++node.front_facing;
+                    if (dot(pool_.plane_of(i).normal, best.plane.normal) >= T(0))
+                        emit(out.polygons, i), ++node.front_facing;
                     else
                         facing_back.push_back(i);
                     break;
                 case Side::Spanning: {
-                    split_polygon(v, plane, eps_, f_part_, b_part_);
+                    split_polygon(v, best.plane, eps_, f_part_, b_part_);
                     const std::uint32_t src = pool_.polygons[i].source;
                     front.push_back(pool_.add(f_part_, src));
                     back.push_back(pool_.add(b_part_, src));
-                    ++splits;
+                    ++s.splits;
                     break;
                 }
             }
         }
-        for (const std::uint32_t i : facing_back) emit(emitted, i);
+        for (const std::uint32_t i : facing_back) emit(out.polygons, i);
+        node.count = std::uint32_t(out.polygons.size()) - node.first;
+        node.plane = best.plane;
+        node.axis_aligned = best.axis;
+        s.polygons_at_nodes += node.count;
+        ++s.interior_nodes;
+        node.front = std::uint32_t(out.nodes.size());
+        node.back = node.front + 1;
+        out.nodes.emplace_back();
+        out.nodes.emplace_back();
+        // The cells beside an axis-aligned plane are not known to be in or out.
+        const BspCell fc = best.axis ? BspCell::Unknown : BspCell::Outside;
+        const BspCell bc = best.axis ? BspCell::Unknown : BspCell::Inside;
+        task.list.clear();
+        task.list.shrink_to_fit();
+        stack.push_back({node.back, task.depth + 1, bc, std::move(back)});
+        stack.push_back({node.front, task.depth + 1, fc, std::move(front)});
     }
 
-    /// The statistics that are read off the finished tree.
+    /// Makes `node` a leaf holding the task's polygons; an empty one takes the cell its side of
+    /// the parent's plane says.
+    void make_leaf(const Task& task, BspNode<T, N>& node, BspBuildResult<T, N>& out) {
+        BspStatistics& s = out.stats;
+        for (const std::uint32_t i : task.list) emit(out.polygons, i);
+        node.count = std::uint32_t(task.list.size());
+        node.cell = node.count == 0 ? task.cell_if_empty : BspCell::Unknown;
+        s.polygons_in_leaves += node.count;
+        ++s.leaves;
+        if (node.count == 0) ++s.empty_leaves;
+    }
+
+    /// The totals of a finished tree, and whether it is solid (every leaf a known empty cell).
     static void finish_statistics(BspBuildResult<T, N>& out) {
         BspStatistics& s = out.stats;
         s.nodes = out.nodes.size();
@@ -240,7 +247,7 @@ class Builder {
     PolygonPool<T, N> pool_;
     BspOptions options_;
     T eps_;
-    std::vector<Vec<T, N>> f_part_, b_part_;  // split_polygon's output, reused
+    std::vector<Vec<T, N>> f_part_, b_part_;  // split_polygon's output, reused by every split
 };
 
 }  // namespace bsp_detail

@@ -6,8 +6,8 @@
 // cost that would otherwise dominate the many small nodes. A node no larger than 8 primitives goes
 // to the full sweep instead, which is exact and, that small, cheaper.
 //
-// A large node (parallel_binning_from primitives) bins in chunks on several threads when the rule's
-// options allow (threads != 1), each chunk into its own bins, merged afterwards; box unions and
+// A large node (parallel_binning_from primitives) bins in chunks on several threads when the
+// driver's executor allows, each chunk into its own bins, merged afterwards; box unions and
 // counts are exact in any order, so the split is the same as binned serially.
 #include "bvhkit/build/sweep_sah.hpp"
 
@@ -24,14 +24,13 @@ class BinnedSahRule {
         : in_(in),
           costs_(options.costs),
           max_bins_(std::clamp<std::uint32_t>(options.bin_count, 2, 256)),
-          threads_(options.threads),
           bins_(N * max_bins_),
           right_area_(max_bins_),
           small_nodes_(in, options) {}
 
-    Split<T> operator()(const SplitTask<T, N>& task) {
+    Split<T> operator()(const SplitTask<T, N>& task, const Executor& exec) {
         const auto count = static_cast<std::uint32_t>(task.indices.size());
-        if (count <= sweep_below) return small_nodes_(task);
+        if (count <= sweep_below) return small_nodes_(task, exec);
         const std::uint32_t bin_count = std::min(max_bins_, 4 + count / 20);
         const Aabb<T, N>& cb = task.centroid_bounds;
         T scale[N];
@@ -44,10 +43,10 @@ class BinnedSahRule {
         }
         const BinMapping mapping(cb.min, scale, bin_count);
         const std::size_t row = N * bin_count;
-        if (threads_ != 1 && have_parallel() && count >= parallel_binning_from) {
+        if (exec.is_parallel() && count >= parallel_binning_from) {
             const std::size_t chunks = (count + binning_chunk - 1) / binning_chunk;
             if (chunk_bins_.size() < chunks * row) chunk_bins_.resize(chunks * row);
-            parallel_for(count, binning_chunk, threads_, [&](std::size_t b, std::size_t e) {
+            exec.parallel_for(count, binning_chunk, [&](std::size_t b, std::size_t e) {
                 bin_range(task.indices.subspan(b, e - b), mapping,
                           &chunk_bins_[b / binning_chunk * row]);
             });
@@ -156,7 +155,6 @@ class BinnedSahRule {
     BuildInput<T, N> in_;
     SahCosts costs_;
     std::uint32_t max_bins_;
-    unsigned threads_;
     std::vector<Bin> bins_;        // N rows of bins, reused for every node
     std::vector<Bin> chunk_bins_;  // N rows per chunk of a node binned in parallel
     std::vector<T> right_area_;

@@ -94,12 +94,12 @@ inline std::size_t pair_up(const std::vector<std::uint32_t>& nearest,
 template <class T, std::size_t N>
 Bvh<Aabb<T, N>> build_bottom_up(std::span<const Aabb<T, N>> boxes,
                                 std::span<const Vec<T, N>> centroids,
-                                std::span<const std::uint32_t> indices,
-                                const BuildOptions& options) {
+                                std::span<const std::uint32_t> indices, const BuildOptions& options,
+                                const Executor& exec) {
     BinaryTree tree;
     const std::size_t n = indices.size();
     if (n == 0) return {};
-    const std::vector<MortonItem> items = morton_order(centroids, indices, options.threads);
+    const std::vector<MortonItem> items = morton_order(centroids, indices, exec);
     tree.reserve(2 * n - 1);
     tree.order.resize(n);
     std::vector<std::uint32_t> cluster(n);  // tree node of each live cluster, in order
@@ -113,7 +113,7 @@ Bvh<Aabb<T, N>> build_bottom_up(std::span<const Aabb<T, N>> boxes,
     std::vector<std::uint32_t> nearest(n), partner(n);
     while (cluster.size() > 1) {
         const std::size_t m = cluster.size();
-        parallel_for(m, 1024, options.threads, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(m, 1024, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i)
                 nearest[i] = bottom_up_detail::nearest(box, i, radius);
         });
@@ -136,6 +136,15 @@ Bvh<Aabb<T, N>> build_bottom_up(std::span<const Aabb<T, N>> boxes,
     }
     tree.root = cluster[0];
     return flatten(tree, boxes, {options.max_leaf_size, options.max_depth, options.costs});
+}
+
+/// As above, on an executor of options.threads.
+template <class T, std::size_t N>
+Bvh<Aabb<T, N>> build_bottom_up(std::span<const Aabb<T, N>> boxes,
+                                std::span<const Vec<T, N>> centroids,
+                                std::span<const std::uint32_t> indices,
+                                const BuildOptions& options) {
+    return build_bottom_up(boxes, centroids, indices, options, Executor(options.threads));
 }
 
 }  // namespace bvhkit

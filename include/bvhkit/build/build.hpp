@@ -24,28 +24,28 @@ namespace build_detail {
 
 template <class T, std::size_t N>
 Bvh<Aabb<T, N>> build_unoptimized(BuildInput<T, N>& in, std::vector<std::uint32_t> indices,
-                                  const BuildOptions& options) {
+                                  const BuildOptions& options, const Executor& exec) {
     switch (options.builder) {
         case Builder::BinnedSah: {
             BinnedSahRule<T, N> rule(in, options);
-            return build_top_down(in, std::move(indices), options, rule);
+            return build_top_down(in, std::move(indices), options, rule, exec);
         }
         case Builder::SweepSah: {
             SweepSahRule<T, N> rule(in, options);
-            return build_top_down(in, std::move(indices), options, rule);
+            return build_top_down(in, std::move(indices), options, rule, exec);
         }
         case Builder::TopDown: {
             TopDownRule<T, N> rule(in, options);
-            return build_top_down(in, std::move(indices), options, rule);
+            return build_top_down(in, std::move(indices), options, rule, exec);
         }
         case Builder::BottomUp:
             return build_bottom_up(in.boxes, in.centroids, std::span<const std::uint32_t>(indices),
-                                   options);
+                                   options, exec);
         case Builder::Insertion:
             return build_insertion(in.boxes, std::span<const std::uint32_t>(indices), options);
         case Builder::Lbvh:
             return build_lbvh(in.boxes, in.centroids, std::span<const std::uint32_t>(indices),
-                              options);
+                              options, exec);
     }
     throw Error("build_bvh: unknown builder");
 }
@@ -100,8 +100,12 @@ Bvh<Aabb<T, N>> build_bvh(std::span<const Aabb<T, N>> boxes, std::span<const Vec
     BuildInput<T, N> in{e ? std::span<const Aabb<T, N>>(scaled_boxes) : boxes,
                         e ? std::span<const Vec<T, N>>(scaled_centroids) : centroids};
     std::vector<Vec<T, N>> fixed_centroids;
-    std::vector<std::uint32_t> indices = usable_primitives(in, fixed_centroids, options, report);
-    Bvh<Aabb<T, N>> bvh = build_detail::build_unoptimized(in, std::move(indices), options);
+    // The user's knob is options.threads; everything below runs on this one executor (one task
+    // arena for the whole build).
+    const Executor exec(options.threads);
+    std::vector<std::uint32_t> indices =
+        usable_primitives(in, fixed_centroids, options, exec, report);
+    Bvh<Aabb<T, N>> bvh = build_detail::build_unoptimized(in, std::move(indices), options, exec);
     if (options.optimize) {
         ReinsertionOptions r;
         r.flatten = {options.max_leaf_size, options.max_depth, options.costs};

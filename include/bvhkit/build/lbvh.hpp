@@ -33,12 +33,12 @@ inline int delta(const std::vector<MortonItem>& items, std::int64_t i, std::int6
 /// The unflattened LBVH of `indices`: internal nodes 0 .. n-2 (root 0), leaf k at n - 1 + k.
 template <class T, std::size_t N>
 BinaryTree build_lbvh_tree(std::span<const Vec<T, N>> centroids,
-                           std::span<const std::uint32_t> indices, unsigned threads) {
+                           std::span<const std::uint32_t> indices, const Executor& exec) {
     using lbvh_detail::delta;
     BinaryTree tree;
     const std::size_t n = indices.size();
     if (n == 0) return tree;
-    const std::vector<MortonItem> items = morton_order(centroids, indices, threads);
+    const std::vector<MortonItem> items = morton_order(centroids, indices, exec);
     tree.left.assign(2 * n - 1, no_child);
     tree.right.assign(2 * n - 1, no_child);
     tree.first.assign(2 * n - 1, 0);
@@ -50,7 +50,7 @@ BinaryTree build_lbvh_tree(std::span<const Vec<T, N>> centroids,
         tree.count[n - 1 + k] = 1;
     }
     tree.root = 0;
-    parallel_for(n - 1, 2048, threads, [&](std::size_t b, std::size_t e) {
+    exec.parallel_for(n - 1, 2048, [&](std::size_t b, std::size_t e) {
         for (std::size_t node = b; node < e; ++node) {
             const auto i = std::int64_t(node);
             const int d = delta(items, i, i + 1) > delta(items, i, i - 1) ? 1 : -1;
@@ -80,9 +80,17 @@ BinaryTree build_lbvh_tree(std::span<const Vec<T, N>> centroids,
 
 template <class T, std::size_t N>
 Bvh<Aabb<T, N>> build_lbvh(std::span<const Aabb<T, N>> boxes, std::span<const Vec<T, N>> centroids,
-                           std::span<const std::uint32_t> indices, const BuildOptions& options) {
-    const BinaryTree tree = build_lbvh_tree(centroids, indices, options.threads);
+                           std::span<const std::uint32_t> indices, const BuildOptions& options,
+                           const Executor& exec) {
+    const BinaryTree tree = build_lbvh_tree(centroids, indices, exec);
     return flatten(tree, boxes, {options.max_leaf_size, options.max_depth, options.costs});
+}
+
+/// As above, on an executor of options.threads.
+template <class T, std::size_t N>
+Bvh<Aabb<T, N>> build_lbvh(std::span<const Aabb<T, N>> boxes, std::span<const Vec<T, N>> centroids,
+                           std::span<const std::uint32_t> indices, const BuildOptions& options) {
+    return build_lbvh(boxes, centroids, indices, options, Executor(options.threads));
 }
 
 }  // namespace bvhkit

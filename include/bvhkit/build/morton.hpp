@@ -8,16 +8,12 @@
 // index, so the order is a total order and the same with any number of threads.
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
-#include "bvhkit/build/parallel.hpp"
+#include "bvhkit/exec/executor.hpp"
 #include "bvhkit/math/aabb.hpp"
-
-#if defined(BVHKIT_HAVE_TBB)
-#include <tbb/parallel_sort.h>
-#include <tbb/task_arena.h>
-#endif
 
 namespace bvhkit {
 
@@ -74,22 +70,16 @@ struct MortonItem {
 /// The primitives `indices` sorted by the Morton codes of their centroids.
 template <class T, std::size_t N>
 std::vector<MortonItem> morton_order(std::span<const Vec<T, N>> centroids,
-                                     std::span<const std::uint32_t> indices, unsigned threads) {
+                                     std::span<const std::uint32_t> indices, const Executor& exec) {
     Aabb<T, N> bounds;
     for (std::uint32_t i : indices) bounds.grow(centroids[i]);
     std::vector<MortonItem> items(indices.size());
-    parallel_for(indices.size(), 4096, threads, [&](std::size_t b, std::size_t e) {
+    exec.parallel_for(indices.size(), 4096, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k)
             items[k] = {morton_code(centroids[indices[k]], bounds), indices[k]};
     });
-#if defined(BVHKIT_HAVE_TBB)
-    if (threads != 1 && items.size() > 16384) {
-        // The order is total (no equal items), so a parallel sort gives the serial result.
-        with_threads(threads, [&] { tbb::parallel_sort(items.begin(), items.end()); });
-        return items;
-    }
-#endif
-    std::sort(items.begin(), items.end());
+    // The order is total (no equal items), so a parallel sort gives the serial result.
+    exec.sort_total(items.begin(), items.end(), std::less<>());
     return items;
 }
 

@@ -4,8 +4,8 @@
 // binned builder can make, so its greedy choice is never worse at a node; the price is a sort per
 // node and axis (O(n log^2 n) for the whole build).
 //
-// A large node (parallel_axes_from primitives) sweeps its axes at the same time when the rule's
-// options allow (threads != 1), each axis in its own buffers; the best split is then taken in the
+// A large node (parallel_axes_from primitives) sweeps its axes at the same time when the driver's
+// executor allows, each axis in its own buffers; the best split is then taken in the
 // serial order (lowest cost, first axis, first position on it), so it is the serial one.
 #include "bvhkit/build/sah.hpp"
 #include "bvhkit/build/top_down_core.hpp"
@@ -18,17 +18,17 @@ class SweepSahRule {
     static constexpr std::size_t parallel_axes_from = 1u << 15;
 
     SweepSahRule(const BuildInput<T, N>& in, const BuildOptions& options)
-        : in_(in), costs_(options.costs), threads_(options.threads) {}
+        : in_(in), costs_(options.costs) {}
 
-    Split<T> operator()(const SplitTask<T, N>& task) {
+    Split<T> operator()(const SplitTask<T, N>& task, const Executor& exec) {
         const auto count = static_cast<std::uint32_t>(task.indices.size());
         AxisBest best[N];
-        if (threads_ != 1 && have_parallel() && count >= parallel_axes_from) {
+        if (exec.is_parallel() && count >= parallel_axes_from) {
             if (order_.size() < N * count) {
                 order_.resize(N * count);
                 right_area_.resize(N * count);
             }
-            parallel_for(N, 1, threads_, [&](std::size_t b, std::size_t e) {
+            exec.parallel_for(N, 1, [&](std::size_t b, std::size_t e) {
                 for (std::size_t a = b; a < e; ++a)
                     best[a] = sweep(task, a, &order_[a * count], &right_area_[a * count]);
             });
@@ -88,7 +88,6 @@ class SweepSahRule {
 
     BuildInput<T, N> in_;
     SahCosts costs_;
-    unsigned threads_;
     std::vector<std::pair<T, std::uint32_t>> order_;  // (centroid, index), reused for every node
     std::vector<T> right_area_;
 };

@@ -8,23 +8,24 @@
 // Halting: a node becomes a leaf when it holds one primitive, when it reaches max_depth, or when
 // the rule asks for a leaf and it holds no more than max_leaf_size primitives.
 //
-// Threads (BuildOptions::threads != 1, with oneTBB): the usual two phases of a parallel binned
-// build. The nodes above a size cutoff are split one task each, both children of a node at the
-// same time, and the largest of them bin and partition in parallel chunks too (all threads on the
-// few large top nodes); every node below the cutoff becomes a subtree built by the serial driver
-// into its own node array (one subtree per task), and a last pass lays those out exactly where
-// the serial driver puts them. Every decision depends on a node's primitives and size only, never
-// on the thread count, so the tree is the same bit for bit.
+// Threads (an Executor of more than one thread, with oneTBB): the usual two phases of a parallel
+// binned build. The nodes above a size cutoff are split one task each, both children of a node at
+// the same time, and the largest of them bin and partition in parallel chunks too (all threads on
+// the few large top nodes); every node below the cutoff becomes a subtree built by the serial
+// driver into its own node array (one subtree per task), and a last pass lays those out exactly
+// where the serial driver puts them. Every decision depends on a node's primitives and size only,
+// never on the thread count, so the tree is the same bit for bit.
 #include <algorithm>
 #include <memory>
 #include <numeric>
 #include <span>
 #include <string>
+#include <type_traits>
 
 #include "bvhkit/build/box_accumulator.hpp"
 #include "bvhkit/build/options.hpp"
-#include "bvhkit/build/parallel.hpp"
 #include "bvhkit/error.hpp"
+#include "bvhkit/exec/executor.hpp"
 
 namespace bvhkit {
 
@@ -95,8 +96,8 @@ namespace top_down_detail {
 /// depends on the thread count.
 inline constexpr std::size_t chunk = 8192;
 /// Ranges at least this long are partitioned stably through a scratch buffer (in parallel chunks
-/// when threads allow), shorter ones in place. The choice depends on the size alone, so the order
-/// of primitive_indices is the same with any number of threads.
+/// when the executor allows), shorter ones in place. The choice depends on the size alone, so the
+/// order of primitive_indices is the same with any number of threads.
 inline constexpr std::size_t stable_partition_from = 4 * chunk;
 }  // namespace top_down_detail
 
@@ -105,7 +106,8 @@ inline constexpr std::size_t stable_partition_from = 4 * chunk;
 /// outside its box) is replaced by the box's centre, so the centroid never decides.
 template <class T, std::size_t N>
 std::vector<std::uint32_t> usable_primitives(BuildInput<T, N>& in, std::vector<Vec<T, N>>& fixed,
-                                             const BuildOptions& options, BuildReport* report) {
+                                             const BuildOptions& options, const Executor& exec,
+                                             BuildReport* report) {
     using top_down_detail::chunk;
     if (in.boxes.size() != in.centroids.size())
         throw Error("build: " + std::to_string(in.boxes.size()) + " boxes but " +
@@ -114,12 +116,12 @@ std::vector<std::uint32_t> usable_primitives(BuildInput<T, N>& in, std::vector<V
         throw Error("build: " + std::to_string(in.boxes.size()) + " primitives; at most 2^32 - 2");
     std::vector<std::uint32_t> indices;
     const std::size_t n = in.boxes.size();
-    if (options.threads != 1 && have_parallel() && n >= 4 * chunk) {
+    if (exec.is_parallel() && n >= 4 * chunk) {
         // The usual case, every primitive usable as it is, checked in parallel: then the indices
         // are 0..n-1. Anything else takes the serial loop below, which says what to skip or fix.
         indices.resize(n);
         std::vector<char> clean((n + chunk - 1) / chunk);
-        parallel_for(n, chunk, options.threads, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(n, chunk, [&](std::size_t b, std::size_t e) {
             bool ok = true;
             for (std::size_t i = b; i < e; ++i) {
                 const Aabb<T, N>& box = in.boxes[i];
@@ -171,15 +173,15 @@ struct RangeBounds {
 /// in any order, so the result does not depend on the chunks).
 template <class T, std::size_t N>
 RangeBounds<T, N> range_bounds(const BuildInput<T, N>& in, std::span<const std::uint32_t> range,
-                               unsigned threads) {
+                               const Executor& exec) {
     using top_down_detail::chunk;
     RangeBounds<T, N> all;
-    if (threads == 1 || !have_parallel() || range.size() < 4 * chunk) {
+    if (!exec.is_parallel() || range.size() < 4 * chunk) {
         for (std::uint32_t i : range) all.add(in, i);
         return all;
     }
     std::vector<RangeBounds<T, N>> part((range.size() + chunk - 1) / chunk);
-    parallel_for(range.size(), chunk, threads, [&](std::size_t b, std::size_t e) {
+    exec.parallel_for(range.size(), chunk, [&](std::size_t b, std::size_t e) {
         RangeBounds<T, N>& p = part[b / chunk];
         for (std::size_t k = b; k < e; ++k) p.add(in, range[k]);
     });
@@ -196,12 +198,12 @@ namespace top_down_detail {
 template <class T, std::size_t N, class GoesLeft>
 std::uint32_t stable_partition(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
                                std::span<std::uint32_t> scratch, const GoesLeft& goes_left,
-                               unsigned threads, RangeBounds<T, N>& left,
+                               const Executor& exec, RangeBounds<T, N>& left,
                                RangeBounds<T, N>& right) {
     const std::size_t n = range.size();
     std::uint32_t* const out = range.data();
     std::uint32_t* const tmp = scratch.data();
-    if (threads == 1 || !have_parallel()) {
+    if (!exec.is_parallel()) {
         // Left ones move down in place (the write never passes the read), right ones to scratch.
         std::size_t l = 0, r = 0;
         for (std::size_t k = 0; k < n; ++k) {
@@ -224,7 +226,7 @@ std::uint32_t stable_partition(const BuildInput<T, N>& in, std::span<std::uint32
     std::vector<Part> parts((n + chunk - 1) / chunk);  // one allocation per large node only
     // A chunk's left primitives go to its part of scratch from the front, the right ones from
     // the back (so reversed).
-    parallel_for(n, chunk, threads, [&](std::size_t b, std::size_t e) {
+    exec.parallel_for(n, chunk, [&](std::size_t b, std::size_t e) {
         Part& p = parts[b / chunk];
         std::size_t l = b, r = e;
         for (std::size_t k = b; k < e; ++k) {
@@ -246,7 +248,7 @@ std::uint32_t stable_partition(const BuildInput<T, N>& in, std::span<std::uint32
         parts[c].right_at = right_total;
         right_total += std::min(n, (c + 1) * chunk) - c * chunk - parts[c].left_count;
     }
-    parallel_for(n, chunk, threads, [&](std::size_t b, std::size_t e) {
+    exec.parallel_for(n, chunk, [&](std::size_t b, std::size_t e) {
         const Part& p = parts[b / chunk];
         std::copy_n(tmp + b, p.left_count, out + p.left_at);
         std::reverse_copy(tmp + b + p.left_count, tmp + e, out + p.right_at);
@@ -283,11 +285,11 @@ std::uint32_t partition_in_place(const BuildInput<T, N>& in, std::span<std::uint
 /// Partitions `range` by `goes_left`: stably through scratch when it is long, else in place.
 template <class T, std::size_t N, class GoesLeft>
 std::uint32_t partition_by(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
-                           std::span<std::uint32_t> scratch, unsigned threads,
+                           std::span<std::uint32_t> scratch, const Executor& exec,
                            const GoesLeft& goes_left, RangeBounds<T, N>& left,
                            RangeBounds<T, N>& right) {
     if (range.size() >= stable_partition_from && scratch.size() >= range.size())
-        return stable_partition(in, range, scratch, goes_left, threads, left, right);
+        return stable_partition(in, range, scratch, goes_left, exec, left, right);
     return partition_in_place(in, range, goes_left, left, right);
 }
 
@@ -296,12 +298,12 @@ std::uint32_t partition_by(const BuildInput<T, N>& in, std::span<std::uint32_t> 
 /// Reorders `range` so the primitives going left come first, gathering both sides' bounds on the
 /// way (each primitive is classified and grown exactly once); returns how many go left. A range of
 /// at least stable_partition_from primitives is partitioned stably through `scratch` (as long as
-/// the range; the drivers always pass it), on `threads`; a shorter one in place.
+/// the range; the drivers always pass it), on `exec`; a shorter one in place.
 template <class T, std::size_t N>
 std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
                                    const Split<T>& s, RangeBounds<T, N>& left,
                                    RangeBounds<T, N>& right, std::span<std::uint32_t> scratch = {},
-                                   unsigned threads = 1) {
+                                   const Executor& exec = Executor::serial()) {
     using Kind = typename Split<T>::Kind;
     const auto& c = in.centroids;
     const std::uint32_t a = s.axis;
@@ -316,8 +318,8 @@ std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::ui
                                  return c[i][a] < c[j][a] || (c[i][a] == c[j][a] && i < j);
                              });
             if (range.size() >= top_down_detail::stable_partition_from) {
-                left = range_bounds(in, std::span<const std::uint32_t>(range.first(k)), threads);
-                right = range_bounds(in, std::span<const std::uint32_t>(range.subspan(k)), threads);
+                left = range_bounds(in, std::span<const std::uint32_t>(range.first(k)), exec);
+                right = range_bounds(in, std::span<const std::uint32_t>(range.subspan(k)), exec);
             } else {
                 for (std::uint32_t i = 0; i < range.size(); ++i)
                     (i < k ? left : right).add(in, range[i]);
@@ -326,11 +328,11 @@ std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::ui
         }
         case Kind::AtPosition:  // one loop per kind, the kind not tested per primitive
             return top_down_detail::partition_by(
-                in, range, scratch, threads, [&](std::uint32_t i) { return c[i][a] < s.position; },
+                in, range, scratch, exec, [&](std::uint32_t i) { return c[i][a] < s.position; },
                 left, right);
         case Kind::AtBin:
             return top_down_detail::partition_by(
-                in, range, scratch, threads,
+                in, range, scratch, exec,
                 [&](std::uint32_t i) {
                     return bin_of(c[i][a], s.bin_origin, s.bin_scale, s.bin_count) <= s.bin;
                 },
@@ -365,11 +367,21 @@ struct Context {
     std::uint32_t max_depth, max_leaf;
 };
 
+/// Asks `rule` to split `task`: with the executor where the rule takes one (to bin or sweep a large
+/// node in parallel), else without.
+template <class T, std::size_t N, class SplitRule>
+Split<T> ask_rule(SplitRule& rule, const SplitTask<T, N>& task, const Executor& exec) {
+    if constexpr (std::is_invocable_v<SplitRule&, const SplitTask<T, N>&, const Executor&>)
+        return rule(task, exec);
+    else
+        return rule(task);
+}
+
 /// One step of every driver: 0 when the node of `w` is a leaf, else partitions its range and
 /// returns how many of it go left, with both sides' bounds.
 template <class T, std::size_t N, class SplitRule>
 std::uint32_t split_node(const Context<T, N>& cx, const Work<T, N>& w, SplitRule& rule,
-                         unsigned threads, RangeBounds<T, N>& left, RangeBounds<T, N>& right) {
+                         const Executor& exec, RangeBounds<T, N>& left, RangeBounds<T, N>& right) {
     const std::uint32_t count = w.end - w.begin;
     if (count == 1 || w.depth >= cx.max_depth) return 0;
     const Aabb<T, N> centroid_bounds = w.bounds.centroids.box();
@@ -382,11 +394,13 @@ std::uint32_t split_node(const Context<T, N>& cx, const Work<T, N>& w, SplitRule
     const bool must_halve =
         count > cx.max_leaf && levels_to_halve(count, cx.max_leaf) + 1 >= cx.max_depth - w.depth;
     const Split<T> split =
-        must_halve ? Split<T>::leaf()
-                   : rule(SplitTask<T, N>{range, w.bounds.boxes.box(), centroid_bounds, w.depth});
+        must_halve
+            ? Split<T>::leaf()
+            : ask_rule(rule, SplitTask<T, N>{range, w.bounds.boxes.box(), centroid_bounds, w.depth},
+                       exec);
     if (split.kind == Split<T>::Kind::Leaf && count <= cx.max_leaf) return 0;
     std::uint32_t left_count =
-        must_halve ? 0 : partition_primitives(cx.in, range, split, left, right, scratch, threads);
+        must_halve ? 0 : partition_primitives(cx.in, range, split, left, right, scratch, exec);
     if (left_count == 0 || left_count == count) {
         // The rule gave no split (or could not split). Fall back to the object median on the
         // centroids' longest axis; if all centroids coincide the order is arbitrary, so halve.
@@ -395,7 +409,7 @@ std::uint32_t split_node(const Context<T, N>& cx, const Work<T, N>& w, SplitRule
             cx.in, range,
             Split<T>::at_count(static_cast<std::uint32_t>(centroid_bounds.largest_axis()),
                                count / 2),
-            left, right, scratch, threads);
+            left, right, scratch, exec);
     }
     return left_count;
 }
@@ -404,13 +418,14 @@ std::uint32_t split_node(const Context<T, N>& cx, const Work<T, N>& w, SplitRule
 /// appending each sibling pair when its parent is split, depth first, left before right.
 template <class T, std::size_t N, class SplitRule, class Nodes>
 void build_serial(const Context<T, N>& cx, const Work<T, N>& root, SplitRule& rule, Nodes& nodes) {
+    const Executor serial = Executor::serial();
     std::vector<Work<T, N>> stack{root};
     while (!stack.empty()) {
         const Work<T, N> w = stack.back();
         stack.pop_back();
         nodes[w.node].bounds = w.bounds.boxes.box();
         RangeBounds<T, N> left, right;
-        const std::uint32_t left_count = split_node(cx, w, rule, 1, left, right);
+        const std::uint32_t left_count = split_node(cx, w, rule, serial, left, right);
         if (left_count == 0) {
             nodes[w.node].first = w.begin;
             nodes[w.node].count = w.end - w.begin;
@@ -444,32 +459,28 @@ struct TopNode {
 
 template <class T, std::size_t N, class SplitRule>
 void build_top_node(const Context<T, N>& cx, const Work<T, N>& w, const BuildOptions& options,
-                    TopNode<T, N>& t) {
+                    const Executor& exec, TopNode<T, N>& t) {
     t.bounds = w.bounds.boxes.box();
     const std::uint32_t count = w.end - w.begin;
     if (count > parallel_subtree_cutoff) {
         // A rule per node: rules keep scratch, and the two children run at the same time. It
-        // bins in parallel (threads = 0: this build's arena) when the node is large.
-        BuildOptions inner = options;
-        inner.threads = 0;
-        SplitRule rule(cx.in, inner);
+        // bins in parallel (in this build's arena) when the node is large.
+        SplitRule rule(cx.in, options);
         RangeBounds<T, N> lb, rb;
-        if (const std::uint32_t k = split_node(cx, w, rule, 0, lb, rb)) {
+        if (const std::uint32_t k = split_node(cx, w, rule, exec, lb, rb)) {
             const Work<T, N> left{0, w.begin, w.begin + k, w.depth + 1, lb};
             const Work<T, N> right{0, w.begin + k, w.end, w.depth + 1, rb};
             t.children = std::make_unique<TopNode<T, N>[]>(2);
-            parallel_invoke(
-                0, [&] { build_top_node<T, N, SplitRule>(cx, left, options, t.children[0]); },
-                [&] { build_top_node<T, N, SplitRule>(cx, right, options, t.children[1]); });
+            exec.parallel_invoke(
+                [&] { build_top_node<T, N, SplitRule>(cx, left, options, exec, t.children[0]); },
+                [&] { build_top_node<T, N, SplitRule>(cx, right, options, exec, t.children[1]); });
             return;
         }
         t.subtree.resize(1);
         t.subtree[0] = {t.bounds, w.begin, count};
         return;
     }
-    BuildOptions serial = options;
-    serial.threads = 1;
-    SplitRule rule(cx.in, serial);
+    SplitRule rule(cx.in, options);
     t.subtree.reserve(2 * count - 1);
     t.subtree.emplace_back();
     Work<T, N> root = w;
@@ -494,18 +505,18 @@ void place_top_node(TopNode<T, N>& t, std::uint32_t self, std::uint32_t& next,
     }
 }
 
-/// The parallel driver (run inside with_threads): the top tree in parallel, then one parallel copy
-/// of every subtree to its place, local child indices shifted.
+/// The parallel driver (run inside the executor's arena): the top tree in parallel, then one
+/// parallel copy of every subtree to its place, local child indices shifted.
 template <class T, std::size_t N, class SplitRule, class Nodes>
 void build_parallel(const Context<T, N>& cx, const Work<T, N>& root, const BuildOptions& options,
-                    Nodes& nodes) {
+                    const Executor& exec, Nodes& nodes) {
     TopNode<T, N> top;
-    build_top_node<T, N, SplitRule>(cx, root, options, top);
+    build_top_node<T, N, SplitRule>(cx, root, options, exec, top);
     std::vector<TopNode<T, N>*> all;
     std::uint32_t next = 1;
     place_top_node(top, 0, next, all);
     nodes.resize(next);
-    parallel_for(all.size(), 1, 0, [&](std::size_t b, std::size_t e) {
+    exec.parallel_for(all.size(), 1, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             TopNode<T, N>& t = *all[k];
             if (t.children) {
@@ -528,11 +539,11 @@ void build_parallel(const Context<T, N>& cx, const Work<T, N>& root, const Build
 }  // namespace top_down_detail
 
 /// Builds over `indices` (from usable_primitives) with `rule` deciding each split. In parallel
-/// when options.threads != 1 and oneTBB is there, for rules made from (BuildInput, BuildOptions):
-/// each task makes its own.
+/// when `exec` is and oneTBB is there, for rules made from (BuildInput, BuildOptions): each task
+/// makes its own.
 template <class T, std::size_t N, class SplitRule>
 Bvh<Aabb<T, N>> build_top_down(const BuildInput<T, N>& in, std::vector<std::uint32_t> indices,
-                               const BuildOptions& options, SplitRule& rule) {
+                               const BuildOptions& options, SplitRule& rule, const Executor& exec) {
     using namespace top_down_detail;
     Bvh<Aabb<T, N>> bvh;
     bvh.primitive_indices = std::move(indices);
@@ -549,17 +560,18 @@ Bvh<Aabb<T, N>> build_top_down(const BuildInput<T, N>& in, std::vector<std::uint
     constexpr bool remakeable =
         std::is_constructible_v<SplitRule, const BuildInput<T, N>&, const BuildOptions&>;
     if constexpr (remakeable) {
-        if (options.threads != 1 && have_parallel() && n > parallel_subtree_cutoff) {
-            with_threads(options.threads, [&] {
-                const Work<T, N> root{0, 0, n, 0, range_bounds<T, N>(in, idx, 0)};
-                build_parallel<T, N, SplitRule>(cx, root, options, bvh.nodes);
+        if (exec.is_parallel() && n > parallel_subtree_cutoff) {
+            exec.run([&] {
+                const Work<T, N> root{0, 0, n, 0, range_bounds<T, N>(in, idx, exec)};
+                build_parallel<T, N, SplitRule>(cx, root, options, exec, bvh.nodes);
             });
             return bvh;
         }
     }
     bvh.nodes.reserve(2 * idx.size() - 1);
     bvh.nodes.emplace_back();
-    build_serial(cx, Work<T, N>{0, 0, n, 0, range_bounds<T, N>(in, idx, 1)}, rule, bvh.nodes);
+    build_serial(cx, Work<T, N>{0, 0, n, 0, range_bounds<T, N>(in, idx, Executor::serial())}, rule,
+                 bvh.nodes);
     return bvh;
 }
 

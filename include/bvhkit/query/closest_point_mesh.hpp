@@ -24,7 +24,7 @@
 #include <span>
 
 #include "bvhkit/build/build.hpp"
-#include "bvhkit/build/parallel.hpp"
+#include "bvhkit/exec/executor.hpp"
 #include "bvhkit/math/select.hpp"
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
@@ -168,19 +168,24 @@ class ClosestPointMesh {
     /// particular order. A negative or NaN radius finds nothing.
     void within_radius(const Vec<T, 3>& p, T radius, std::vector<MeshPoint<T>>& out) const {
         out.clear();
-        bvhkit::within_radius(bvh_, p, radius, distance(), [&](std::uint32_t s, T) {
-            out.push_back(point_of(s, p));
+        bvhkit::within_radius(bvh_, p, radius, distance(), [&](LeafSlot s, T) {
+            out.push_back(point_of(s.value, p));
             return true;
         });
     }
 
-    /// closest_point for every point, on `threads` threads (0 = all; see build/parallel.hpp).
+    /// closest_point for every point, on `threads` threads (0 = all; see exec/executor.hpp).
     void closest_points(std::span<const Vec<T, 3>> points, std::span<MeshPoint<T>> out,
                         unsigned threads = 0) const {
+        closest_points(points, out, Executor(threads));
+    }
+    /// closest_point for every point, on `exec`.
+    void closest_points(std::span<const Vec<T, 3>> points, std::span<MeshPoint<T>> out,
+                        const Executor& exec) const {
         if (out.size() < points.size())
             throw Error("ClosestPointMesh::closest_points: " + std::to_string(points.size()) +
                         " points but room for " + std::to_string(out.size()));
-        parallel_for(points.size(), 1024, threads, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(points.size(), 1024, [&](std::size_t b, std::size_t e) {
             NearestScratch<T> scratch;
             for (std::size_t i = b; i < e; ++i) out[i] = closest_point(points[i], scratch);
         });

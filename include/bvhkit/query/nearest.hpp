@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "bvhkit/bvh/sibling_pair.hpp"
+#include "bvhkit/bvh/traverse.hpp"
 #include "bvhkit/primitives/hit.hpp"
 #include "bvhkit/query/min_heap.hpp"
 #include "bvhkit/query/stats.hpp"
@@ -182,43 +183,30 @@ void k_nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, std::size_t k, Di
     std::sort(out.begin(), out.end());
 }
 
-/// Every primitive within `radius` of `p` (inclusive): on_found(slot, squared distance) returns
-/// true to go on, false to stop. Depth first with a fixed stack (the order does not matter here).
-/// A negative or NaN radius holds nothing (no ball has it): no primitive is reported.
+/// Every primitive within `radius` of `p` (inclusive): on_found(LeafSlot, squared distance)
+/// returns true to go on, false to stop. Depth first (bvh/traverse.hpp; the order does not matter
+/// here). A negative or NaN radius holds nothing (no ball has it): no primitive is reported.
+/// (`distance` still takes the slot as a number: it is the functor nearest() and k_nearest()
+/// share.)
 template <class T, std::size_t N, class Distance, class OnFound, class Stats = NoStats>
 bool within_radius(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, T radius, Distance&& distance,
                    OnFound&& on_found, Stats&& stats = {}) {
-    if (bvh.empty() || !(radius >= T(0))) return true;
+    if (!(radius >= T(0))) return true;
     const T r2 = radius * radius;
     const T prune2 = nearest_detail::prune_radius2(distance, p, r2);
-    const auto* nodes = bvh.nodes.data();
-    stats.node();
-    if (nodes[0].bounds.distance_squared(p) > prune2) return true;
-    std::uint32_t stack[max_bvh_depth];
-    std::uint32_t size = 0, current = 0;
-    while (true) {
-        const auto& node = nodes[current];
-        if (node.is_leaf()) {
-            for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-                stats.primitive();
-                const T d2 = distance(s, p, r2);
-                if (d2 <= r2 && !on_found(s, d2)) return false;
-            }
-        } else {
-            const std::uint32_t l = node.left();
-            stats.node();
-            stats.node();
-            const bool hl = nodes[l].bounds.distance_squared(p) <= prune2;
-            const bool hr = nodes[l + 1].bounds.distance_squared(p) <= prune2;
-            if (hl || hr) {
-                if (hl && hr) stack[size++] = l + 1;
-                current = hl ? l : l + 1;
-                continue;
-            }
+    const auto enter = [&](std::uint32_t, const BvhNode<Aabb<T, N>>& node) {
+        stats.node();
+        return node.bounds.distance_squared(p) <= prune2;
+    };
+    const auto on_leaf = [&](const BvhNode<Aabb<T, N>>& leaf) {
+        for (const LeafSlot s : leaf_slots(leaf)) {
+            stats.primitive();
+            const T d2 = distance(s.value, p, r2);
+            if (d2 <= r2 && !on_found(s, d2)) return false;
         }
-        if (size == 0) return true;
-        current = stack[--size];
-    }
+        return true;
+    };
+    return traverse_depth_first(bvh, enter, on_leaf);
 }
 
 }  // namespace bvhkit

@@ -7,14 +7,15 @@
 // node on the path pushes one child), no allocation. on_hit(std::uint32_t primitive) returns true
 // to go on, false to stop the query early (the function then returns false).
 //
-// Batch versions answer many queries (in parallel with oneTBB, see build/parallel.hpp) into one
+// Batch versions answer many queries (in parallel with oneTBB, see exec/executor.hpp) into one
 // compressed list: the hits of query q are hits[offsets[q] .. offsets[q + 1]), in traversal order,
 // the same for any number of threads.
 #include <span>
 #include <vector>
 
-#include "bvhkit/build/parallel.hpp"
 #include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/traverse.hpp"
+#include "bvhkit/exec/executor.hpp"
 #include "bvhkit/query/stats.hpp"
 
 namespace bvhkit {
@@ -25,35 +26,19 @@ template <class T, std::size_t N, class NodeTest, class PrimTest, class OnHit,
           class Stats = NoStats>
 bool overlap_walk(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
                   NodeTest&& node_test, PrimTest&& prim_test, OnHit&& on_hit, Stats&& stats = {}) {
-    if (bvh.empty()) return true;
-    const auto* nodes = bvh.nodes.data();
-    stats.node();
-    if (!node_test(nodes[0].bounds)) return true;
-    std::uint32_t stack[max_bvh_depth];
-    std::uint32_t size = 0;
-    std::uint32_t current = 0;
-    while (true) {
-        const auto& node = nodes[current];
-        if (node.is_leaf()) {
-            for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-                const std::uint32_t p = bvh.primitive_indices[s];
-                stats.primitive();
-                if (prim_test(primitive_boxes[p]) && !on_hit(p)) return false;
-            }
-        } else {
-            const std::uint32_t l = node.left();
-            stats.node();
-            stats.node();
-            const bool hl = node_test(nodes[l].bounds), hr = node_test(nodes[l + 1].bounds);
-            if (hl || hr) {
-                if (hl && hr) stack[size++] = l + 1;
-                current = hl ? l : l + 1;
-                continue;
-            }
+    const auto enter = [&](std::uint32_t, const BvhNode<Aabb<T, N>>& node) {
+        stats.node();
+        return node_test(node.bounds);
+    };
+    const auto on_leaf = [&](const BvhNode<Aabb<T, N>>& leaf) {
+        for (const LeafSlot s : leaf_slots(leaf)) {
+            const std::uint32_t p = bvh.primitive_indices[s.value];
+            stats.primitive();
+            if (prim_test(primitive_boxes[p]) && !on_hit(p)) return false;
         }
-        if (size == 0) return true;
-        current = stack[--size];
-    }
+        return true;
+    };
+    return traverse_depth_first(bvh, enter, on_leaf);
 }
 
 /// Primitives whose box overlaps `box`.
@@ -95,12 +80,12 @@ namespace overlap_detail {
 /// Runs query(q, push) for every q; chunks of queries collect into their own lists, joined in
 /// order, so the result does not depend on the threads.
 template <class Query>
-BatchHits run_batch(std::size_t count, unsigned threads, Query&& query) {
+BatchHits run_batch(std::size_t count, const Executor& exec, Query&& query) {
     constexpr std::size_t grain = 256;
     const std::size_t chunks = (count + grain - 1) / grain;
     std::vector<std::vector<std::uint32_t>> chunk_hits(chunks);
     std::vector<std::size_t> counts(count);
-    parallel_for(count, grain, threads, [&](std::size_t b, std::size_t e) {
+    exec.parallel_for(count, grain, [&](std::size_t b, std::size_t e) {
         auto& out = chunk_hits[b / grain];
         for (std::size_t q = b; q < e; ++q) {
             const std::size_t before = out.size();
@@ -124,8 +109,8 @@ BatchHits run_batch(std::size_t count, unsigned threads, Query&& query) {
 
 template <class T, std::size_t N>
 BatchHits query_boxes(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
-                      std::span<const Aabb<T, N>> queries, unsigned threads = 0) {
-    return overlap_detail::run_batch(queries.size(), threads, [&](std::size_t q, auto&& push) {
+                      std::span<const Aabb<T, N>> queries, const Executor& exec) {
+    return overlap_detail::run_batch(queries.size(), exec, [&](std::size_t q, auto&& push) {
         query_box(bvh, primitive_boxes, queries[q], push);
     });
 }
@@ -133,18 +118,38 @@ BatchHits query_boxes(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> pr
 template <class T, std::size_t N>
 BatchHits query_spheres(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
                         std::span<const Vec<T, N>> centers, std::span<const T> radii,
-                        unsigned threads = 0) {
-    return overlap_detail::run_batch(centers.size(), threads, [&](std::size_t q, auto&& push) {
+                        const Executor& exec) {
+    return overlap_detail::run_batch(centers.size(), exec, [&](std::size_t q, auto&& push) {
         query_sphere(bvh, primitive_boxes, centers[q], radii[q], push);
     });
 }
 
 template <class T, std::size_t N>
 BatchHits query_points(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
-                       std::span<const Vec<T, N>> points, unsigned threads = 0) {
-    return overlap_detail::run_batch(points.size(), threads, [&](std::size_t q, auto&& push) {
+                       std::span<const Vec<T, N>> points, const Executor& exec) {
+    return overlap_detail::run_batch(points.size(), exec, [&](std::size_t q, auto&& push) {
         query_point(bvh, primitive_boxes, points[q], push);
     });
+}
+
+// The same on `threads` threads (0 = all, 1 = serial).
+template <class T, std::size_t N>
+BatchHits query_boxes(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
+                      std::span<const Aabb<T, N>> queries, unsigned threads = 0) {
+    return query_boxes(bvh, primitive_boxes, queries, Executor(threads));
+}
+
+template <class T, std::size_t N>
+BatchHits query_spheres(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
+                        std::span<const Vec<T, N>> centers, std::span<const T> radii,
+                        unsigned threads = 0) {
+    return query_spheres(bvh, primitive_boxes, centers, radii, Executor(threads));
+}
+
+template <class T, std::size_t N>
+BatchHits query_points(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
+                       std::span<const Vec<T, N>> points, unsigned threads = 0) {
+    return query_points(bvh, primitive_boxes, points, Executor(threads));
 }
 
 }  // namespace bvhkit

@@ -18,6 +18,7 @@
 #include <span>
 
 #include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/traversal_stack.hpp"
 #include "bvhkit/math/ray.hpp"
 #include "bvhkit/primitives/hit.hpp"
 #include "bvhkit/primitives/primitive.hpp"
@@ -41,7 +42,7 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
     // One stack for all eight octant instances, outside them: each with its own 512-byte array,
     // GCC's stack-frame growth limit stopped it from inlining them into the dispatch in a large
     // file (the bench's), and the out-of-line walk measured 5-6% slower on R1.
-    Entry stack[max_bvh_depth];
+    FixedStack<Entry, max_bvh_depth> stack;
     slab.with_octant([&](auto octant) {
         constexpr unsigned O = decltype(octant)::value;
         const RayPairTest<T, N> pair_test(slab, octant);
@@ -53,7 +54,6 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
             stats.node();
             if (!slab.template clip<O>(nodes[0].bounds, t0, t1)) return;
         }
-        std::uint32_t size = 0;
         std::uint32_t current = 0;
         auto interval = pair_test.interval(ray.tmin, ray.tmax);  // made again after each leaf
         while (true) {
@@ -72,8 +72,7 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
                     // the far child is always written to the stack, and kept only when both hit.
                     const bool both = hits == 3u;
                     const bool right_first = hits == 2u || (both && entry[1] < entry[0]);
-                    stack[size] = Entry{left + !right_first, entry[right_first ? 0 : 1]};
-                    size += both;
+                    stack.push_if(Entry{left + !right_first, entry[right_first ? 0 : 1]}, both);
                     current = left + right_first;
                     // Ask now for the lines read next: the near child's children, and when both
                     // children are hit, the far child's children, read when it is popped (its
@@ -86,11 +85,12 @@ void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
                 }
             }
             // Pop the next subtree that can still hold something within [tmin, tmax].
+            Entry next;
             do {
-                if (size == 0) return;
-                --size;
-            } while (stack[size].t_entry > ray.tmax);
-            current = stack[size].node;
+                if (stack.empty()) return;
+                next = stack.pop();
+            } while (next.t_entry > ray.tmax);
+            current = next.node;
         }
     });
 }

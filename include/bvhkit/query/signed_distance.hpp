@@ -128,15 +128,20 @@ class SignedDistanceMesh {
     }
     bool inside(const Vec<T, 3>& p) const { return signed_distance(p).distance < T(0); }
 
-    /// signed_distance for every point, on `threads` threads (0 = all; see build/parallel.hpp):
+    /// signed_distance for every point, on `threads` threads (0 = all; see exec/executor.hpp):
     /// the same answers as one at a time, for any thread count. Safe to call from many threads
     /// on one const mesh.
     void signed_distances(std::span<const Vec<T, 3>> points, std::span<SignedDistance<T>> out,
                           unsigned threads = 0) const {
+        signed_distances(points, out, Executor(threads));
+    }
+    /// signed_distance for every point, on `exec`.
+    void signed_distances(std::span<const Vec<T, 3>> points, std::span<SignedDistance<T>> out,
+                          const Executor& exec) const {
         if (out.size() < points.size())
             throw Error("SignedDistanceMesh::signed_distances: " + std::to_string(points.size()) +
                         " points but room for " + std::to_string(out.size()));
-        parallel_for(points.size(), 1024, threads, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(points.size(), 1024, [&](std::size_t b, std::size_t e) {
             NearestScratch<T> scratch;
             for (std::size_t i = b; i < e; ++i) out[i] = signed_distance(points[i], scratch);
         });

@@ -32,8 +32,9 @@
 #include <string>
 
 #include "bvhkit/build/build.hpp"
-#include "bvhkit/build/parallel.hpp"
+#include "bvhkit/bvh/traverse.hpp"
 #include "bvhkit/error.hpp"
+#include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 
 namespace bvhkit {
@@ -198,11 +199,14 @@ class WindingNumberMesh {
         check_order(order);
         if (bvh_.empty()) return T(0);
         double sum = 0;
-        std::uint32_t stack[max_bvh_depth + 1];
-        std::uint32_t size = 0;
-        stack[size++] = 0;
-        while (size) {
-            const std::uint32_t k = stack[--size];
+        // Its own walk, not traverse_depth_first (bvh/traverse.hpp): that one, entering the right
+        // child first so the sum keeps its order, took 1.6% more instructions (63.8M against
+        // 62.8M for 4000 points about a 36,864-triangle torus, callgrind). Both children are
+        // pushed, so the stack holds one more than the depth.
+        FixedStack<std::uint32_t, max_bvh_depth + 1> stack;
+        stack.push(0);
+        while (!stack.empty()) {
+            const std::uint32_t k = stack.pop();
             const auto& node = bvh_.nodes[k];
             const Dipole& d = dipoles_[k];
             const Vec<T, 3> r = d.centre - q;
@@ -226,12 +230,14 @@ class WindingNumberMesh {
                 continue;
             }
             if (node.is_leaf()) {
-                for (std::uint32_t s = node.first; s < node.first + node.count; ++s)
-                    sum += double(solid_angle(tris_[s].p0, tris_[s].p1, tris_[s].p2, q));
+                for (const LeafSlot s : leaf_slots(node)) {  // tris_ is in leaf order
+                    const Triangle<T>& t = tris_[s.value];
+                    sum += double(solid_angle(t.p0, t.p1, t.p2, q));
+                }
                 continue;
             }
-            stack[size++] = node.left();
-            stack[size++] = node.right();
+            stack.push(node.left());
+            stack.push(node.right());
         }
         return T(sum / (4 * std::numbers::pi));
     }
@@ -239,12 +245,17 @@ class WindingNumberMesh {
     /// fast() for many points (in parallel with oneTBB; the same values as serial).
     void fast(std::span<const Vec<T, 3>> points, std::span<T> out, T beta = T(2),
               unsigned threads = 0, int order = 3) const {
+        fast(points, out, beta, Executor(threads), order);
+    }
+    /// fast() for many points, on `exec`.
+    void fast(std::span<const Vec<T, 3>> points, std::span<T> out, T beta, const Executor& exec,
+              int order = 3) const {
         check_beta(beta);
         check_order(order);
         if (out.size() < points.size())
             throw Error("WindingNumberMesh::fast: " + std::to_string(points.size()) +
                         " points but room for " + std::to_string(out.size()));
-        parallel_for(points.size(), 512, threads, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(points.size(), 512, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) out[i] = fast(points[i], beta, order);
         });
     }

@@ -1,0 +1,98 @@
+#pragma once
+// traverse_depth_first: the one non-recursive depth-first walk over a Bvh (in the spirit of
+// madmann91/bvh v2's traverse_top_down): `enter(index, node)` says whether the walk goes into a
+// node (the root included); a leaf it goes into is handed to `on_leaf(node)`, which returns false
+// to stop the whole walk. At an inner node the walk pushes one child and goes straight on into the
+// other (FirstChild says which), so the stack holds at most one entry per level and the nodes are
+// entered in the order of a recursive pre-order walk.
+//
+// Used by the overlap queries (query/overlap.hpp) and within_radius (query/nearest.hpp), where it
+// took fewer instructions than their own loops did (callgrind: 132.7M against 147.6M for 160,000
+// box and sphere queries on a 36,864-triangle torus; 434.6M against 438.6M for 20,000
+// within_radius). Not used by the winding number (query/winding_number.hpp says why), the ray
+// walk (nearer child first by entry distance, branch-free pushes) or the tree-vs-tree walks
+// (pairs of nodes, query/pairs.hpp), which keep their own loops on a TraversalStack or their
+// own pair stacks.
+//
+// Leaves hand out leaf slots (positions in primitive_indices): LeafSlot keeps them apart from
+// primitive indices, so a callback cannot take one for the other by mistake.
+#include <cstdint>
+#include <span>
+
+#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/traversal_stack.hpp"
+
+namespace bvhkit {
+
+/// A position in Bvh::primitive_indices (and in anything stored in leaf order), as opposed to a
+/// primitive index (a position in the caller's primitives). Explicit both ways: only .value turns
+/// one back into a number.
+struct LeafSlot {
+    std::uint32_t value = 0;
+    constexpr LeafSlot() = default;
+    constexpr explicit LeafSlot(std::uint32_t v) : value(v) {}
+    friend constexpr bool operator==(LeafSlot, LeafSlot) = default;
+    friend constexpr auto operator<=>(LeafSlot, LeafSlot) = default;
+};
+
+/// The slots of a leaf, [first, first + count), for range-for.
+struct LeafSlots {
+    struct Iterator {
+        std::uint32_t at;
+        constexpr LeafSlot operator*() const { return LeafSlot(at); }
+        constexpr Iterator& operator++() {
+            ++at;
+            return *this;
+        }
+        friend constexpr bool operator==(Iterator, Iterator) = default;
+    };
+    std::uint32_t first = 0, count = 0;
+    constexpr Iterator begin() const { return {first}; }
+    constexpr Iterator end() const { return {first + count}; }
+};
+
+template <class Volume>
+constexpr LeafSlots leaf_slots(const BvhNode<Volume>& leaf) {
+    return {leaf.first, leaf.count};
+}
+
+enum class FirstChild { Left, Right };
+
+/// Walks `nodes` (a Bvh's, root at 0) depth first; see the top of this file. Returns false when
+/// on_leaf stopped the walk. No allocation: the stack is the caller's (usually a local).
+template <FirstChild first = FirstChild::Left, class Node, class Enter, class OnLeaf>
+bool traverse_depth_first(std::span<const Node> nodes, TraversalStack& stack, Enter&& enter,
+                          OnLeaf&& on_leaf) {
+    if (nodes.empty()) return true;
+    stack.clear();
+    std::uint32_t current = 0;
+    while (true) {
+        const Node& node = nodes[current];
+        if (enter(current, node)) {
+            if (!node.is_leaf()) {
+                const std::uint32_t l = node.left();
+                if constexpr (first == FirstChild::Left) {
+                    stack.push(l + 1);
+                    current = l;
+                } else {
+                    stack.push(l);
+                    current = l + 1;
+                }
+                continue;
+            }
+            if (!on_leaf(node)) return false;
+        }
+        if (stack.empty()) return true;
+        current = stack.pop();
+    }
+}
+
+/// The same over a whole Bvh.
+template <FirstChild first = FirstChild::Left, class Volume, class Enter, class OnLeaf>
+bool traverse_depth_first(const Bvh<Volume>& bvh, Enter&& enter, OnLeaf&& on_leaf) {
+    TraversalStack stack;
+    return traverse_depth_first<first>(std::span<const BvhNode<Volume>>(bvh.nodes), stack, enter,
+                                       on_leaf);
+}
+
+}  // namespace bvhkit
