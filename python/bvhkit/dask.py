@@ -126,7 +126,9 @@ def _map(
 def _dtype(scene: Any) -> np.dtype:
     if isinstance(scene, (TriangleMesh, SharedScene)):
         return scene.dtype
-    raise TypeError(f"scene: must be a bvhkit.TriangleMesh or SharedScene, not {type(scene).__name__}")
+    raise TypeError(
+        f"scene: must be a bvhkit.TriangleMesh or SharedScene, not {type(scene).__name__}"
+    )
 
 
 def closest_point(

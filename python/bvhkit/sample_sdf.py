@@ -157,7 +157,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         if ext.lower() not in MESH_SUFFIXES:
             continue
         if name in seen:
-            print(f"FAILED {file}: writes {name}.npz as {seen[name]} does; skipped", file=sys.stderr)
+            print(f"FAILED {file}: writes {name}.npz as {seen[name]} does; skipped",
+                  file=sys.stderr)
             failed += 1
             continue
         seen[name] = file

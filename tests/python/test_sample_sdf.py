@@ -105,3 +105,13 @@ def test_bad_arguments(mesh_dir, tmp_path, capsys):
     r = subprocess.run([sys.executable, "-m", "bvhkit", "frobnicate"], capture_output=True,
                        text=True)
     assert r.returncode == 2 and "unknown command" in r.stderr
+
+
+def test_two_files_with_one_name_are_reported(tmp_path, capsys):
+    meshes = tmp_path / "meshes"
+    meshes.mkdir()
+    write_obj(meshes / "x.obj", *bvhkit.load_mesh("sphere:subdiv=1"))
+    (meshes / "x.ply").write_text("not read")
+    assert sample_sdf.main([str(meshes), "--out", str(tmp_path / "out"), "--points", "10"]) == 1
+    assert "FAILED x.ply: writes x.npz as x.obj does" in capsys.readouterr().err
+    assert os.listdir(tmp_path / "out") == ["x.npz"]

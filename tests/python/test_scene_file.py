@@ -172,3 +172,21 @@ def test_load_names_the_file(tmp_path):
     path.write_bytes(small_scene_bytes()[:-3])
     with pytest.raises(ValueError, match="bad.bvhscene"):
         bvhkit.TriangleMesh.load(path)
+
+
+def test_to_bytes_while_other_threads_query_and_build():
+    from concurrent.futures import ThreadPoolExecutor
+
+    v, f = bvhkit.load_mesh("sphere:subdiv=4")
+    scene = bvhkit.TriangleMesh(v, f)
+    p = np.random.default_rng(1).uniform(-1.5, 1.5, (20_000, 3))
+    want = bvhkit.TriangleMesh(v, f).signed_distance(p, sign="winding_number")
+    with ThreadPoolExecutor(4) as pool:
+        # The first queries build the proximity trees while to_bytes snapshots the scene.
+        queries = [pool.submit(scene.signed_distance, p, "winding_number", 1) for _ in range(4)]
+        saved = [pool.submit(scene.to_bytes) for _ in range(4)]
+        for q in queries:
+            np.testing.assert_array_equal(q.result(), want)
+    for s in saved:
+        copy = bvhkit.TriangleMesh.from_bytes(s.result())
+        np.testing.assert_array_equal(copy.signed_distance(p, sign="winding_number"), want)
