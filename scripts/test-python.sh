@@ -30,6 +30,8 @@ fi
 # The build tools live in the venv and the build is not isolated, so that build/python stays
 # valid between runs (an isolated build gets a fresh nanobind path each time and rebuilds all).
 "$venv/bin/python" -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.0" numpy pytest
+# Optional for the package; the tests of bvhkit.dask and sample-sdf need it.
+"$venv/bin/python" -m pip install -q "dask[distributed]"
 "$venv/bin/python" -m pip install -q --no-build-isolation \
   --config-settings=build-dir=build/python .
 cd tests/python  # import the installed package, not python/bvhkit

@@ -21,6 +21,7 @@ import numpy as np
 
 from . import _arrays as _a
 from . import _bvhkit
+from . import _scene_file
 
 __version__: str = _bvhkit.version
 
@@ -119,6 +120,7 @@ class TriangleMesh:
         except ValueError as e:
             raise ValueError(f"builder or ray_test: {e}") from None
         self._vertex_count = len(v)
+        self._builder = builder.replace("_", "-")
 
     # ------------------------------------------------------------------ rays
 
@@ -279,6 +281,66 @@ class TriangleMesh:
     def __repr__(self) -> str:
         """Face count and dtype."""
         return f"TriangleMesh(faces={self.face_count}, dtype={self.dtype})"
+
+    # ------------------------------------------------------------------ saving and loading
+
+    def to_bytes(self) -> bytes:
+        """The scene as bytes (format: docs/scale-out.md): the mesh (as refitted, if it was) and
+        the trees built so far, the proximity ones only if a query has built them. Reading it back
+        with :meth:`from_bytes` rebuilds nothing and answers bit for bit as this scene does."""
+        return _scene_file.encode(self.dtype, self._builder, self._impl.state())
+
+    @classmethod
+    def from_bytes(cls, data: Any, threads: int = 0) -> "TriangleMesh":
+        """A scene from :meth:`to_bytes`'s bytes. Everything is checked (a checksum over the whole,
+        the sizes, and each tree as the library's loaders check it); damaged or foreign data
+        raises ValueError. ``threads`` is for the trees built later, if any."""
+        return cls._from_bytes(data, "data", _a.threads(threads))
+
+    def save(self, path: Any) -> None:
+        """Writes :meth:`to_bytes` to the file ``path``."""
+        import os
+
+        with open(os.fspath(path), "wb") as f:
+            f.write(self.to_bytes())
+
+    @classmethod
+    def load(cls, path: Any, threads: int = 0) -> "TriangleMesh":
+        """A scene from a file written by :meth:`save` (ValueError naming the file if damaged)."""
+        import os
+
+        p = os.fspath(path)
+        with open(p, "rb") as f:
+            data = f.read()
+        return cls._from_bytes(data, p, _a.threads(threads))
+
+    @classmethod
+    def _from_bytes(cls, data: Any, what: str, threads: int) -> "TriangleMesh":
+        self = cls.__new__(cls)
+        self._load(data, what, threads)
+        return self
+
+    def _load(self, data: Any, what: str, threads: int) -> None:
+        d = _scene_file.decode(data, what)
+        impl = _bvhkit.Scene32 if d.dtype == np.float32 else _bvhkit.Scene64
+        try:
+            self._impl = impl(d.vertices, d.faces, d.builder, threads, d.tree, d.sdf, d.winding)
+        except ValueError as e:
+            raise ValueError(f"{what}: {e}") from None
+        self.dtype = d.dtype
+        self._vertex_count = len(d.vertices)
+        self._builder = d.builder
+        _scene_file.load_count += 1
+
+    def __getstate__(self) -> dict:
+        """Pickles through :meth:`to_bytes`: the trees travel built."""
+        return {"bvhkit.TriangleMesh": self.to_bytes()}
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickles through :meth:`from_bytes`."""
+        if not isinstance(state, dict) or "bvhkit.TriangleMesh" not in state:
+            raise ValueError("state: not a pickled bvhkit.TriangleMesh")
+        self._load(state["bvhkit.TriangleMesh"], "pickled TriangleMesh", 0)
 
 
 from ._collision import (  # noqa: E402

@@ -7,10 +7,17 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
+#include <span>
+
+#include <nanobind/stl/optional.h>
 
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/bvh/statistics.hpp"
+#include "bvhkit/io/signed_distance_mesh_file.hpp"
+#include "bvhkit/io/triangle_bvh_file.hpp"
+#include "bvhkit/io/winding_number_mesh_file.hpp"
 #include "bvhkit/query/signed_distance.hpp"
 #include "bvhkit/query/winding_number.hpp"
 #include "bvhkit/triangle_bvh.hpp"
@@ -37,6 +44,43 @@ class Scene {
         TriangleBvhOptions ray_options(options_);
         ray_options.triangle_test = ray_test == "fast" ? TriangleTest::Fast : TriangleTest::Watertight;
         rays_ = TriangleBvh<T>(mesh_, ray_options);
+    }
+
+    /// A scene from the parts state() gave (bvhkit/_scene_file.py holds them in one container):
+    /// the trees are loaded from their files, checked as every load is, never rebuilt, and must
+    /// cover exactly the mesh's faces. Any failure is a bvhkit::Error (ValueError).
+    Scene(const Rows<T, 3>& vertices, const Faces& faces, const std::string& builder,
+          unsigned threads, const nb::bytes& tree, const std::optional<nb::bytes>& sdf,
+          const std::optional<nb::bytes>& winding)
+        : mesh_(make_mesh<T>(vertices, faces)), options_(parse_builder(builder)) {
+        options_.threads = threads;
+        const auto span = [](const nb::bytes& b) {
+            return std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(b.c_str()),
+                                                 b.size());
+        };
+        const std::size_t nt = mesh_.triangles.size();
+        const auto check = [&](std::size_t count, const char* what) {
+            if (count != nt)
+                throw Error(std::string(what) + ": covers " + std::to_string(count) +
+                            " faces, the mesh has " + std::to_string(nt));
+        };
+        // The bytes objects stay referenced by the caller and are immutable: safe without the GIL.
+        const auto tree_bytes = span(tree);
+        const std::optional<std::span<const std::uint8_t>> sdf_bytes =
+            sdf ? std::optional(span(*sdf)) : std::nullopt;
+        const std::optional<std::span<const std::uint8_t>> winding_bytes =
+            winding ? std::optional(span(*winding)) : std::nullopt;
+        nb::gil_scoped_release release;
+        rays_ = triangle_bvh_from_bytes<T>(tree_bytes);
+        check(rays_.triangle_count(), "ray tree");
+        if (sdf_bytes) {
+            sdf_ = std::make_unique<SignedDistanceMesh<T>>(
+                signed_distance_mesh_from_bytes<T>(*sdf_bytes));
+            check(sdf_->closest_point_mesh().triangle_count(), "signed distance tree");
+        }
+        if (winding_bytes)
+            winding_ = std::make_unique<WindingNumberMesh<T>>(
+                winding_number_mesh_from_bytes<T>(*winding_bytes));
     }
 
     using Ray3 = Ray<T, 3>;
@@ -195,6 +239,37 @@ class Scene {
     }
     std::size_t triangle_count() const { return mesh_.triangles.size(); }
 
+    /// What the loading constructor takes: (vertices, faces int64, ray_test, ray tree file bytes,
+    /// signed distance file bytes or None, winding number file bytes or None), the proximity
+    /// files only where those structures have been built. One consistent snapshot.
+    nb::tuple state() const {
+        std::vector<T> v;
+        std::vector<std::int64_t> f;
+        std::vector<std::uint8_t> tree, sdf, winding;
+        bool has_sdf = false, has_winding = false, fast = false;
+        {
+            nb::gil_scoped_release release;
+            const std::shared_lock<std::shared_mutex> lock(mutex_);
+            const std::lock_guard<std::mutex> build_lock(build_mutex_);  // sdf_, winding_ stable
+            v.reserve(3 * mesh_.vertices.size());
+            for (const auto& p : mesh_.vertices) v.insert(v.end(), {p[0], p[1], p[2]});
+            f.reserve(3 * mesh_.triangles.size());
+            for (const auto& t : mesh_.triangles) f.insert(f.end(), {t[0], t[1], t[2]});
+            fast = rays_.triangle_test() == TriangleTest::Fast;
+            tree = to_bytes(rays_);
+            if ((has_sdf = bool(sdf_))) sdf = to_bytes(*sdf_);
+            if ((has_winding = bool(winding_))) winding = to_bytes(*winding_);
+        }
+        const auto bytes = [](const std::vector<std::uint8_t>& b) {
+            return nb::bytes(reinterpret_cast<const char*>(b.data()), b.size());
+        };
+        const std::size_t nv = mesh_.vertices.size(), nf = mesh_.triangles.size();
+        return nb::make_tuple(owned_array(std::move(v), nv, 3), owned_array(std::move(f), nf, 3),
+                              fast ? "fast" : "watertight", bytes(tree),
+                              has_sdf ? nb::object(bytes(sdf)) : nb::none(),
+                              has_winding ? nb::object(bytes(winding)) : nb::none());
+    }
+
   private:
     /// Builds what a query needs, once (the caller holds the shared lock; builders take this one).
     void prepare(bool need_sdf, bool need_winding) const {
@@ -221,6 +296,13 @@ void bind_scene_type(nb::module_& m, const char* name) {
                       unsigned>(),
              nb::arg("vertices"), nb::arg("faces"), nb::arg("builder"), nb::arg("ray_test"),
              nb::arg("threads"), "Builds the ray tree over the mesh.")
+        .def(nb::init<const Rows<T, 3>&, const Faces&, const std::string&, unsigned,
+                      const nb::bytes&, const std::optional<nb::bytes>&,
+                      const std::optional<nb::bytes>&>(),
+             nb::arg("vertices"), nb::arg("faces"), nb::arg("builder"), nb::arg("threads"),
+             nb::arg("tree"), nb::arg("sdf").none(), nb::arg("winding").none(),
+             "Loads the scene from the parts state() gave (nothing is rebuilt).")
+        .def("state", &S::state, "The mesh and the built trees' files, for saving.")
         .def("intersect", &S::intersect, nb::arg("origins"), nb::arg("directions"),
              nb::arg("tmin"), nb::arg("tmax"), nb::arg("t"), nb::arg("face"),
              nb::arg("barycentric"), nb::arg("threads"),

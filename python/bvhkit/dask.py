@@ -1,0 +1,249 @@
+"""bvhkit's point and ray queries over dask arrays, partition by partition.
+
+Each function takes a :class:`bvhkit.TriangleMesh` (or the :class:`SharedScene` that :func:`share`
+returns) and a dask array of points (n, 3), or of ray origins and directions (n, 3) each, and
+returns dask arrays chunked as the input's rows; ``.compute()`` gives exactly the arrays the
+single-process call gives (every point and ray is answered on its own).
+
+The scene reaches each worker once, not once per partition: with a distributed Client active it
+is scattered to every worker (``client.scatter(scene, broadcast=True)``); without one it is a
+single key of the graph, which the local threaded scheduler uses in place. It travels in
+TriangleMesh's file format, trees included, so no worker rebuilds them (docs/scale-out.md).
+To reuse one shipment for several calls, pass ``share(scene)`` instead of the scene.
+
+``threads`` is per partition and defaults to 1: dask already runs partitions in parallel.
+
+dask is optional for bvhkit; this module needs it (``pip install "dask[distributed]"``).
+"""
+
+from __future__ import annotations
+
+import uuid
+from typing import Any, Callable, Optional, Sequence
+
+import numpy as np
+
+try:
+    import dask
+    import dask.array as da
+except ImportError as e:  # pragma: no cover - exercised where dask is absent
+    raise ImportError(
+        'bvhkit.dask needs dask: pip install "dask[array]" (or "dask[distributed]" for a cluster)'
+    ) from e
+
+from . import ClosestPoints, RayHits, TriangleMesh
+from . import _arrays as _a
+
+__all__ = [
+    "SharedScene",
+    "share",
+    "closest_point",
+    "signed_distance",
+    "winding_number",
+    "contains",
+    "intersect",
+    "occluded",
+    "count_intersections",
+]
+
+_SIGNS = ("pseudonormal", "winding_number")
+
+
+class SharedScene:
+    """A scene shipped to the workers once (see :func:`share`); pass it to the functions of this
+    module in place of the scene. ``ref`` is a distributed Future or a dask Delayed."""
+
+    def __init__(self, ref: Any, dtype: np.dtype) -> None:
+        self.ref = ref
+        self.dtype = dtype
+
+    def __repr__(self) -> str:
+        """The reference."""
+        return f"SharedScene({self.ref!r})"
+
+
+def _active_client() -> Any:
+    try:
+        from distributed import default_client
+    except ImportError:
+        return None
+    try:
+        return default_client()
+    except ValueError:  # no client in this process
+        return None
+
+
+def share(scene: TriangleMesh, client: Any = None) -> SharedScene:
+    """Ships ``scene`` once for any number of later calls: scattered to every worker of
+    ``client`` (default: the active distributed Client), or, with none, wrapped as one graph key.
+    The scene is copied as it is now; a later ``refit`` of it is not seen by the shared copy."""
+    if isinstance(scene, SharedScene):
+        return scene
+    if not isinstance(scene, TriangleMesh):
+        raise TypeError(f"scene: must be a bvhkit.TriangleMesh, not {type(scene).__name__}")
+    client = client if client is not None else _active_client()
+    if client is not None:
+        ref = client.scatter(scene, broadcast=True, hash=False)
+    else:
+        # An explicit name: dask would otherwise tokenize the scene by pickling it.
+        ref = dask.delayed(scene, name=f"bvhkit-scene-{uuid.uuid4().hex}", traverse=False)
+    return SharedScene(ref, scene.dtype)
+
+
+def _rows(name: str, value: Any, like: Optional[da.Array] = None) -> da.Array:
+    """(n, 3) as a dask array with whole rows in each chunk (and ``like``'s row chunks)."""
+    a = value if isinstance(value, da.Array) else da.asarray(value)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{name}: must have shape (n, 3), not {a.shape}")
+    if like is not None:
+        if a.shape[0] != like.shape[0]:
+            raise ValueError(f"{name}: {a.shape[0]} rows, origins has {like.shape[0]}")
+        return a.rechunk((like.chunks[0], 3))
+    return a.rechunk({1: 3})
+
+
+def _map(
+    scene: Any,
+    arrays: Sequence[da.Array],
+    fn: Callable[..., Any],
+    outputs: Sequence[tuple[tuple[int, ...], Any]],
+) -> list[da.Array]:
+    """fn(scene, *blocks) on each row partition; ``outputs``: per result, the shape after the row
+    axis and the dtype. Returns one dask array per result."""
+    shared = share(scene)
+    blocks = [a.to_delayed().ravel() for a in arrays]
+    call = dask.delayed(fn, pure=True, nout=len(outputs))
+    columns: list[list[da.Array]] = [[] for _ in outputs]
+    for i, rows in enumerate(arrays[0].chunks[0]):
+        results = call(shared.ref, *(b[i] for b in blocks))
+        for out, (tail, dtype), result in zip(columns, outputs, results):
+            out.append(da.from_delayed(result, (rows, *tail), dtype=dtype))
+    if not arrays[0].chunks[0]:
+        return [da.empty((0, *tail), dtype=dtype) for tail, dtype in outputs]
+    return [da.concatenate(c) for c in columns]
+
+
+def _dtype(scene: Any) -> np.dtype:
+    if isinstance(scene, (TriangleMesh, SharedScene)):
+        return scene.dtype
+    raise TypeError(
+        f"scene: must be a bvhkit.TriangleMesh or SharedScene, not {type(scene).__name__}"
+    )
+
+
+def closest_point(
+    scene: Any, points: Any, max_distance: float = np.inf, threads: int = 1
+) -> ClosestPoints:
+    """:meth:`TriangleMesh.closest_point` on each partition: ClosestPoints of dask arrays."""
+    t, md = _a.threads(threads), float(max_distance)
+    if not md >= 0:
+        raise ValueError(f"max_distance: must be >= 0 (inf for no limit), not {max_distance}")
+    dt = _dtype(scene)
+    p = _rows("points", points)
+
+    def block(s: TriangleMesh, b: np.ndarray) -> tuple:
+        return tuple(s.closest_point(b, md, threads=t))
+
+    outs = [((), dt), ((3,), dt), ((), np.int64), ((3,), dt)]
+    return ClosestPoints(*_map(scene, [p], block, outs))
+
+
+def signed_distance(
+    scene: Any, points: Any, sign: str = "pseudonormal", threads: int = 1
+) -> da.Array:
+    """:meth:`TriangleMesh.signed_distance` on each partition."""
+    t = _a.threads(threads)
+    if sign not in _SIGNS:
+        raise ValueError(f"sign: {sign!r} is not one of {', '.join(map(repr, _SIGNS))}")
+    p = _rows("points", points)
+
+    def block(s: TriangleMesh, b: np.ndarray) -> tuple:
+        return (s.signed_distance(b, sign=sign, threads=t),)
+
+    return _map(scene, [p], block, [((), _dtype(scene))])[0]
+
+
+def winding_number(
+    scene: Any, points: Any, exact: bool = False, beta: float = 2.0, threads: int = 1
+) -> da.Array:
+    """:meth:`TriangleMesh.winding_number` on each partition."""
+    t, b_ = _a.threads(threads), float(beta)
+    if not b_ > 0 or not np.isfinite(b_):
+        raise ValueError(f"beta: must be a positive finite number, not {beta}")
+    p = _rows("points", points)
+
+    def block(s: TriangleMesh, b: np.ndarray) -> tuple:
+        return (s.winding_number(b, exact=bool(exact), beta=b_, threads=t),)
+
+    return _map(scene, [p], block, [((), _dtype(scene))])[0]
+
+
+def contains(scene: Any, points: Any, threads: int = 1) -> da.Array:
+    """:meth:`TriangleMesh.contains` on each partition: (n,) bool."""
+    return winding_number(scene, points, threads=threads) > 0.5
+
+
+def _ray_args(scene: Any, origins: Any, directions: Any, tmin: Any, tmax: Any):
+    _dtype(scene)
+    o = _rows("origins", origins)
+    d = _rows("directions", directions, like=o)
+    for name, v in (("tmin", tmin), ("tmax", tmax)):
+        if not np.isscalar(v):
+            raise TypeError(f"{name}: must be a scalar here, not {type(v).__name__}")
+    return o, d, float(tmin), float(tmax)
+
+
+def intersect(
+    scene: Any,
+    origins: Any,
+    directions: Any,
+    tmin: float = 0.0,
+    tmax: float = np.inf,
+    threads: int = 1,
+) -> RayHits:
+    """:meth:`TriangleMesh.intersect` on each partition (``tmin``, ``tmax``: scalars): RayHits of
+    dask arrays."""
+    t = _a.threads(threads)
+    o, d, t0, t1 = _ray_args(scene, origins, directions, tmin, tmax)
+    dt = _dtype(scene)
+
+    def block(s: TriangleMesh, bo: np.ndarray, bd: np.ndarray) -> tuple:
+        return tuple(s.intersect(bo, bd, t0, t1, threads=t))
+
+    return RayHits(*_map(scene, [o, d], block, [((), dt), ((), np.int64), ((3,), dt)]))
+
+
+def occluded(
+    scene: Any,
+    origins: Any,
+    directions: Any,
+    tmin: float = 0.0,
+    tmax: float = np.inf,
+    threads: int = 1,
+) -> da.Array:
+    """:meth:`TriangleMesh.occluded` on each partition: (n,) bool."""
+    t = _a.threads(threads)
+    o, d, t0, t1 = _ray_args(scene, origins, directions, tmin, tmax)
+
+    def block(s: TriangleMesh, bo: np.ndarray, bd: np.ndarray) -> tuple:
+        return (s.occluded(bo, bd, t0, t1, threads=t),)
+
+    return _map(scene, [o, d], block, [((), np.bool_)])[0]
+
+
+def count_intersections(
+    scene: Any,
+    origins: Any,
+    directions: Any,
+    tmin: float = 0.0,
+    tmax: float = np.inf,
+    threads: int = 1,
+) -> da.Array:
+    """:meth:`TriangleMesh.count_intersections` on each partition: (n,) int64."""
+    t = _a.threads(threads)
+    o, d, t0, t1 = _ray_args(scene, origins, directions, tmin, tmax)
+
+    def block(s: TriangleMesh, bo: np.ndarray, bd: np.ndarray) -> tuple:
+        return (s.count_intersections(bo, bd, t0, t1, threads=t),)
+
+    return _map(scene, [o, d], block, [((), np.int64)])[0]
