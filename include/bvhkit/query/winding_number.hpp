@@ -77,110 +77,125 @@ class WindingNumberMesh {
     friend struct serial_detail::WindingNumberMeshAccess;
     WindingNumberMesh() = default;  // for the loader, which fills bvh_ and tris_
 
-    // The dipoles from bvh_ and tris_ alone (a loaded file derives them so).
+    /// What derive_dipoles() keeps per node, in double, for the node's parent.
+    struct NodeMoments {
+        Vec<double, 3> an{};               // sum of area-weighted normals
+        Vec<double, 3> weighted_centre{};  // sum of area * centroid
+        double area = 0;
+        Vec<double, 3> centre{};          // weighted_centre / area (the box's centre if no area)
+        std::array<double, 9> first{};    // sum a_i (centroid_i - centre) (x) n_i
+        std::array<double, 27> second{};  // S[9 * j + 3 * k + i]
+    };
+
+    // The dipoles from bvh_ and tris_ alone (a loaded file derives them so): per node the sum of
+    // area-weighted normals, the area-weighted centre, the first and second moments about it, and
+    // a radius, children before parents (reverse array order). Sums in double.
     void derive_dipoles() {
-        // Per node: sum of area-weighted normals, area-weighted centre, the first moment
-        // sum(a_i (centroid_i - centre) (x) n_i) and radius, children before parents (reverse
-        // array order). Sums in double; a child's moment moves to its parent's centre by
-        // (c_child - c) (x) an_child.
         const std::size_t n = bvh_.nodes.size();
         dipoles_.resize(n);
-        std::vector<std::array<double, 9>> moment(n);
-        std::vector<std::array<double, 27>> second(n);  // S[9 * j + 3 * k + i]
-        std::vector<Vec<double, 3>> centres(n), normals(n);
-        std::vector<Vec<double, 3>> weighted_centres(n);  // sum of area * centroid
-        std::vector<double> areas(n);
+        std::vector<NodeMoments> moments(n);
         for (std::size_t k = n; k-- > 0;) {
             const auto& node = bvh_.nodes[k];
-            Dipole& d = dipoles_[k];
-            Vec<double, 3> an{}, centre{};
-            double area = 0;
+            NodeMoments& m = moments[k];
             if (node.is_leaf()) {
-                for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-                    const Triangle<T>& t = tris_[s];
-                    const Vec<double, 3> nrm = Vec<double, 3>(t.normal()) * 0.5;
-                    const double a = length(nrm);
-                    an += nrm;
-                    centre += Vec<double, 3>(t.centroid()) * a;
-                    area += a;
-                }
+                leaf_area_and_centre(node, m);
             } else {
                 for (std::uint32_t c : {node.left(), node.right()}) {
-                    an += normals[c];
-                    centre += weighted_centres[c];
-                    area += areas[c];
+                    m.an += moments[c].an;
+                    m.weighted_centre += moments[c].weighted_centre;
+                    m.area += moments[c].area;
                 }
             }
-            const Vec<double, 3> c =
-                area > 0 ? centre / area : Vec<double, 3>(node.bounds.centroid());
-            std::array<double, 9> m{};
-            const auto add_outer = [&m](const Vec<double, 3>& x, const Vec<double, 3>& y) {
-                for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j) m[3 * i + j] += x[i] * y[j];
-            };
-            std::array<double, 27> sm{};
-            // sm += (x (x) y) (x) z, the first two indices symmetric by construction or by use.
-            const auto add_outer3 = [&sm](const Vec<double, 3>& x, const Vec<double, 3>& y,
-                                          const Vec<double, 3>& z) {
-                for (int j = 0; j < 3; ++j)
-                    for (int l = 0; l < 3; ++l)
-                        for (int i = 0; i < 3; ++i) sm[9 * j + 3 * l + i] += x[j] * y[l] * z[i];
-            };
+            m.centre =
+                m.area > 0 ? m.weighted_centre / m.area : Vec<double, 3>(node.bounds.centroid());
             if (node.is_leaf()) {
-                for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-                    const Triangle<T>& t = tris_[s];
-                    const Vec<double, 3> g(t.centroid()), area_n = Vec<double, 3>(t.normal()) * 0.5;
-                    add_outer(g - c, area_n);
-                    add_outer3(g - c, g - c, area_n);
-                    for (const Vec<T, 3>& v : {t.p0, t.p1, t.p2}) {
-                        const Vec<double, 3> e = Vec<double, 3>(v) - g;
-                        add_outer3(e, e, area_n / 12.0);
-                    }
-                }
+                add_leaf_moments(node, m);
             } else {
-                // A child's moments move from its centre c' to c: x - c = (x - c') + d.
-                for (std::uint32_t ch : {node.left(), node.right()}) {
-                    const Vec<double, 3> dc = centres[ch] - c;
-                    for (int i = 0; i < 9; ++i) m[i] += moment[ch][i];
-                    add_outer(dc, normals[ch]);
-                    for (int i = 0; i < 27; ++i) sm[i] += second[ch][i];
-                    for (int j = 0; j < 3; ++j)
-                        for (int l = 0; l < 3; ++l)
-                            for (int i = 0; i < 3; ++i)
-                                sm[9 * j + 3 * l + i] += dc[j] * moment[ch][3 * l + i] +
-                                                         dc[l] * moment[ch][3 * j + i] +
-                                                         dc[j] * dc[l] * normals[ch][i];
-                }
+                for (std::uint32_t ch : {node.left(), node.right()})
+                    add_child_moments(moments[ch], m);
             }
-            second[k] = sm;
-            for (int j = 0, u = 0; j < 3; ++j)
-                for (int kk = j; kk < 3; ++kk, ++u)
-                    for (int i = 0; i < 3; ++i)
-                        d.second[3 * u + i] = T(sm[9 * j + 3 * kk + i] * (j == kk ? 1.0 : 2.0));
-            for (int j = 0; j < 3; ++j) {
-                double su = 0, sv = 0;
-                for (int i = 0; i < 3; ++i)
-                    su += sm[9 * j + 3 * i + i], sv += sm[9 * i + 3 * i + j];
-                d.traces[j] = T(2 * su + sv);
-            }
-            moment[k] = m;
-            centres[k] = c;
-            normals[k] = an;
-            d.an = Vec<T, 3>(an);
-            areas[k] = area;
-            weighted_centres[k] = centre;
-            d.centre = Vec<T, 3>(c);
-            for (int i = 0; i < 9; ++i) d.moment[i] = T(m[i]);
-            // Radius: the farthest corner of the node's box bounds every triangle below it.
-            double r2 = 0;
-            for (int corner = 0; corner < 8; ++corner) {
-                Vec<double, 3> p;
-                for (int a = 0; a < 3; ++a)
-                    p[a] = (corner >> a & 1) ? node.bounds.max[a] : node.bounds.min[a];
-                r2 = std::max(r2, length_squared(p - c));
-            }
-            d.radius = T(std::sqrt(r2));
+            store_dipole(node, m, dipoles_[k]);
         }
+    }
+
+    void leaf_area_and_centre(const BvhNode<Aabb<T, 3>>& node, NodeMoments& m) const {
+        for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+            const Triangle<T>& t = tris_[s];
+            const Vec<double, 3> nrm = Vec<double, 3>(t.normal()) * 0.5;
+            const double a = length(nrm);
+            m.an += nrm;
+            m.weighted_centre += Vec<double, 3>(t.centroid()) * a;
+            m.area += a;
+        }
+    }
+
+    static void add_outer(std::array<double, 9>& m, const Vec<double, 3>& x,
+                          const Vec<double, 3>& y) {
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) m[3 * i + j] += x[i] * y[j];
+    }
+    // sm += (x (x) y) (x) z, the first two indices symmetric by construction or by use.
+    static void add_outer3(std::array<double, 27>& sm, const Vec<double, 3>& x,
+                           const Vec<double, 3>& y, const Vec<double, 3>& z) {
+        for (int j = 0; j < 3; ++j)
+            for (int l = 0; l < 3; ++l)
+                for (int i = 0; i < 3; ++i) sm[9 * j + 3 * l + i] += x[j] * y[l] * z[i];
+    }
+
+    /// A leaf's first and second moments about m.centre, from its triangles: each triangle's
+    /// centroid term plus its own spread (the vertices' offsets from the centroid, over 12).
+    void add_leaf_moments(const BvhNode<Aabb<T, 3>>& node, NodeMoments& m) const {
+        const Vec<double, 3> c = m.centre;
+        for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+            const Triangle<T>& t = tris_[s];
+            const Vec<double, 3> g(t.centroid()), area_n = Vec<double, 3>(t.normal()) * 0.5;
+            add_outer(m.first, g - c, area_n);
+            add_outer3(m.second, g - c, g - c, area_n);
+            for (const Vec<T, 3>& v : {t.p0, t.p1, t.p2}) {
+                const Vec<double, 3> e = Vec<double, 3>(v) - g;
+                add_outer3(m.second, e, e, area_n / 12.0);
+            }
+        }
+    }
+
+    /// A child's moments moved from its centre c' to the parent's c: x - c = (x - c') + d.
+    static void add_child_moments(const NodeMoments& child, NodeMoments& m) {
+        const Vec<double, 3> dc = child.centre - m.centre;
+        for (int i = 0; i < 9; ++i) m.first[i] += child.first[i];
+        add_outer(m.first, dc, child.an);
+        for (int i = 0; i < 27; ++i) m.second[i] += child.second[i];
+        for (int j = 0; j < 3; ++j)
+            for (int l = 0; l < 3; ++l)
+                for (int i = 0; i < 3; ++i)
+                    m.second[9 * j + 3 * l + i] += dc[j] * child.first[3 * l + i] +
+                                                   dc[l] * child.first[3 * j + i] +
+                                                   dc[j] * dc[l] * child.an[i];
+    }
+
+    /// The node's Dipole in T: the symmetric second moment packed, its traces, and a radius (the
+    /// farthest corner of the node's box bounds every triangle below it).
+    static void store_dipole(const BvhNode<Aabb<T, 3>>& node, const NodeMoments& m, Dipole& d) {
+        const auto& sm = m.second;
+        for (int j = 0, u = 0; j < 3; ++j)
+            for (int kk = j; kk < 3; ++kk, ++u)
+                for (int i = 0; i < 3; ++i)
+                    d.second[3 * u + i] = T(sm[9 * j + 3 * kk + i] * (j == kk ? 1.0 : 2.0));
+        for (int j = 0; j < 3; ++j) {
+            double su = 0, sv = 0;
+            for (int i = 0; i < 3; ++i) su += sm[9 * j + 3 * i + i], sv += sm[9 * i + 3 * i + j];
+            d.traces[j] = T(2 * su + sv);
+        }
+        d.an = Vec<T, 3>(m.an);
+        d.centre = Vec<T, 3>(m.centre);
+        for (int i = 0; i < 9; ++i) d.moment[i] = T(m.first[i]);
+        double r2 = 0;
+        for (int corner = 0; corner < 8; ++corner) {
+            Vec<double, 3> p;
+            for (int a = 0; a < 3; ++a)
+                p[a] = (corner >> a & 1) ? node.bounds.max[a] : node.bounds.min[a];
+            r2 = std::max(r2, length_squared(p - m.centre));
+        }
+        d.radius = T(std::sqrt(r2));
     }
 
   public:
