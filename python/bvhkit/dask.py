@@ -222,13 +222,7 @@ def occluded(
     threads: int = 1,
 ) -> da.Array:
     """:meth:`TriangleMesh.occluded` on each partition: (n,) bool."""
-    t = _a.threads(threads)
-    o, d, t0, t1 = _ray_args(scene, origins, directions, tmin, tmax)
-
-    def block(s: TriangleMesh, bo: np.ndarray, bd: np.ndarray) -> tuple:
-        return (s.occluded(bo, bd, t0, t1, threads=t),)
-
-    return _map(scene, [o, d], block, [((), np.bool_)])[0]
+    return _per_ray(scene, origins, directions, tmin, tmax, threads, "occluded", np.bool_)
 
 
 def count_intersections(
@@ -240,10 +234,26 @@ def count_intersections(
     threads: int = 1,
 ) -> da.Array:
     """:meth:`TriangleMesh.count_intersections` on each partition: (n,) int64."""
+    return _per_ray(
+        scene, origins, directions, tmin, tmax, threads, "count_intersections", np.int64
+    )
+
+
+def _per_ray(
+    scene: Any,
+    origins: Any,
+    directions: Any,
+    tmin: float,
+    tmax: float,
+    threads: int,
+    method: str,
+    dtype: Any,
+) -> da.Array:
+    """One value per ray from the scene's `method`, partition by partition."""
     t = _a.threads(threads)
     o, d, t0, t1 = _ray_args(scene, origins, directions, tmin, tmax)
 
     def block(s: TriangleMesh, bo: np.ndarray, bd: np.ndarray) -> tuple:
-        return (s.count_intersections(bo, bd, t0, t1, threads=t),)
+        return (getattr(s, method)(bo, bd, t0, t1, threads=t),)
 
-    return _map(scene, [o, d], block, [((), np.int64)])[0]
+    return _map(scene, [o, d], block, [((), dtype)])[0]
