@@ -118,86 +118,6 @@ class WindingNumberMesh {
         }
     }
 
-    void leaf_area_and_centre(const BvhNode<Aabb<T, 3>>& node, NodeMoments& m) const {
-        for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-            const Triangle<T>& t = tris_[s];
-            const Vec<double, 3> nrm = Vec<double, 3>(t.normal()) * 0.5;
-            const double a = length(nrm);
-            m.an += nrm;
-            m.weighted_centre += Vec<double, 3>(t.centroid()) * a;
-            m.area += a;
-        }
-    }
-
-    static void add_outer(std::array<double, 9>& m, const Vec<double, 3>& x,
-                          const Vec<double, 3>& y) {
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) m[3 * i + j] += x[i] * y[j];
-    }
-    // sm += (x (x) y) (x) z, the first two indices symmetric by construction or by use.
-    static void add_outer3(std::array<double, 27>& sm, const Vec<double, 3>& x,
-                           const Vec<double, 3>& y, const Vec<double, 3>& z) {
-        for (int j = 0; j < 3; ++j)
-            for (int l = 0; l < 3; ++l)
-                for (int i = 0; i < 3; ++i) sm[9 * j + 3 * l + i] += x[j] * y[l] * z[i];
-    }
-
-    /// A leaf's first and second moments about m.centre, from its triangles: each triangle's
-    /// centroid term plus its own spread (the vertices' offsets from the centroid, over 12).
-    void add_leaf_moments(const BvhNode<Aabb<T, 3>>& node, NodeMoments& m) const {
-        const Vec<double, 3> c = m.centre;
-        for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-            const Triangle<T>& t = tris_[s];
-            const Vec<double, 3> g(t.centroid()), area_n = Vec<double, 3>(t.normal()) * 0.5;
-            add_outer(m.first, g - c, area_n);
-            add_outer3(m.second, g - c, g - c, area_n);
-            for (const Vec<T, 3>& v : {t.p0, t.p1, t.p2}) {
-                const Vec<double, 3> e = Vec<double, 3>(v) - g;
-                add_outer3(m.second, e, e, area_n / 12.0);
-            }
-        }
-    }
-
-    /// A child's moments moved from its centre c' to the parent's c: x - c = (x - c') + d.
-    static void add_child_moments(const NodeMoments& child, NodeMoments& m) {
-        const Vec<double, 3> dc = child.centre - m.centre;
-        for (int i = 0; i < 9; ++i) m.first[i] += child.first[i];
-        add_outer(m.first, dc, child.an);
-        for (int i = 0; i < 27; ++i) m.second[i] += child.second[i];
-        for (int j = 0; j < 3; ++j)
-            for (int l = 0; l < 3; ++l)
-                for (int i = 0; i < 3; ++i)
-                    m.second[9 * j + 3 * l + i] += dc[j] * child.first[3 * l + i] +
-                                                   dc[l] * child.first[3 * j + i] +
-                                                   dc[j] * dc[l] * child.an[i];
-    }
-
-    /// The node's Dipole in T: the symmetric second moment packed, its traces, and a radius (the
-    /// farthest corner of the node's box bounds every triangle below it).
-    static void store_dipole(const BvhNode<Aabb<T, 3>>& node, const NodeMoments& m, Dipole& d) {
-        const auto& sm = m.second;
-        for (int j = 0, u = 0; j < 3; ++j)
-            for (int kk = j; kk < 3; ++kk, ++u)
-                for (int i = 0; i < 3; ++i)
-                    d.second[3 * u + i] = T(sm[9 * j + 3 * kk + i] * (j == kk ? 1.0 : 2.0));
-        for (int j = 0; j < 3; ++j) {
-            double su = 0, sv = 0;
-            for (int i = 0; i < 3; ++i) su += sm[9 * j + 3 * i + i], sv += sm[9 * i + 3 * i + j];
-            d.traces[j] = T(2 * su + sv);
-        }
-        d.an = Vec<T, 3>(m.an);
-        d.centre = Vec<T, 3>(m.centre);
-        for (int i = 0; i < 9; ++i) d.moment[i] = T(m.first[i]);
-        double r2 = 0;
-        for (int corner = 0; corner < 8; ++corner) {
-            Vec<double, 3> p;
-            for (int a = 0; a < 3; ++a)
-                p[a] = (corner >> a & 1) ? node.bounds.max[a] : node.bounds.min[a];
-            r2 = std::max(r2, length_squared(p - m.centre));
-        }
-        d.radius = T(std::sqrt(r2));
-    }
-
   public:
     /// The exact winding number: every triangle's solid angle.
     T exact(const Vec<T, 3>& q) const {
@@ -313,6 +233,86 @@ class WindingNumberMesh {
             r[0] * double(d.traces[0]) + r[1] * double(d.traces[1]) + r[2] * double(d.traces[2]);
         const double inv5 = inv3 / rr;
         return 0.5 * inv5 * (15.0 * rS / rr - 3.0 * rt);
+    }
+
+    void leaf_area_and_centre(const BvhNode<Aabb<T, 3>>& node, NodeMoments& m) const {
+        for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+            const Triangle<T>& t = tris_[s];
+            const Vec<double, 3> nrm = Vec<double, 3>(t.normal()) * 0.5;
+            const double a = length(nrm);
+            m.an += nrm;
+            m.weighted_centre += Vec<double, 3>(t.centroid()) * a;
+            m.area += a;
+        }
+    }
+
+    static void add_outer(std::array<double, 9>& m, const Vec<double, 3>& x,
+                          const Vec<double, 3>& y) {
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) m[3 * i + j] += x[i] * y[j];
+    }
+    // sm += (x (x) y) (x) z, the first two indices symmetric by construction or by use.
+    static void add_outer3(std::array<double, 27>& sm, const Vec<double, 3>& x,
+                           const Vec<double, 3>& y, const Vec<double, 3>& z) {
+        for (int j = 0; j < 3; ++j)
+            for (int l = 0; l < 3; ++l)
+                for (int i = 0; i < 3; ++i) sm[9 * j + 3 * l + i] += x[j] * y[l] * z[i];
+    }
+
+    /// A leaf's first and second moments about m.centre, from its triangles: each triangle's
+    /// centroid term plus its own spread (the vertices' offsets from the centroid, over 12).
+    void add_leaf_moments(const BvhNode<Aabb<T, 3>>& node, NodeMoments& m) const {
+        const Vec<double, 3> c = m.centre;
+        for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+            const Triangle<T>& t = tris_[s];
+            const Vec<double, 3> g(t.centroid()), area_n = Vec<double, 3>(t.normal()) * 0.5;
+            add_outer(m.first, g - c, area_n);
+            add_outer3(m.second, g - c, g - c, area_n);
+            for (const Vec<T, 3>& v : {t.p0, t.p1, t.p2}) {
+                const Vec<double, 3> e = Vec<double, 3>(v) - g;
+                add_outer3(m.second, e, e, area_n / 12.0);
+            }
+        }
+    }
+
+    /// A child's moments moved from its centre c' to the parent's c: x - c = (x - c') + d.
+    static void add_child_moments(const NodeMoments& child, NodeMoments& m) {
+        const Vec<double, 3> dc = child.centre - m.centre;
+        for (int i = 0; i < 9; ++i) m.first[i] += child.first[i];
+        add_outer(m.first, dc, child.an);
+        for (int i = 0; i < 27; ++i) m.second[i] += child.second[i];
+        for (int j = 0; j < 3; ++j)
+            for (int l = 0; l < 3; ++l)
+                for (int i = 0; i < 3; ++i)
+                    m.second[9 * j + 3 * l + i] += dc[j] * child.first[3 * l + i] +
+                                                   dc[l] * child.first[3 * j + i] +
+                                                   dc[j] * dc[l] * child.an[i];
+    }
+
+    /// The node's Dipole in T: the symmetric second moment packed, its traces, and a radius (the
+    /// farthest corner of the node's box bounds every triangle below it).
+    static void store_dipole(const BvhNode<Aabb<T, 3>>& node, const NodeMoments& m, Dipole& d) {
+        const auto& sm = m.second;
+        for (int j = 0, u = 0; j < 3; ++j)
+            for (int kk = j; kk < 3; ++kk, ++u)
+                for (int i = 0; i < 3; ++i)
+                    d.second[3 * u + i] = T(sm[9 * j + 3 * kk + i] * (j == kk ? 1.0 : 2.0));
+        for (int j = 0; j < 3; ++j) {
+            double su = 0, sv = 0;
+            for (int i = 0; i < 3; ++i) su += sm[9 * j + 3 * i + i], sv += sm[9 * i + 3 * i + j];
+            d.traces[j] = T(2 * su + sv);
+        }
+        d.an = Vec<T, 3>(m.an);
+        d.centre = Vec<T, 3>(m.centre);
+        for (int i = 0; i < 9; ++i) d.moment[i] = T(m.first[i]);
+        double r2 = 0;
+        for (int corner = 0; corner < 8; ++corner) {
+            Vec<double, 3> p;
+            for (int a = 0; a < 3; ++a)
+                p[a] = (corner >> a & 1) ? node.bounds.max[a] : node.bounds.min[a];
+            r2 = std::max(r2, length_squared(p - m.centre));
+        }
+        d.radius = T(std::sqrt(r2));
     }
 
     AabbBvh<T, 3> bvh_;
