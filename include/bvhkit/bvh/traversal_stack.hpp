@@ -51,6 +51,13 @@ class FixedStack {
     const Entry& top() const {
         return items_[size_ - 1];
     }
+    /// The entry k below the top (0: the top), for walks that reorder what they just pushed.
+    Entry& from_top(std::size_t k) {
+#if !defined(NDEBUG)
+        if (k >= size_) throw Error("traversal stack: read below the bottom");
+#endif
+        return items_[size_ - 1 - k];
+    }
 
   private:
     Entry items_[Capacity];  // left uninitialized: only [0, size_) is ever read

@@ -16,6 +16,7 @@
 #include <cstdint>
 
 #include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/traversal_stack.hpp"
 #include "bvhkit/query/stats.hpp"
 #include "bvhkit/volumes/bounding_volume.hpp"
 
@@ -111,8 +112,7 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
         stats.node();
         return Traits::overlaps(a.nodes[x].bounds, b.nodes[y].bounds, pose);
     };
-    std::array<detail::NodePair, detail::pair_stack_size> stack;
-    std::size_t top = 0;
+    FixedStack<detail::NodePair, detail::pair_stack_size> stack;
     // Of two children that both overlap, the one whose centre is nearer the other node's is
     // searched first: its subtree is likelier to hold a touching pair, which ends a yes/no query.
     const auto nearer_on_top = [](const auto& nodes, const auto& w, std::uint32_t lower,
@@ -122,9 +122,9 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
             std::swap(pl, pu);
     };
     if (!overlap(0, 0)) return true;
-    stack[top++] = {0, 0};
-    while (top > 0) {
-        const detail::NodePair p = stack[--top];
+    stack.push({0, 0});
+    while (!stack.empty()) {
+        const detail::NodePair p = stack.pop();
         const auto& na = a.nodes[p.a];
         const auto& nb = b.nodes[p.b];
         if (na.is_leaf() && nb.is_leaf()) {
@@ -143,11 +143,11 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
                 open_a < open_b ||
                 (open_a == open_b && Traits::size(na.bounds) >= Traits::size(nb.bounds));
             if (pick_a) {
-                if (ar) stack[top++] = {na.right(), p.b};
-                if (al) stack[top++] = {na.left(), p.b};
+                if (ar) stack.push({na.right(), p.b});
+                if (al) stack.push({na.left(), p.b});
             } else {
-                if (br) stack[top++] = {p.a, nb.right()};
-                if (bl) stack[top++] = {p.a, nb.left()};
+                if (br) stack.push({p.a, nb.right()});
+                if (bl) stack.push({p.a, nb.left()});
             }
             continue;
         }
@@ -155,41 +155,41 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
             case detail::Open::A:
                 if constexpr (detail::Placeable<V>) {
                     const V w = Traits::place(nb.bounds, pose);
-                    const std::size_t before = top;
+                    const std::size_t before = stack.size();
                     for (const std::uint32_t x : {na.right(), na.left()}) {
                         stats.node();
                         if (Traits::overlaps_placed(a.nodes[x].bounds, w, slack))
-                            stack[top++] = {x, p.b};
+                            stack.push({x, p.b});
                     }
-                    if (top == before + 2)
-                        nearer_on_top(a.nodes, w, stack[top - 2].a, stack[top - 1].a,
-                                      stack[top - 2], stack[top - 1]);
+                    if (stack.size() == before + 2)
+                        nearer_on_top(a.nodes, w, stack.from_top(1).a, stack.from_top(0).a,
+                                      stack.from_top(1), stack.from_top(0));
                 } else {
-                    if (overlap(na.right(), p.b)) stack[top++] = {na.right(), p.b};
-                    if (overlap(na.left(), p.b)) stack[top++] = {na.left(), p.b};
+                    if (overlap(na.right(), p.b)) stack.push({na.right(), p.b});
+                    if (overlap(na.left(), p.b)) stack.push({na.left(), p.b});
                 }
                 break;
             case detail::Open::B:
                 if constexpr (detail::Placeable<V>) {
                     const V w = Traits::place(na.bounds, inverse);
-                    const std::size_t before = top;
+                    const std::size_t before = stack.size();
                     for (const std::uint32_t y : {nb.right(), nb.left()}) {
                         stats.node();
                         if (Traits::overlaps_placed(b.nodes[y].bounds, w, slack))
-                            stack[top++] = {p.a, y};
+                            stack.push({p.a, y});
                     }
-                    if (top == before + 2)
-                        nearer_on_top(b.nodes, w, stack[top - 2].b, stack[top - 1].b,
-                                      stack[top - 2], stack[top - 1]);
+                    if (stack.size() == before + 2)
+                        nearer_on_top(b.nodes, w, stack.from_top(1).b, stack.from_top(0).b,
+                                      stack.from_top(1), stack.from_top(0));
                 } else {
-                    if (overlap(p.a, nb.right())) stack[top++] = {p.a, nb.right()};
-                    if (overlap(p.a, nb.left())) stack[top++] = {p.a, nb.left()};
+                    if (overlap(p.a, nb.right())) stack.push({p.a, nb.right()});
+                    if (overlap(p.a, nb.left())) stack.push({p.a, nb.left()});
                 }
                 break;
             case detail::Open::Both:
                 for (std::uint32_t x : {na.right(), na.left()})
                     for (std::uint32_t y : {nb.right(), nb.left()})
-                        if (overlap(x, y)) stack[top++] = {x, y};
+                        if (overlap(x, y)) stack.push({x, y});
                 break;
         }
     }

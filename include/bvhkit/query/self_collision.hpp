@@ -9,6 +9,7 @@
 // tested once.
 #include <algorithm>
 
+#include "bvhkit/bvh/traversal_stack.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 
 namespace bvhkit {
@@ -40,11 +41,10 @@ bool self_collide(const CollisionModel<V>& m, std::vector<Contact<typename V::Sc
         stats.node();
         return Traits::overlaps(nodes[x].bounds, nodes[y].bounds);
     };
-    std::array<detail::NodePair, detail::pair_stack_size> stack;
-    std::size_t top = 0;
-    stack[top++] = {0, 0};
-    while (top > 0) {
-        const detail::NodePair p = stack[--top];
+    FixedStack<detail::NodePair, detail::pair_stack_size> stack;
+    stack.push({0, 0});
+    while (!stack.empty()) {
+        const detail::NodePair p = stack.pop();
         const auto& na = nodes[p.a];
         const auto& nb = nodes[p.b];
         if (p.a == p.b) {
@@ -52,9 +52,9 @@ bool self_collide(const CollisionModel<V>& m, std::vector<Contact<typename V::Sc
                 for (std::uint32_t s = na.first; s < na.first + na.count; ++s)
                     for (std::uint32_t t = s + 1; t < na.first + na.count; ++t) test(s, t);
             } else {
-                stack[top++] = {na.left(), na.left()};
-                stack[top++] = {na.right(), na.right()};
-                if (overlap(na.left(), na.right())) stack[top++] = {na.left(), na.right()};
+                stack.push({na.left(), na.left()});
+                stack.push({na.right(), na.right()});
+                if (overlap(na.left(), na.right())) stack.push({na.left(), na.right()});
             }
             continue;
         }
@@ -66,11 +66,11 @@ bool self_collide(const CollisionModel<V>& m, std::vector<Contact<typename V::Sc
         const bool open_a =
             nb.is_leaf() || (!na.is_leaf() && Traits::size(na.bounds) >= Traits::size(nb.bounds));
         if (open_a) {
-            if (overlap(na.left(), p.b)) stack[top++] = {na.left(), p.b};
-            if (overlap(na.right(), p.b)) stack[top++] = {na.right(), p.b};
+            if (overlap(na.left(), p.b)) stack.push({na.left(), p.b});
+            if (overlap(na.right(), p.b)) stack.push({na.right(), p.b});
         } else {
-            if (overlap(p.a, nb.left())) stack[top++] = {p.a, nb.left()};
-            if (overlap(p.a, nb.right())) stack[top++] = {p.a, nb.right()};
+            if (overlap(p.a, nb.left())) stack.push({p.a, nb.left()});
+            if (overlap(p.a, nb.right())) stack.push({p.a, nb.right()});
         }
     }
     std::sort(contacts.begin(), contacts.end(), [](const auto& x, const auto& y) {
