@@ -1,13 +1,14 @@
-// libFuzzer target: the TriangleBvh, ClosestPointMesh, SignedDistanceMesh and WindingNumberMesh
-// loaders on arbitrary bytes, as they come and again with the checksum recomputed (random bytes
-// almost never carry a valid checksum, and the checks behind it are the ones worth fuzzing). A
-// load may throw bvhkit::Error; a structure it accepts, with or without validate(), must answer
-// queries with indices in range (ASan and UBSan watch the walks).
+// libFuzzer target: the TriangleBvh, ClosestPointMesh, SignedDistanceMesh, WindingNumberMesh and
+// DynamicTree loaders on arbitrary bytes, as they come and again with the checksum recomputed
+// (random bytes almost never carry a valid checksum, and the checks behind it are the ones worth
+// fuzzing). A load may throw bvhkit::Error; a structure it accepts, with or without validate(),
+// must answer queries with indices in range (ASan and UBSan watch the walks).
 #include <cstdlib>
 #include <span>
 #include <vector>
 
 #include "bvhkit/io/closest_point_mesh_file.hpp"
+#include "bvhkit/io/dynamic_tree_file.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/io/winding_number_mesh_file.hpp"
@@ -90,6 +91,25 @@ void load_winding_number_mesh_and_query(std::span<const std::uint8_t> bytes) {
     }
 }
 
+/// A DynamicTree the loader accepts must keep working: queries, moves, a pair step, validate().
+template <class T, std::size_t N>
+void load_dynamic_tree_and_use(std::span<const std::uint8_t> bytes) {
+    try {
+        auto tree = bvhkit::dynamic_tree_from_bytes<T, N>(bytes);
+        const bvhkit::Aabb<T, N> box(bvhkit::Vec<T, N>(T(-1)), bvhkit::Vec<T, N>(T(1)));
+        tree.query(box,
+                   [&](bvhkit::ProxyId id) { return tree.contains(id) || (std::abort(), false); });
+        for (bvhkit::ProxyId id = 0; id < tree.id_bound() && id < 8; ++id)
+            if (tree.contains(id)) tree.move(id, box);
+        (void)tree.create(box);
+        tree.update_pairs([](bvhkit::ProxyId, bvhkit::ProxyId) {},
+                          [](bvhkit::ProxyId, bvhkit::ProxyId) {});
+        tree.rebuild(false);
+        tree.validate();
+    } catch (const bvhkit::Error&) {
+    }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -118,6 +138,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             load_winding_number_mesh_and_query<double>(resealed);
         else
             load_winding_number_mesh_and_query<float>(resealed);
+    } else if (size > 17 && data[12] == 5) {
+        // Byte 17 is the volume: 2 for a 2D tree.
+        const bool flat = data[17] == 2;
+        if (flat) load_dynamic_tree_and_use<float, 2>(raw);
+        if (flat && as_double) load_dynamic_tree_and_use<double, 2>(resealed);
+        if (flat && !as_double) load_dynamic_tree_and_use<float, 2>(resealed);
+        if (!flat && as_double) load_dynamic_tree_and_use<double, 3>(resealed);
+        if (!flat && !as_double) load_dynamic_tree_and_use<float, 3>(resealed);
     } else if (as_double) {
         load_and_query<double>(resealed);
     } else {

@@ -1,7 +1,7 @@
 // Writes the seed corpus of fuzz_tree_file into the folder given: small saved TriangleBvh files
 // (float and double, both triangle layouts, one with skipped triangles, an empty tree),
-// ClosestPointMesh, SignedDistanceMesh and WindingNumberMesh files, each a few KB so the fuzzer's
-// mutations land on every section.
+// ClosestPointMesh, SignedDistanceMesh, WindingNumberMesh and DynamicTree files, each a few KB so
+// the fuzzer's mutations land on every section.
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bvhkit/io/closest_point_mesh_file.hpp"
+#include "bvhkit/io/dynamic_tree_file.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/io/winding_number_mesh_file.hpp"
@@ -67,5 +68,19 @@ int main(int argc, char** argv) {
     bvhkit::save(bvhkit::SignedDistanceMesh<double>(octahedron), dir / "signed_double.bvh");
     bvhkit::save(bvhkit::WindingNumberMesh<float>(octahedron), dir / "winding_float.bvh");
     bvhkit::save(bvhkit::WindingNumberMesh<double>(octahedron), dir / "winding_double.bvh");
+    // Dynamic trees: a few boxes, one destroyed, one moved, a pair step, one more move pending.
+    bvhkit::DynamicTree<float, 2> flat;
+    for (int i = 0; i < 12; ++i)
+        flat.create(bvhkit::Aabb<float, 2>({float(i), 0}, {float(i) + 1.5f, 1}), std::uint64_t(i));
+    flat.destroy(3);
+    flat.update_pairs([](bvhkit::ProxyId, bvhkit::ProxyId) {},
+                      [](bvhkit::ProxyId, bvhkit::ProxyId) {});
+    flat.move(5, bvhkit::Aabb<float, 2>({20, 0}, {21, 1}));
+    bvhkit::save(flat, dir / "dynamic_2d_float.bvh");
+    bvhkit::DynamicTree<double, 3> solid;
+    for (int i = 0; i < 10; ++i)
+        solid.create(bvhkit::Aabb<double, 3>({0, double(i), 0}, {1, double(i) + 1.5, 1}));
+    solid.enlarge(2, bvhkit::Aabb<double, 3>({5, 5, 5}, {6, 6, 6}));
+    bvhkit::save(solid, dir / "dynamic_3d_double.bvh");
     return 0;
 }

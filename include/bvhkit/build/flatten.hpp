@@ -59,15 +59,22 @@ struct FlattenOptions {
     SahCosts costs{};
 };
 
-/// Lays `tree` out as a Bvh; `boxes` are the primitive boxes, indexed by the entries of `order`.
+namespace flatten_detail {
+
+/// Per node of a BinaryTree: its box, primitive count, height, and whether the subtree is
+/// cheapest as one leaf (by the SAH costs, within max_leaf_size).
 template <class T, std::size_t N>
-Bvh<Aabb<T, N>> flatten(const BinaryTree& tree, std::span<const Aabb<T, N>> boxes,
-                        const FlattenOptions& options = {}) {
-    Bvh<Aabb<T, N>> bvh;
-    if (tree.root == no_child) return bvh;
+struct SubtreeMeasures {
+    std::vector<Aabb<T, N>> box;
+    std::vector<std::uint32_t> prims, height;
+    std::vector<std::uint8_t> collapse;
+};
+
+/// One post-order pass (children before parents, from an explicit pre-order list reversed).
+template <class T, std::size_t N>
+SubtreeMeasures<T, N> measure_subtrees(const BinaryTree& tree, std::span<const Aabb<T, N>> boxes,
+                                       const FlattenOptions& options) {
     const std::size_t n = tree.size();
-    // Post-order pass (children before parents, from an explicit pre-order list reversed): boxes,
-    // primitive counts and whether the subtree is cheapest as one leaf.
     std::vector<std::uint32_t> preorder;
     preorder.reserve(n);
     preorder.push_back(tree.root);
@@ -78,56 +85,83 @@ Bvh<Aabb<T, N>> flatten(const BinaryTree& tree, std::span<const Aabb<T, N>> boxe
             preorder.push_back(tree.right[v]);
         }
     }
-    std::vector<Aabb<T, N>> box(n);
-    std::vector<std::uint32_t> prims(n), height(n, 0);
+    SubtreeMeasures<T, N> m;
+    m.box.resize(n);
+    m.prims.resize(n);
+    m.height.assign(n, 0);
+    m.collapse.assign(n, 0);
     std::vector<double> cost(n);  // best SAH cost of the subtree, in area units
-    std::vector<std::uint8_t> collapse(n, 0);
     for (std::size_t k = preorder.size(); k-- > 0;) {
         const std::uint32_t v = preorder[k];
         if (tree.left[v] == no_child) {
             Aabb<T, N> b;
             for (std::uint32_t s = tree.first[v]; s < tree.first[v] + tree.count[v]; ++s)
                 b.grow(boxes[tree.order[s]]);
-            box[v] = b;
-            prims[v] = tree.count[v];
-            cost[v] = options.costs.intersection * prims[v] * double(b.area());
-            collapse[v] = 1;
+            m.box[v] = b;
+            m.prims[v] = tree.count[v];
+            cost[v] = options.costs.intersection * m.prims[v] * double(b.area());
+            m.collapse[v] = 1;
             continue;
         }
         const std::uint32_t l = tree.left[v], r = tree.right[v];
-        height[v] = 1 + std::max(height[l], height[r]);
-        box[v] = unite(box[l], box[r]);
-        prims[v] = prims[l] + prims[r];
-        const double area = double(box[v].area());
+        m.height[v] = 1 + std::max(m.height[l], m.height[r]);
+        m.box[v] = unite(m.box[l], m.box[r]);
+        m.prims[v] = m.prims[l] + m.prims[r];
+        const double area = double(m.box[v].area());
         const double split = options.costs.traversal * area + cost[l] + cost[r];
-        const double leaf = options.costs.intersection * prims[v] * area;
-        if (prims[v] <= options.max_leaf_size && leaf <= split) {
-            collapse[v] = 1;
+        const double leaf = options.costs.intersection * m.prims[v] * area;
+        if (m.prims[v] <= options.max_leaf_size && leaf <= split) {
+            m.collapse[v] = 1;
             cost[v] = leaf;
         } else {
             cost[v] = split;
         }
     }
+    return m;
+}
+
+/// Appends the primitives of the subtree of `v` to `out`, left to right; `gather` is scratch.
+inline void append_primitives(const BinaryTree& tree, std::uint32_t v,
+                              std::vector<std::uint32_t>& out, std::vector<std::uint32_t>& gather) {
+    gather.assign(1, v);
+    while (!gather.empty()) {
+        const std::uint32_t u = gather.back();
+        gather.pop_back();
+        if (tree.left[u] == no_child) {
+            for (std::uint32_t s = tree.first[u]; s < tree.first[u] + tree.count[u]; ++s)
+                out.push_back(tree.order[s]);
+        } else {
+            gather.push_back(tree.right[u]);
+            gather.push_back(tree.left[u]);
+        }
+    }
+}
+
+}  // namespace flatten_detail
+
+/// Lays `tree` out as a Bvh; `boxes` are the primitive boxes, indexed by the entries of `order`.
+// The layout walk stays one function of some 80 lines: its three cases (a run laid out in halves,
+// a subtree too tall for the depth left, an ordinary node) share the work stack and the node array
+// it appends to.
+template <class T, std::size_t N>
+Bvh<Aabb<T, N>> flatten(const BinaryTree& tree, std::span<const Aabb<T, N>> boxes,
+                        const FlattenOptions& options = {}) {
+    Bvh<Aabb<T, N>> bvh;
+    if (tree.root == no_child) return bvh;
+    const flatten_detail::SubtreeMeasures<T, N> measures =
+        flatten_detail::measure_subtrees(tree, boxes, options);
+    const auto& box = measures.box;
+    const auto& prims = measures.prims;
+    const auto& height = measures.height;
+    const auto& collapse = measures.collapse;
 
     const std::uint32_t max_depth = std::min(options.max_depth, max_bvh_depth);
     const std::uint32_t max_leaf = std::max<std::uint32_t>(1, options.max_leaf_size);
     bvh.nodes.reserve(2 * std::size_t(prims[tree.root]));
     bvh.primitive_indices.reserve(prims[tree.root]);
     std::vector<std::uint32_t> gather;  // reused stack for collecting a collapsed subtree's leaves
-    // Appends the primitives of the subtree of `v` to `out`, left to right.
     const auto collect = [&](std::uint32_t v, std::vector<std::uint32_t>& out) {
-        gather.assign(1, v);
-        while (!gather.empty()) {
-            const std::uint32_t u = gather.back();
-            gather.pop_back();
-            if (tree.left[u] == no_child) {
-                for (std::uint32_t s = tree.first[u]; s < tree.first[u] + tree.count[u]; ++s)
-                    out.push_back(tree.order[s]);
-            } else {
-                gather.push_back(tree.right[u]);
-                gather.push_back(tree.left[u]);
-            }
-        }
+        flatten_detail::append_primitives(tree, v, out, gather);
     };
     // A subtree too tall for the depth left is laid out balanced instead, halving the run of its
     // primitives (left to right, so still grouped as the builder grouped them) from the depth where

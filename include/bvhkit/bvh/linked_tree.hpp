@@ -24,6 +24,10 @@
 
 namespace bvhkit {
 
+namespace serial_detail {
+struct DynamicTreeAccess;  // io/dynamic_tree_file.hpp: saves and loads the pool as it is
+}
+
 /// How insert() picks the sibling of a new leaf.
 enum class InsertionStrategy : std::uint8_t {
     /// The classic descent: at each node go to the child whose union with the new box is smaller,
@@ -305,6 +309,8 @@ class LinkedTree {
     }
 
   private:
+    friend struct serial_detail::DynamicTreeAccess;
+
     template <class V>
     static void release(V& v) {
         V().swap(v);

@@ -41,6 +41,10 @@
 
 namespace bvhkit {
 
+namespace serial_detail {
+struct DynamicTreeAccess;  // io/dynamic_tree_file.hpp: saves and loads the whole state
+}
+
 template <class T, std::size_t N, class UserData = std::uint64_t>
 class DynamicTree {
     static_assert(N == 2 || N == 3, "DynamicTree is for 2D and 3D boxes");
@@ -453,6 +457,7 @@ class DynamicTree {
   private:
     template <class, std::size_t, class>
     friend class DynamicTree;
+    friend struct serial_detail::DynamicTreeAccess;
     using Node = dynamic_detail::Node<T, N>;
     using Proxy = dynamic_detail::Proxy<T, N, UserData>;
     using Guard = dynamic_detail::WalkCounter::Guard;

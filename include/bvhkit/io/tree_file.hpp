@@ -40,10 +40,11 @@ enum class FileKind : std::uint32_t {
     TriangleBvh = 1,
     ClosestPointMesh = 2,
     SignedDistanceMesh = 3,
-    WindingNumberMesh = 4
+    WindingNumberMesh = 4,
+    DynamicTree = 5
 };
 enum class ScalarCode : std::uint8_t { Float32 = 1, Float64 = 2 };
-enum class VolumeCode : std::uint8_t { Aabb3 = 1 };
+enum class VolumeCode : std::uint8_t { Aabb3 = 1, Aabb2 = 2 };
 
 template <class T>
 constexpr ScalarCode scalar_code() {
