@@ -42,7 +42,8 @@ class Scene {
         options_.threads = threads;
         nb::gil_scoped_release release;
         TriangleBvhOptions ray_options(options_);
-        ray_options.triangle_test = ray_test == "fast" ? TriangleTest::Fast : TriangleTest::Watertight;
+        ray_options.triangle_test =
+            ray_test == "fast" ? TriangleTest::Fast : TriangleTest::Watertight;
         rays_ = TriangleBvh<T>(mesh_, ray_options);
     }
 
@@ -96,14 +97,14 @@ class Scene {
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock(mutex_);
         run_batch(k, 1024, threads, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) per_ray(i, Ray3(row(o, i), row(d, i), t0[i], t1[i]));
+            for (std::size_t i = b; i < e; ++i)
+                per_ray(i, Ray3(row(o, i), row(d, i), t0[i], t1[i]));
         });
     }
 
-    void intersect(const Rows<T, 3>& origins, const Rows<T, 3>& directions,
-                   const Column<T>& tmin, const Column<T>& tmax, OutColumn<T> t,
-                   OutColumn<std::int64_t> face, OutRows<T, 3> barycentric,
-                   unsigned threads) const {
+    void intersect(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
+                   const Column<T>& tmax, OutColumn<T> t, OutColumn<std::int64_t> face,
+                   OutRows<T, 3> barycentric, unsigned threads) const {
         expect_rows(t, origins.shape(0), "t");
         expect_rows(face, origins.shape(0), "face");
         expect_rows(barycentric, origins.shape(0), "barycentric");
@@ -183,13 +184,11 @@ class Scene {
                        op[i] = sdf_->signed_distance(p, scratch).distance;
                    });
         } else if (sign == "winding_number") {
-            points(pts, threads, true, true,
-                   [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
-                       const MeshPoint<T> c = sdf_->closest_point_mesh().closest_point(p, scratch);
-                       const T d = c ? std::sqrt(c.distance_squared)
-                                     : std::numeric_limits<T>::infinity();
-                       op[i] = winding_->inside(p) ? -d : d;
-                   });
+            points(pts, threads, true, true, [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
+                const MeshPoint<T> c = sdf_->closest_point_mesh().closest_point(p, scratch);
+                const T d = c ? std::sqrt(c.distance_squared) : std::numeric_limits<T>::infinity();
+                op[i] = winding_->inside(p) ? -d : d;
+            });
         } else {
             throw Error("sign: '" + sign + "' is not one of 'pseudonormal', 'winding_number'");
         }
@@ -205,8 +204,8 @@ class Scene {
 
     void refit(const Rows<T, 3>& vertices) {
         if (vertices.shape(0) != mesh_.vertices.size())
-            throw Error("vertices: " + std::to_string(vertices.shape(0)) +
-                        " rows, the scene has " + std::to_string(mesh_.vertices.size()));
+            throw Error("vertices: " + std::to_string(vertices.shape(0)) + " rows, the scene has " +
+                        std::to_string(mesh_.vertices.size()));
         const T* v = vertices.data();
         nb::gil_scoped_release release;
         const std::unique_lock<std::shared_mutex> lock(mutex_);
@@ -291,7 +290,8 @@ class Scene {
 template <class T>
 void bind_scene_type(nb::module_& m, const char* name) {
     using S = Scene<T>;
-    nb::class_<S>(m, name, "A triangle mesh ready for ray and proximity queries (see bvhkit.TriangleMesh).")
+    nb::class_<S>(m, name,
+                  "A triangle mesh ready for ray and proximity queries (see bvhkit.TriangleMesh).")
         .def(nb::init<const Rows<T, 3>&, const Faces&, const std::string&, const std::string&,
                       unsigned>(),
              nb::arg("vertices"), nb::arg("faces"), nb::arg("builder"), nb::arg("ray_test"),
@@ -303,12 +303,11 @@ void bind_scene_type(nb::module_& m, const char* name) {
              nb::arg("tree"), nb::arg("sdf").none(), nb::arg("winding").none(),
              "Loads the scene from the parts state() gave (nothing is rebuilt).")
         .def("state", &S::state, "The mesh and the built trees' files, for saving.")
-        .def("intersect", &S::intersect, nb::arg("origins"), nb::arg("directions"),
-             nb::arg("tmin"), nb::arg("tmax"), nb::arg("t"), nb::arg("face"),
-             nb::arg("barycentric"), nb::arg("threads"),
-             "Closest hit of each ray into the output arrays.")
-        .def("occluded", &S::occluded, nb::arg("origins"), nb::arg("directions"),
-             nb::arg("tmin"), nb::arg("tmax"), nb::arg("out"), nb::arg("threads"),
+        .def("intersect", &S::intersect, nb::arg("origins"), nb::arg("directions"), nb::arg("tmin"),
+             nb::arg("tmax"), nb::arg("t"), nb::arg("face"), nb::arg("barycentric"),
+             nb::arg("threads"), "Closest hit of each ray into the output arrays.")
+        .def("occluded", &S::occluded, nb::arg("origins"), nb::arg("directions"), nb::arg("tmin"),
+             nb::arg("tmax"), nb::arg("out"), nb::arg("threads"),
              "Whether each ray hits anything within [tmin, tmax].")
         .def("count_intersections", &S::count_intersections, nb::arg("origins"),
              nb::arg("directions"), nb::arg("tmin"), nb::arg("tmax"), nb::arg("out"),

@@ -1,7 +1,7 @@
 #pragma once
 // BuildOptions: one struct chooses the builder and its parameters. The default, binned SAH with 16
-// bins, is the right choice for ray tracing; the others are there to compare and to teach (seed
-// 001).
+// bins, is the right choice for ray tracing; the others (the classic top-down rules, bottom-up
+// clustering, insertion, the Morton-code hierarchy) are there to compare and to teach.
 #include <cstdint>
 #include <string_view>
 #include <vector>
