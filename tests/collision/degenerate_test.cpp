@@ -7,6 +7,7 @@
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/query/self_collision.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
+#include "bvhkit/volumes/convex_hull.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
 #include "bvhkit/volumes/rss.hpp"
@@ -151,6 +152,7 @@ TEST(Degenerate, IdenticalPosesTouchEverywhere) {
     check_identity<Obb<float>>(m);
     check_identity<Rss<float>>(m);
     check_identity<Kdop<float, 18>>(m);
+    check_identity<ConvexHull<float>>(m);
 }
 
 /// A tetrahedron and a copy placed by an exact translation so that they touch at one vertex, or
@@ -197,6 +199,7 @@ TEST(Degenerate, TouchingAtAVertexOrAnEdge) {
     check_touching<Rss<float>>();
     check_touching<Kdop<float, 14>>();
     check_touching<Kdop<float, 26>>();
+    check_touching<ConvexHull<float>>();
 }
 
 TEST(Degenerate, ZeroAreaTrianglesCollideAsSegmentsAndPoints) {

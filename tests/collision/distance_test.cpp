@@ -6,6 +6,7 @@
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
+#include "bvhkit/volumes/convex_hull.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
 #include "bvhkit/volumes/rss.hpp"
@@ -81,6 +82,7 @@ void check_all(const TriangleMesh& fa, const TriangleMesh& fb, std::size_t count
     check_distance<Obb<double>>(ma, mb, poses, truth);
     check_distance<Rss<double>>(ma, mb, poses, truth);
     check_distance<Kdop<double, 18>>(ma, mb, poses, truth);
+    check_distance<ConvexHull<double>>(ma, mb, poses, truth);
     std::printf("[ distance ] %zu separated poses\n", poses.size());
 }
 
@@ -166,6 +168,7 @@ TEST(Refit, EveryVolumeMatchesRebuild) {
     check_refit<Kdop<float, 14>>(m);
     check_refit<Kdop<float, 18>>(m);
     check_refit<Kdop<float, 26>>(m);
+    check_refit<ConvexHull<float>>(m);
 }
 
 TEST(Refit, RejectsAnotherMesh) {
@@ -212,6 +215,8 @@ TEST(Volumes, PromisesHold) {
     check_volume_promises<Kdop<double, 14>>();
     check_volume_promises<Kdop<double, 18>>();
     check_volume_promises<Kdop<double, 26>>();
+    check_volume_promises<ConvexHull<double>>();
+    check_volume_promises<ConvexHull<double, 4>>();  // capped: the swept margin at work
 }
 
 // Rss: every vertex lies within the radius of the rectangle, and the rectangle distance (the

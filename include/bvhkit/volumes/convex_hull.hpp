@@ -1,0 +1,286 @@
+#pragma once
+// ConvexHull<T, Cap>: the tightest bounding volume of the classic list, the convex hull of a node's
+// vertices, with at most Cap vertices so that every node has the same size.
+//
+// Fitting. A node with at most Cap distinct vertices keeps them all: its volume is their exact
+// hull. A larger node takes the vertices of its hull (Quickhull, volumes/quickhull.hpp, exact
+// orientation tests), keeps Cap of them, and is swept by a sphere of radius `margin` that covers
+// what was dropped: the volume is conv(kept) + ball(margin), with margin the largest distance of a
+// dropped hull vertex to conv(kept). That covers every vertex of the node: the distance to a
+// convex set is a convex function, so over conv(hull vertices) it is largest at a vertex. The kept
+// vertices are chosen greedily, each time the one farthest from the hull of those kept so far
+// (starting from the extremes along x, y and z), which keeps margin small. Distances come from
+// GJK in double and are rounded up, so the volume is conservative.
+//
+// Tests. Two hulls are apart when some direction v separates them by more than both margins and
+// the slack: min over A of v.a - max over B of v.b > (margin_a + margin_b + slack) |v|. GJK
+// (Gilbert, Johnson and Keerthi 1988; volumes/gjk.hpp) searches the direction, but the decision is
+// taken on the support values alone with a bound on their rounding, so no rounding in GJK can make
+// two meeting volumes "apart". A bounding-sphere test goes first. The same support values give the
+// distance lower bound. Under a pose, B's points are moved on the fly (B's directions are taken
+// into B's frame once per step: v . (R b + t) = (R^T v) . b + v . t).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <queue>
+#include <span>
+#include <vector>
+
+#include "bvhkit/volumes/bounding_volume.hpp"
+#include "bvhkit/volumes/gjk.hpp"
+#include "bvhkit/volumes/quickhull.hpp"
+
+namespace bvhkit {
+
+template <class T, std::size_t Cap = 16>
+struct ConvexHull {
+    static_assert(Cap >= 4, "a hull needs room for a tetrahedron");
+    using Scalar = T;
+    static constexpr std::size_t capacity = Cap;
+
+    std::array<Vec<T, 3>, Cap> points{};  // the kept vertices; the first `count` are used
+    std::uint32_t count = 0;              // 0: empty (meets nothing)
+    T margin = 0;                         // radius of the sphere swept over conv(points)
+    Vec<T, 3> center{};                   // centre of the points' box
+    T reach = 0;  // half the points' box diagonal + margin: a bounding sphere's radius
+
+    bool is_empty() const { return count == 0; }
+    std::span<const Vec<T, 3>> vertices() const { return {points.data(), count}; }
+};
+
+namespace hull_detail {
+
+/// An upper bound of the distance from p to conv(s), by GJK in double; the nearest point found is
+/// a convex combination of s, so its distance can only be too large (the rounding of the
+/// combination is added).
+template <class T>
+double distance_to_hull(const Vec<T, 3>& p, std::span<const Vec<T, 3>> s) {
+    const Vec<double, 3> q(p);
+    GjkSimplex<double> simplex;
+    Vec<double, 3> v = Vec<double, 3>(s[0]) - q;
+    double scale = length(q);
+    for (int step = 0; step < 64; ++step) {
+        std::size_t best = 0;
+        double low = std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < s.size(); ++i) {
+            const double d = dot(v, Vec<double, 3>(s[i]));
+            if (d < low) {
+                low = d;
+                best = i;
+            }
+        }
+        const Vec<double, 3> a(s[best]);
+        scale = std::max(scale, length(a));
+        const Vec<double, 3> w = a - q;
+        const double v2 = length_squared(v);
+        if (step > 0 && v2 - dot(v, w) <= 1e-12 * v2) break;
+        simplex.add(w, a);
+        bool inside = false;
+        v = simplex.nearest(inside);
+        if (inside) return 16 * std::numeric_limits<double>::epsilon() * scale;
+        if (length_squared(v) == 0) break;
+    }
+    // The combination's point, recomputed from the weights (clamped, normalised).
+    Vec<double, 3> x{};
+    double total = 0;
+    const auto weights = simplex.weights();
+    for (std::size_t i = 0; i < weights.size(); ++i) {
+        const double l = std::max(weights[i], 0.0);
+        x += simplex.point_a(i) * l;
+        total += l;
+    }
+    if (!(total > 0)) return length(Vec<double, 3>(s[0]) - q) * (1 + 1e-15) + 1e-15 * scale;
+    x = x * (1 / total);
+    return length(q - x) * (1 + 1e-15) + 16 * std::numeric_limits<double>::epsilon() * scale;
+}
+
+/// Rounds a non-negative double up to T.
+template <class T>
+T round_up(double x) {
+    T y = T(x);
+    if (double(y) < x) y = std::nextafter(y, std::numeric_limits<T>::infinity());
+    return y;
+}
+
+/// `cap` of the hull vertices `hull`: the extremes along the axes, then greedily the vertex
+/// farthest from the hull of those kept (distances only shrink as vertices are kept, so a stale
+/// distance is an upper bound and the candidates wait in a max-heap until their turn). Adds the
+/// largest distance of a vertex left out to `margin`.
+template <class T>
+std::vector<std::uint32_t> select_farthest(std::span<const Vec<T, 3>> points,
+                                           const std::vector<std::uint32_t>& hull, std::size_t cap,
+                                           double& margin) {
+    std::vector<std::uint32_t> keep;
+    std::vector<Vec<T, 3>> kept;
+    auto take = [&](std::uint32_t i) {
+        if (keep.size() == cap || std::find(keep.begin(), keep.end(), i) != keep.end()) return;
+        keep.push_back(i);
+        kept.push_back(points[i]);
+    };
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+        auto [lo, hi] = std::minmax_element(hull.begin(), hull.end(), [&](auto a, auto b) {
+            return points[a][axis] < points[b][axis];
+        });
+        take(*lo);
+        take(*hi);
+    }
+    using Entry = std::pair<double, std::uint32_t>;
+    std::priority_queue<Entry> heap;
+    for (std::uint32_t i : hull)
+        if (std::find(keep.begin(), keep.end(), i) == keep.end())
+            heap.push({std::numeric_limits<double>::infinity(), i});
+    while (keep.size() < cap && !heap.empty()) {
+        const std::uint32_t i = heap.top().second;
+        heap.pop();
+        const double d = distance_to_hull<T>(points[i], kept);
+        if (d <= 0) continue;
+        if (heap.empty() || d >= heap.top().first)
+            take(i);
+        else
+            heap.push({d, i});
+    }
+    double worst = 0;
+    while (!heap.empty()) {
+        worst = std::max(worst, distance_to_hull<T>(points[heap.top().second], kept));
+        heap.pop();
+    }
+    margin += worst;
+    return keep;
+}
+
+/// The hull volume of `points` (sorted, unique), swept by at least `margin`.
+template <class T, std::size_t Cap>
+ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin) {
+    ConvexHull<T, Cap> v;
+    if (points.empty()) return v;
+    std::vector<std::uint32_t> keep;
+    if (points.size() <= Cap) {
+        for (std::uint32_t i = 0; i < points.size(); ++i) keep.push_back(i);
+    } else {
+        const std::vector<std::uint32_t> hull = quickhull_vertices(points);
+        keep = hull.size() <= Cap ? hull : select_farthest<T>(points, hull, Cap, margin);
+    }
+    Aabb<T, 3> box;
+    for (std::uint32_t i : keep) {
+        v.points[v.count++] = points[i];
+        box.grow(points[i]);
+    }
+    v.margin = margin > 0 ? round_up<T>(margin) : T(0);
+    v.center = box.centroid();
+    // The box's half diagonal: it holds every kept vertex, and it never shrinks when volumes
+    // merge, so size() grows from child to parent.
+    const double half = length(Vec<double, 3>(box.max) - Vec<double, 3>(box.min)) * 0.5;
+    v.reach = round_up<T>((half + double(v.margin)) * (1 + 1e-12)) * (T(1) + detail::fit_pad<T>);
+    return v;
+}
+
+/// Sorted, unique copy of `points`.
+template <class T>
+std::vector<Vec<T, 3>> sorted_unique(std::vector<Vec<T, 3>> points) {
+    std::sort(points.begin(), points.end(), lexicographic_less<T>);
+    points.erase(std::unique(points.begin(), points.end()), points.end());
+    return points;
+}
+
+}  // namespace hull_detail
+
+template <class T, std::size_t Cap>
+struct VolumeTraits<ConvexHull<T, Cap>> {
+    using V = ConvexHull<T, Cap>;
+    using Prepared = PreparedPose<T>;
+    static constexpr bool merge_is_tight = false;
+
+    static V fit(std::span<const Triangle<T>> tris) {
+        std::vector<Vec<T, 3>> points;
+        points.reserve(3 * tris.size());
+        for (const auto& t : tris) {
+            points.push_back(t.p0);
+            points.push_back(t.p1);
+            points.push_back(t.p2);
+        }
+        points = hull_detail::sorted_unique(std::move(points));
+        return hull_detail::hull_of<T, Cap>(points, 0.0);
+    }
+    /// conv(A) + ball(ra) and conv(B) + ball(rb) both lie in conv(A u B) + ball(max(ra, rb)).
+    static V merge(const V& a, const V& b) {
+        if (a.is_empty()) return b;
+        if (b.is_empty()) return a;
+        std::vector<Vec<T, 3>> points(a.points.begin(), a.points.begin() + a.count);
+        points.insert(points.end(), b.points.begin(), b.points.begin() + b.count);
+        points = hull_detail::sorted_unique(std::move(points));
+        return hull_detail::hull_of<T, Cap>(points, double(std::max(a.margin, b.margin)));
+    }
+    static Prepared prepare(const Transform<T>& pose, T slack) { return {pose, slack}; }
+    static bool overlaps(const V& a, const V& b) {
+        return overlaps(a, b, prepare(Transform<T>::identity(), T(0)));
+    }
+    static bool overlaps(const V& a, const V& b, const Prepared& p) {
+        if (a.is_empty() || b.is_empty()) return false;
+        return search(a, b, p, true) <= T(0);
+    }
+    static T size(const V& v) { return v.reach * v.reach; }
+    static T distance_lower_bound(const V& a, const V& b, const Prepared& p) {
+        if (a.is_empty() || b.is_empty()) return T(0);
+        return std::max(T(0), search(a, b, p, false));
+    }
+
+  private:
+    /// The largest certified separation of the two volumes found (<= 0: none). `decide`: stop at
+    /// the first positive one, or as soon as the cores are seen to lie closer than the margins.
+    static T search(const V& a, const V& b, const Prepared& p, bool decide) {
+        constexpr T eps = std::numeric_limits<T>::epsilon();
+        const T inflate = a.margin + b.margin + p.slack;
+        const Vec<T, 3> cb = p.r * b.center + p.t;
+        // A bound on the rounding of every support value below, per unit of |v|.
+        const T err =
+            T(16) * eps * (length(a.center) + a.reach + length(b.center) + b.reach + length(p.t));
+        Vec<T, 3> v = a.center - cb;
+        T best = length(v) - a.reach - b.reach - p.slack - err;
+        if (decide && best > T(0)) return best;
+        if (!(length_squared(v) > T(0))) v = {T(1), T(0), T(0)};
+        GjkSimplex<T> simplex;
+        for (int step = 0; step < 32; ++step) {
+            const Vec<T, 3> u = p.r.transpose_times(v);
+            std::uint32_t ia = 0, ib = 0;
+            T ha = dot(v, a.points[0]), hb = dot(u, b.points[0]);
+            for (std::uint32_t i = 1; i < a.count; ++i) {
+                const T d = dot(v, a.points[i]);
+                if (d < ha) {
+                    ha = d;
+                    ia = i;
+                }
+            }
+            for (std::uint32_t j = 1; j < b.count; ++j) {
+                const T d = dot(u, b.points[j]);
+                if (d > hb) {
+                    hb = d;
+                    ib = j;
+                }
+            }
+            hb += dot(v, p.t);
+            const T len = length(v);
+            // The gap along v / |v|, made smaller by every rounding it may hold.
+            const T gap = (ha - hb - err * len) / (len * (T(1) + T(8) * eps)) - inflate;
+            if (gap > best) {
+                best = gap;
+                if (decide && best > T(0)) return best;
+            }
+            const Vec<T, 3> w = a.points[ia] - (p.r * b.points[ib] + p.t);
+            const T v2 = len * len;
+            if (step > 0 && v2 - dot(v, w) <= T(1e-4) * v2) break;  // as close as it gets
+            simplex.add(w, a.points[ia]);
+            bool inside = false;
+            v = simplex.nearest(inside);
+            if (inside || !(length_squared(v) > T(0))) break;
+            // The cores are within the margins of each other: the volumes meet.
+            if (decide && length(v) < inflate) break;
+        }
+        return best;
+    }
+};
+
+using ConvexHullf = ConvexHull<float, 16>;
+
+}  // namespace bvhkit

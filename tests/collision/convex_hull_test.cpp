@@ -1,0 +1,331 @@
+// The convex-hull volume and its parts, against references that share none of their arithmetic:
+// Quickhull's vertices against exact support values (floating-point expansions) along many
+// directions; GJK's point-to-hull distance against a long-double nearest point over every triangle
+// of the point set; the capped volume's containment of every vertex it was fitted to. Hard point
+// sets in every test: cube grids (many coplanar and collinear points), flat and collinear sets,
+// slivers, points far from the origin, tiny and huge scales.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bvhkit/io/read_mesh.hpp"
+#include "bvhkit/math/predicates.hpp"
+#include "bvhkit/math/random.hpp"
+#include "bvhkit/query/collision_model.hpp"
+#include "bvhkit/volumes/convex_hull.hpp"
+#include "test_support.hpp"
+
+namespace bvhkit::test {
+namespace {
+
+using Points = std::vector<Vec3f>;
+
+/// Sign of d.p - d.q, exactly: each term d_i (p_i - q_i) as a floating-point expansion.
+int compare_along(const Vec3d& d, const Vec3f& p, const Vec3f& q) {
+    exact::Expansion<4> t[3];
+    for (int i = 0; i < 3; ++i) exact::scale(exact::difference(p[i], q[i]), d[i], t[i]);
+    exact::Expansion<8> two;
+    exact::sum(t[0], t[1], two);
+    exact::Expansion<12> all;
+    exact::sum(two, t[2], all);
+    return exact::sign(all);
+}
+
+/// Every direction's extreme point of the whole set is matched by a hull vertex, exactly.
+void expect_supports_match(const Points& sorted, const std::vector<std::uint32_t>& hull,
+                           SplitMix64& rng, const char* what) {
+    ASSERT_FALSE(hull.empty()) << what;
+    for (int k = 0; k < 200; ++k) {
+        Vec3d d;
+        for (int i = 0; i < 3; ++i) d[i] = rng.uniform(-1, 1);
+        if (k < 6) {  // the axes first
+            d = Vec3d(0.0);
+            d[k % 3] = k < 3 ? 1 : -1;
+        }
+        Vec3f all = sorted[0], kept = sorted[hull[0]];
+        for (const Vec3f& p : sorted)
+            if (compare_along(d, p, all) > 0) all = p;
+        for (std::uint32_t i : hull)
+            if (compare_along(d, sorted[i], kept) > 0) kept = sorted[i];
+        ASSERT_EQ(compare_along(d, all, kept), 0) << what << ": direction " << k;
+    }
+}
+
+Points sorted_unique(Points p) {
+    return hull_detail::sorted_unique(std::move(p));
+}
+
+Points cube_grid(int n, Vec3f origin, float step) {
+    Points p;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+            for (int k = 0; k < n; ++k)
+                p.push_back(origin + Vec3f(float(i), float(j), float(k)) * step);
+    return p;
+}
+
+TEST(Quickhull, HullVerticesHoldEveryPointExactly) {
+    SplitMix64 rng(5);
+    // A cube grid: 8 corners, everything else on faces, edges or inside.
+    {
+        const Points g = sorted_unique(cube_grid(6, Vec3f(0.0f), 1.0f));
+        const auto h = quickhull_vertices<float>(g);
+        EXPECT_EQ(h.size(), 8u);
+        expect_supports_match(g, h, rng, "grid");
+    }
+    // Far from the origin (1e6 offsets, unit spacing: float steps of 1/16) and tiny.
+    for (float offset : {1e6f, -3e5f}) {
+        const Points g = sorted_unique(cube_grid(5, Vec3f(offset, -offset, offset), 0.0625f * 16));
+        expect_supports_match(g, quickhull_vertices<float>(g), rng, "far");
+    }
+    {
+        const Points g = sorted_unique(cube_grid(4, Vec3f(1e-6f), 1e-7f));
+        EXPECT_EQ(quickhull_vertices<float>(g).size(), 8u);
+    }
+    // Random clouds (inside a ball, on a sphere), random sizes, huge and tiny scales.
+    for (int trial = 0; trial < int(scaled(60, 10)); ++trial) {
+        const double scale = std::pow(10.0, rng.uniform(-6, 6));
+        const bool on_sphere = trial % 2 == 0;
+        Points p;
+        const std::size_t n = 4 + rng.below(400);
+        for (std::size_t i = 0; i < n; ++i) {
+            Vec3d q(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+            if (on_sphere) q = normalize(q);
+            p.push_back(Vec3f(q * scale));
+        }
+        const Points s = sorted_unique(p);
+        const auto h = quickhull_vertices<float>(s);
+        expect_supports_match(s, h, rng, on_sphere ? "sphere" : "ball");
+        if (on_sphere) {
+            EXPECT_GE(h.size(), s.size() * 9 / 10) << "almost all are vertices";
+        }
+    }
+}
+
+TEST(Quickhull, FlatAndThinSets) {
+    SplitMix64 rng(6);
+    // Coplanar points in a tilted plane: a 2D hull.
+    Points flat;
+    const Vec3f u(1, 2, 0.5f), v(-0.25f, 0.5f, 3);
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) flat.push_back(u * float(i) + v * float(j));
+    flat = sorted_unique(flat);
+    const auto hf = quickhull_vertices<float>(flat);
+    EXPECT_EQ(hf.size(), 4u);
+    expect_supports_match(flat, hf, rng, "flat");
+    // Collinear: the two ends.
+    Points line;
+    for (int i = 0; i < 30; ++i) line.push_back(Vec3f(1, -2, 3) * float(i) + Vec3f(7, 7, 7));
+    line = sorted_unique(line);
+    const auto hl = quickhull_vertices<float>(line);
+    EXPECT_EQ(hl.size(), 2u);
+    expect_supports_match(line, hl, rng, "line");
+    // A needle and a sliver: nearly collinear and nearly coplanar sets.
+    Points needle, sliver;
+    for (int i = 0; i < 200; ++i) {
+        const float t = float(rng.uniform(0, 1000));
+        needle.push_back(
+            Vec3f(t, t * 1e-6f * float(rng.uniform(-1, 1)), float(rng.uniform(0, 1e-3))));
+        sliver.push_back(Vec3f(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)),
+                               float(rng.uniform(-1e-6, 1e-6))));
+    }
+    needle = sorted_unique(needle);
+    sliver = sorted_unique(sliver);
+    expect_supports_match(needle, quickhull_vertices<float>(needle), rng, "needle");
+    expect_supports_match(sliver, quickhull_vertices<float>(sliver), rng, "sliver");
+    // Few points.
+    for (std::size_t n = 1; n <= 4; ++n) {
+        Points p(sliver.begin(), sliver.begin() + n);
+        EXPECT_EQ(quickhull_vertices<float>(p).size(), n);
+    }
+}
+
+/// Distance from p to triangle (a, b, c) in long double, by the plane when p projects inside and
+/// by the three edges otherwise.
+long double point_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+    using L = long double;
+    auto seg = [&](const Vec3d& s, const Vec3d& e) {
+        L t = 0, len2 = 0;
+        for (int i = 0; i < 3; ++i) {
+            t += (L(p[i]) - s[i]) * (L(e[i]) - s[i]);
+            len2 += (L(e[i]) - s[i]) * (L(e[i]) - s[i]);
+        }
+        t = len2 > 0 ? std::clamp(t / len2, L(0), L(1)) : L(0);
+        L d2 = 0;
+        for (int i = 0; i < 3; ++i) {
+            const L x = L(s[i]) + t * (L(e[i]) - s[i]) - p[i];
+            d2 += x * x;
+        }
+        return std::sqrt(d2);
+    };
+    L best = std::min({seg(a, b), seg(b, c), seg(c, a)});
+    L ab[3], ac[3], ap[3], n[3];
+    for (int i = 0; i < 3; ++i) {
+        ab[i] = L(b[i]) - a[i];
+        ac[i] = L(c[i]) - a[i];
+        ap[i] = L(p[i]) - a[i];
+    }
+    n[0] = ab[1] * ac[2] - ab[2] * ac[1];
+    n[1] = ab[2] * ac[0] - ab[0] * ac[2];
+    n[2] = ab[0] * ac[1] - ab[1] * ac[0];
+    const L n2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    if (n2 > 0) {
+        // Barycentrics of the projection, by the sub-triangle normals.
+        auto side = [&](const L* e0, const L* e1) {
+            const L m[3] = {e0[1] * e1[2] - e0[2] * e1[1], e0[2] * e1[0] - e0[0] * e1[2],
+                            e0[0] * e1[1] - e0[1] * e1[0]};
+            return m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
+        };
+        L bp[3], bc[3], cp[3], ca[3];
+        for (int i = 0; i < 3; ++i) {
+            bp[i] = L(p[i]) - b[i];
+            bc[i] = L(c[i]) - b[i];
+            cp[i] = L(p[i]) - c[i];
+            ca[i] = L(a[i]) - c[i];
+        }
+        if (side(ab, ap) >= 0 && side(bc, bp) >= 0 && side(ca, cp) >= 0)
+            best = std::min(best,
+                            std::fabs(ap[0] * n[0] + ap[1] * n[1] + ap[2] * n[2]) / std::sqrt(n2));
+    }
+    return best;
+}
+
+/// p lies in the hull of s when it lies in a tetrahedron of four of its points (Caratheodory),
+/// decided by exact orientations.
+bool inside_some_tetrahedron(const Vec3d& p, const std::vector<Vec3d>& s) {
+    const std::size_t n = s.size();
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j)
+            for (std::size_t k = j + 1; k < n; ++k)
+                for (std::size_t l = k + 1; l < n; ++l) {
+                    const Vec3d c[4] = {s[i], s[j], s[k], s[l]};
+                    const int whole = orient3d_sign(c[0], c[1], c[2], c[3]);
+                    if (whole == 0) continue;
+                    bool in = true;
+                    for (int f = 0; f < 4 && in; ++f) {
+                        Vec3d q[4] = {c[0], c[1], c[2], c[3]};
+                        q[f] = p;  // p in place of one corner: same orientation or flat
+                        const int o = orient3d_sign(q[0], q[1], q[2], q[3]);
+                        in = o == 0 || o == whole;
+                    }
+                    if (in) return true;
+                }
+    return false;
+}
+
+TEST(Gjk, PointToHullIsAnUpperBoundAndTight) {
+    SplitMix64 rng(8);
+    for (int trial = 0; trial < int(scaled(400, 40)); ++trial) {
+        const std::size_t n = 1 + rng.below(9);
+        const double scale = std::pow(10.0, rng.uniform(-4, 4));
+        const Vec3d offset = trial % 3 == 0 ? Vec3d(1e4, -2e4, 3e3) * scale : Vec3d(0.0);
+        std::vector<Vec3d> s;
+        for (std::size_t i = 0; i < n; ++i) {
+            Vec3d q(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+            if (trial % 4 == 1) q[2] *= 1e-7;  // a sliver
+            s.push_back(offset + q * scale);
+        }
+        Vec3d p =
+            offset + Vec3d(rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-3, 3)) * scale;
+        if (trial % 5 == 2) {  // the centroid: inside (or on a flat set)
+            p = Vec3d(0.0);
+            for (const Vec3d& q : s) p = p + q * (1.0 / double(n));
+        }
+        // The hull's boundary is covered by the triangles of its points, and every such triangle
+        // lies in the hull: for p outside, the least triangle distance is the distance.
+        long double brute = std::numeric_limits<long double>::infinity();
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t j = i; j < n; ++j)
+                for (std::size_t k = j; k < n; ++k)
+                    brute = std::min(brute, point_triangle(p, s[i], s[j], s[k]));
+        const double got = hull_detail::distance_to_hull<double>(p, s);
+        const double tol = 1e-9 * (length(offset) + scale);
+        if (inside_some_tetrahedron(p, s)) {
+            ASSERT_LE(got, tol) << "trial " << trial;
+            continue;
+        }
+        // Outside: the least triangle distance is the distance, and GJK may only be above it.
+        ASSERT_GE(got, double(brute) * (1 - 1e-9) - tol) << "trial " << trial;
+        ASSERT_NEAR(got, double(brute), 1e-6 * double(brute) + tol) << "trial " << trial;
+    }
+}
+
+/// Along many directions (the axes, the cube's diagonals, random ones), no point reaches past the
+/// volume: d.p <= max over the kept vertices of d.q + margin, in long double with a margin far
+/// below the volume's own rounding allowance.
+void expect_covers(const ConvexHull<float, 16>& v, const Points& points, SplitMix64& rng,
+                   const std::string& what) {
+    using L = long double;
+    auto along = [](const Vec3d& d, const Vec3f& p) {
+        return L(d[0]) * p[0] + L(d[1]) * p[1] + L(d[2]) * p[2];
+    };
+    for (int k = 0; k < 100; ++k) {
+        Vec3d d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+        if (k < 26) d = Vec3d(double(k % 3) - 1, double(k / 3 % 3) - 1, double(k / 9 % 3) - 1);
+        if (length(d) == 0) continue;
+        d = normalize(d);
+        L core = -std::numeric_limits<L>::infinity(), all = core, size = 0;
+        for (const Vec3f& q : v.vertices()) core = std::max(core, along(d, q));
+        for (const Vec3f& p : points) {
+            all = std::max(all, along(d, p));
+            size = std::max(size, L(length(Vec3d(p))));
+        }
+        ASSERT_LE(all, core + v.margin + 1e-12L * size) << what << ": direction " << k;
+    }
+}
+
+TEST(ConvexHullVolume, EveryNodeCoversItsVertices) {
+    BVHKIT_REQUIRE_MESH(path, "suzanne.obj");
+    SplitMix64 rng(10);
+    const auto m = read_mesh(path);
+    const CollisionModel<ConvexHull<float, 16>> model(m);
+    const auto& bvh = model.bvh();
+    const auto runs = node_slot_runs(bvh);
+    const auto tris = model.slot_triangles();
+    std::size_t capped = 0;
+    for (std::size_t n = 0; n < bvh.nodes.size(); n += (n < 64 ? 1 : 5)) {
+        const auto& v = bvh.nodes[n].bounds;
+        ASSERT_GE(v.count, 1u);
+        ASSERT_LE(v.count, 16u);
+        capped += v.margin > 0;
+        Points points;
+        for (std::uint32_t t = runs[n].first; t < runs[n].second; ++t)
+            points.insert(points.end(), {tris[t].p0, tris[t].p1, tris[t].p2});
+        expect_covers(v, points, rng, "node " + std::to_string(n));
+        if (points.size() <= 16) {
+            EXPECT_EQ(v.margin, 0.0f) << "small nodes are exact";
+        }
+    }
+    EXPECT_GT(capped, 0u) << "the large nodes need the swept margin";
+}
+
+TEST(ConvexHullVolume, HardPointSetsAreCovered) {
+    SplitMix64 rng(12);
+    std::vector<std::pair<std::string, Points>> sets;
+    sets.push_back({"grid far away", cube_grid(7, Vec3f(1e5f, -1e5f, 3e4f), 0.5f)});
+    sets.push_back({"tiny grid", cube_grid(5, Vec3f(0.0f), 1e-6f)});
+    sets.push_back({"huge grid", cube_grid(5, Vec3f(0.0f), 1e6f)});
+    Points sphere, sliver, needle, flat;
+    for (int i = 0; i < 500; ++i) {
+        const Vec3d r(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+        sphere.push_back(Vec3f(normalize(r) * 3.0));
+        sliver.push_back(Vec3f(float(r[0]), float(r[1] * 1e-5), float(r[2])));
+        needle.push_back(Vec3f(float(r[0] * 1e3), float(r[1] * 1e-4), float(r[2] * 1e-4)));
+        flat.push_back(Vec3f(float(r[0]), float(r[1]), float(r[0] + r[1])));
+    }
+    sets.push_back({"sphere", sphere});
+    sets.push_back({"sliver", sliver});
+    sets.push_back({"needle", needle});
+    sets.push_back({"flat", flat});
+    for (const auto& [name, raw] : sets) {
+        const Points s = sorted_unique(raw);
+        const auto v = hull_detail::hull_of<float, 16>(s, 0.0);
+        EXPECT_LE(v.count, 16u);
+        expect_covers(v, s, rng, name);
+        // The bounding sphere holds everything too.
+        for (const Vec3f& p : s) ASSERT_LE(length(p - v.center), v.reach) << name;
+    }
+}
+
+}  // namespace
+}  // namespace bvhkit::test
