@@ -12,22 +12,17 @@
 #include "args.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/pairs_model.hpp"
-#include "bvhkit/volumes/aabb_volume.hpp"
-#include "bvhkit/volumes/kdop.hpp"
-#include "bvhkit/volumes/obb.hpp"
-#include "bvhkit/volumes/obb_rss.hpp"
-#include "bvhkit/volumes/rss.hpp"
-#include "bvhkit/volumes/sphere.hpp"
 #include "collide_bench.hpp"
 #include "commands.hpp"
 #include "output.hpp"
 #include "pose_file.hpp"
+#include "volume_choice.hpp"
 
 namespace bvhkit::tools {
 namespace {
 
 constexpr const char* kCollideHelp =
-    R"(usage: bvhkit collide MESH_A MESH_B --poses FILE --out FILE [--bv aabb|obb|rss|obbrss|sphere|kdop18]
+    R"(usage: bvhkit collide MESH_A MESH_B --poses FILE --out FILE [--bv aabb|obb|rss|obbrss|sphere|kdop18|hull]
                       [--rule larger|a|b|simultaneous|by-overlap]
 
 For each pose (12 float32: row-major rotation R, translation t; B placed at x' = R x + t in A's
@@ -66,7 +61,7 @@ constexpr const char* kBenchHelp =
 
 Workloads C1 and C2 of docs/workloads.md: the mesh against a copy of itself under N random rigid
 poses (C1: yes/no and all-pairs collision) and the distance at the poses where they do not
-collide (C2), for bvhkit with each volume type (aabb, obb, rss, obbrss, sphere, kdop18) and FCL 0.7
+collide (C2), for bvhkit with each volume type (aabb, obb, rss, obbrss, sphere, kdop18, hull) and FCL 0.7
 (BVHModel<OBBRSS> and <OBB>; FCL has no OBB distance) in this process, one thread each. Times
 are medians of N repetitions interleaved round-robin across the libraries; vs_fcl_best = bvhkit
 queries/s over FCL's best volume type. The agreement of the answers is printed to stderr.
@@ -100,21 +95,8 @@ int collide_command(int argc, char** argv) {
     const DescentRule rule = parse_rule(args.value("--rule", "larger"));
     const std::string bv = args.value("--bv", "aabb");
     std::vector<unsigned char> out;
-    if (bv == "aabb")
-        collide_all<Aabb3f>(ma, mb, poses, rule, out);
-    else if (bv == "obb")
-        collide_all<Obb<float>>(ma, mb, poses, rule, out);
-    else if (bv == "rss")
-        collide_all<Rss<float>>(ma, mb, poses, rule, out);
-    else if (bv == "obbrss")
-        collide_all<ObbRss<float>>(ma, mb, poses, rule, out);
-    else if (bv == "sphere")
-        collide_all<Sphere<float>>(ma, mb, poses, rule, out);
-    else if (bv == "kdop18")
-        collide_all<Kdop<float, 18>>(ma, mb, poses, rule, out);
-    else
-        throw Error("--bv: unknown bounding volume '" + bv +
-                    "' (aabb, obb, rss, obbrss, sphere, kdop18)");
+    with_volume(
+        bv, [&](auto tag) { collide_all<typename decltype(tag)::type>(ma, mb, poses, rule, out); });
     write_bytes(args.value("--out"), out);
     std::size_t colliding = 0, pairs = 0;
     for (std::size_t i = 0; i + 5 <= out.size(); i += 5) {

@@ -9,20 +9,15 @@
 #include "args.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/distance.hpp"
-#include "bvhkit/volumes/aabb_volume.hpp"
-#include "bvhkit/volumes/kdop.hpp"
-#include "bvhkit/volumes/obb.hpp"
-#include "bvhkit/volumes/obb_rss.hpp"
-#include "bvhkit/volumes/rss.hpp"
-#include "bvhkit/volumes/sphere.hpp"
 #include "commands.hpp"
 #include "pose_file.hpp"
+#include "volume_choice.hpp"
 
 namespace bvhkit::tools {
 namespace {
 
 constexpr const char* kHelp =
-    R"(usage: bvhkit distance MESH_A MESH_B --poses FILE --out FILE [--bv rss|obbrss|obb|aabb|sphere|kdop18]
+    R"(usage: bvhkit distance MESH_A MESH_B --poses FILE --out FILE [--bv rss|obbrss|obb|aabb|sphere|kdop18|hull]
 
 For each pose (12 float32: row-major rotation R, translation t; B placed at x' = R x + t in A's
 frame) writes the float32 minimum distance between the two meshes, or -1 where they touch or
@@ -63,21 +58,8 @@ int distance_command(int argc, char** argv) {
     const auto poses = read_pose_file(args.value("--poses"));
     const std::string bv = args.value("--bv", "rss");
     std::vector<unsigned char> out;
-    if (bv == "rss")
-        distance_all<Rss<float>>(ma, mb, poses, out);
-    else if (bv == "obb")
-        distance_all<Obb<float>>(ma, mb, poses, out);
-    else if (bv == "obbrss")
-        distance_all<ObbRss<float>>(ma, mb, poses, out);
-    else if (bv == "aabb")
-        distance_all<Aabb3f>(ma, mb, poses, out);
-    else if (bv == "sphere")
-        distance_all<Sphere<float>>(ma, mb, poses, out);
-    else if (bv == "kdop18")
-        distance_all<Kdop<float, 18>>(ma, mb, poses, out);
-    else
-        throw Error("--bv: unknown bounding volume '" + bv +
-                    "' (rss, obbrss, obb, aabb, sphere, kdop18)");
+    with_volume(bv,
+                [&](auto tag) { distance_all<typename decltype(tag)::type>(ma, mb, poses, out); });
     write_bytes(args.value("--out"), out);
     std::size_t colliding = 0;
     float nearest = std::numeric_limits<float>::infinity();

@@ -9,6 +9,7 @@
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
+#include "bvhkit/volumes/convex_hull.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
 #include "bvhkit/volumes/obb_rss.hpp"
@@ -46,18 +47,30 @@ struct Runner {
     std::function<bool(const Transform<float>&)> collides;
     std::function<std::size_t(const Transform<float>&)> all_pairs;
     std::function<double(const Transform<float>&)> distance;  // empty: not supported
+    // bvhkit only: the model's build time and tree size, and the volume tests of all_pairs calls.
+    double build_ms = 0;
+    std::size_t tree_bytes = 0;
+    std::shared_ptr<std::uint64_t> volume_tests;
 };
 
 template <class V>
 Runner bvhkit_runner(const TriangleMesh& mesh, const char* bv) {
+    const auto t0 = std::chrono::steady_clock::now();
     auto model = std::make_shared<CollisionModel<V>>(mesh);
     auto result = std::make_shared<CollideResult<float>>();
-    Runner r{"bvhkit", bv, {}, {}, {}};
+    Runner r;
+    r.library = "bvhkit";
+    r.bv = bv;
+    r.build_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    r.tree_bytes = model->bvh().nodes.size() * sizeof(model->bvh().nodes[0]);
+    r.volume_tests = std::make_shared<std::uint64_t>(0);
     r.collides = [model](const Transform<float>& p) { return collides(*model, *model, p); };
-    r.all_pairs = [model, result](const Transform<float>& p) {
+    r.all_pairs = [model, result, tests = r.volume_tests](const Transform<float>& p) {
         CollideOptions o;
         o.segments = false;
         collide(*model, *model, p, o, *result);
+        *tests += result->stats.volume_tests;
         return result->contacts.size();
     };
     r.distance = [model](const Transform<float>& p) {
@@ -89,7 +102,9 @@ Runner fcl_runner(const TriangleMesh& mesh, const char* bv, bool with_distance) 
     // The objects hold the model; b's pose is set per query (FCL keeps the pose in the object).
     auto a = std::make_shared<fcl::CollisionObjectd>(model, fcl::Transform3d::Identity());
     auto b = std::make_shared<fcl::CollisionObjectd>(model, fcl::Transform3d::Identity());
-    Runner r{"fcl", bv, {}, {}, {}};
+    Runner r;
+    r.library = "fcl";
+    r.bv = bv;
     r.collides = [a, b](const Transform<float>& p) {
         b->setTransform(to_fcl(p));
         fcl::CollisionRequestd request(1, false);
@@ -151,6 +166,9 @@ std::vector<Row> run_collide_bench(const CollideBenchOptions& options, std::FILE
         runners.push_back(bvhkit_runner<ObbRss<float>>(mesh, "obbrss"));
         runners.push_back(bvhkit_runner<Sphere<float>>(mesh, "sphere"));
         runners.push_back(bvhkit_runner<Kdop<float, 18>>(mesh, "kdop18"));
+        runners.push_back(bvhkit_runner<ConvexHull<float>>(mesh, "hull"));  // 16 vertices
+        runners.push_back(bvhkit_runner<ConvexHull<float, 8>>(mesh, "hull8"));
+        runners.push_back(bvhkit_runner<ConvexHull<float, 32>>(mesh, "hull32"));
 #if BVHKIT_HAVE_FCL
         runners.push_back(fcl_runner<fcl::OBBRSSd>(mesh, "OBBRSS", true));
         runners.push_back(fcl_runner<fcl::OBBd>(mesh, "OBB", false));  // FCL: no OBB distance
@@ -168,6 +186,10 @@ std::vector<Row> run_collide_bench(const CollideBenchOptions& options, std::FILE
                 flags[k][i] = runners[k].collides(poses[i]);
                 pairs[k][i] = runners[k].all_pairs(poses[i]);
             }
+        std::vector<double> tests_per_query(n, 0);
+        for (std::size_t k = 0; k < n; ++k)
+            if (runners[k].volume_tests)
+                tests_per_query[k] = double(*runners[k].volume_tests) / double(poses.size());
         std::vector<Transform<float>> apart;
         for (std::size_t i = 0; i < poses.size(); ++i)
             if (!flags[0][i] &&
@@ -230,6 +252,10 @@ std::vector<Row> run_collide_bench(const CollideBenchOptions& options, std::FILE
                     total_pairs += (long long)pairs[k][i];
                 }
                 row.set("colliding", colliding).set("pairs", total_pairs);
+                if (runners[k].volume_tests)
+                    row.set("build_ms", runners[k].build_ms)
+                        .set("tree_kib", double(runners[k].tree_bytes) / 1024.0)
+                        .set("volume_tests_per_query", tests_per_query[k]);
                 if (runners[k].library == "bvhkit" && fcl_best > 0)
                     row.set("vs_fcl_best", qps / fcl_best);
                 rows.push_back(row);

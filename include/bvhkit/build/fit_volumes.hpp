@@ -6,7 +6,8 @@
 //
 // refit_volumes() is the same fitting after the triangles moved (a deforming mesh), in one reverse
 // pass over the nodes: volumes whose merge is exact (Aabb, Kdop) merge their children; the others
-// (Sphere, Obb) re-fit each node to its run, which is tighter than merging children's volumes.
+// (Sphere, Obb) re-fit each node to its run, which is tighter than merging children's volumes; a
+// volume with a fit_tree() (ConvexHull) fits each parent from data its children kept.
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -38,7 +39,10 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> node_slot_runs(const Bvh<V>
 template <BoundingVolume V>
 void refit_volumes(Bvh<V>& bvh, std::span<const Triangle<typename V::Scalar>> slot_triangles) {
     using Traits = VolumeTraits<V>;
-    if constexpr (Traits::merge_is_tight) {
+    if constexpr (requires { Traits::fit_tree(bvh.nodes, slot_triangles); }) {
+        // The volume fits a parent from what it kept of its children (ConvexHull).
+        Traits::fit_tree(bvh.nodes, slot_triangles);
+    } else if constexpr (Traits::merge_is_tight) {
         for (std::size_t n = bvh.nodes.size(); n-- > 0;) {
             auto& node = bvh.nodes[n];
             node.bounds =

@@ -128,9 +128,14 @@ std::vector<std::uint32_t> select_farthest(std::span<const Vec<T, 3>> points,
     }
     using Entry = std::pair<double, std::uint32_t>;
     std::priority_queue<Entry> heap;
-    for (std::uint32_t i : hull)
-        if (std::find(keep.begin(), keep.end(), i) == keep.end())
-            heap.push({std::numeric_limits<double>::infinity(), i});
+    // First bounds: the distance to the nearest kept vertex (no less than to their hull).
+    for (std::uint32_t i : hull) {
+        if (std::find(keep.begin(), keep.end(), i) != keep.end()) continue;
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const Vec<T, 3>& k : kept)
+            nearest = std::min(nearest, length(Vec<double, 3>(points[i]) - Vec<double, 3>(k)));
+        heap.push({nearest * (1 + 1e-12), i});
+    }
     while (keep.size() < cap && !heap.empty()) {
         const std::uint32_t i = heap.top().second;
         heap.pop();
@@ -141,8 +146,10 @@ std::vector<std::uint32_t> select_farthest(std::span<const Vec<T, 3>> points,
         else
             heap.push({d, i});
     }
+    // The largest distance left out: stale values bound the true ones from above, so the scan
+    // stops at the first one no larger than the largest found.
     double worst = 0;
-    while (!heap.empty()) {
+    while (!heap.empty() && heap.top().first > worst) {
         worst = std::max(worst, distance_to_hull<T>(points[heap.top().second], kept));
         heap.pop();
     }
@@ -150,16 +157,22 @@ std::vector<std::uint32_t> select_farthest(std::span<const Vec<T, 3>> points,
     return keep;
 }
 
-/// The hull volume of `points` (sorted, unique), swept by at least `margin`.
+/// The hull volume of `points` (sorted, unique; `hull_vertices`: already all extreme), swept by
+/// at least `margin`.
 template <class T, std::size_t Cap>
-ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin) {
+ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin,
+                           bool hull_vertices = false) {
     ConvexHull<T, Cap> v;
     if (points.empty()) return v;
     std::vector<std::uint32_t> keep;
     if (points.size() <= Cap) {
         for (std::uint32_t i = 0; i < points.size(); ++i) keep.push_back(i);
     } else {
-        const std::vector<std::uint32_t> hull = quickhull_vertices(points);
+        std::vector<std::uint32_t> hull;
+        if (hull_vertices)
+            for (std::uint32_t i = 0; i < points.size(); ++i) hull.push_back(i);
+        else
+            hull = quickhull_vertices(points);
         keep = hull.size() <= Cap ? hull : select_farthest<T>(points, hull, Cap, margin);
     }
     Aabb<T, 3> box;
@@ -179,7 +192,8 @@ ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin) {
 /// Sorted, unique copy of `points`.
 template <class T>
 std::vector<Vec<T, 3>> sorted_unique(std::vector<Vec<T, 3>> points) {
-    std::sort(points.begin(), points.end(), lexicographic_less<T>);
+    std::sort(points.begin(), points.end(),
+              [](const Vec<T, 3>& a, const Vec<T, 3>& b) { return lexicographic_less(a, b); });
     points.erase(std::unique(points.begin(), points.end()), points.end());
     return points;
 }
@@ -193,15 +207,30 @@ struct VolumeTraits<ConvexHull<T, Cap>> {
     static constexpr bool merge_is_tight = false;
 
     static V fit(std::span<const Triangle<T>> tris) {
-        std::vector<Vec<T, 3>> points;
-        points.reserve(3 * tris.size());
-        for (const auto& t : tris) {
-            points.push_back(t.p0);
-            points.push_back(t.p1);
-            points.push_back(t.p2);
+        return hull_detail::hull_of<T, Cap>(corners(tris), 0.0);
+    }
+    /// Every node of a tree (children after their parent in `nodes`), each from the exact hull
+    /// vertices of its children: the hull of a union is the hull of the parts' hull vertices, so
+    /// no node reads its whole run of triangles again. The volumes are those fit() gives.
+    template <class Nodes>
+    static void fit_tree(Nodes& nodes, std::span<const Triangle<T>> slot_triangles) {
+        std::vector<std::vector<Vec<T, 3>>> hulls(nodes.size());
+        for (std::size_t n = nodes.size(); n-- > 0;) {
+            auto& node = nodes[n];
+            std::vector<Vec<T, 3>> points;
+            if (node.is_leaf()) {
+                points = corners(slot_triangles.subspan(node.first, node.count));
+            } else {
+                for (std::size_t child : {std::size_t(node.left()), std::size_t(node.right())}) {
+                    points.insert(points.end(), hulls[child].begin(), hulls[child].end());
+                    hulls[child] = {};
+                }
+                points = hull_detail::sorted_unique(std::move(points));
+            }
+            for (std::uint32_t i : quickhull_vertices<T>(points)) hulls[n].push_back(points[i]);
+            hulls[n] = hull_detail::sorted_unique(std::move(hulls[n]));
+            node.bounds = hull_detail::hull_of<T, Cap>(hulls[n], 0.0, true);
         }
-        points = hull_detail::sorted_unique(std::move(points));
-        return hull_detail::hull_of<T, Cap>(points, 0.0);
     }
     /// conv(A) + ball(ra) and conv(B) + ball(rb) both lie in conv(A u B) + ball(max(ra, rb)).
     static V merge(const V& a, const V& b) {
@@ -227,6 +256,17 @@ struct VolumeTraits<ConvexHull<T, Cap>> {
     }
 
   private:
+    /// The triangles' corners, sorted, without duplicates.
+    static std::vector<Vec<T, 3>> corners(std::span<const Triangle<T>> tris) {
+        std::vector<Vec<T, 3>> points;
+        points.reserve(3 * tris.size());
+        for (const auto& t : tris) {
+            points.push_back(t.p0);
+            points.push_back(t.p1);
+            points.push_back(t.p2);
+        }
+        return hull_detail::sorted_unique(std::move(points));
+    }
     /// The largest certified separation of the two volumes found (<= 0: none). `decide`: stop at
     /// the first positive one, or as soon as the cores are seen to lie closer than the margins.
     static T search(const V& a, const V& b, const Prepared& p, bool decide) {
