@@ -29,9 +29,10 @@ leaf an empty cell known to be inside or outside).
   --max-depth D     a node at depth D becomes a leaf (default 65536)
   --leaf-size N     a node of at most N polygons becomes a leaf (default 0: split to empty leaves)
   --candidates C    splitter candidates: polygon planes (default), axis-aligned planes, or both
-  --compare         also build the TriangleBvh (binned SAH, double) and trace workload R2 (100,000
-                    random rays from the mesh's box) through both: build time, nodes, memory,
-                    rays per second (one thread) for the closest hit, and hits that differ
+  --compare         also build the TriangleBvh (binned SAH, double) and trace workloads R1 (a
+                    256 x 256 camera) and R2 (100,000 random rays from the mesh's box) through
+                    both: build time, nodes, memory, rays per second (one thread) for the
+                    closest hit, and hits that differ
 MESH is a file (OBJ, PLY, STL) or a generator spec such as torus:u=48,v=24.
 )";
 
@@ -54,15 +55,18 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Adds the BVH's row and both structures' ray throughput on workload R2.
-void compare_with_bvh(const TriangleMesh& mesh, const BspTree<double>& bsp,
-                      std::vector<bench::Row>& rows) {
-    TriangleBvh<double> bvh;
-    const double bvh_ms = bench::median_ms(
-        3, [&] { bvh = TriangleBvh<double>(mesh); }, false);
-    std::vector<Ray<double, 3>> rays;
-    for (const auto& r : random_rays(mesh.bounds(), 100000, 1))
-        rays.emplace_back(Vec<double, 3>(r.origin), Vec<double, 3>(r.direction), r.tmin, r.tmax);
+std::vector<Ray<double, 3>> to_double(const std::vector<Ray3f>& rays) {
+    std::vector<Ray<double, 3>> out;
+    for (const auto& r : rays)
+        out.emplace_back(Vec<double, 3>(r.origin), Vec<double, 3>(r.direction), r.tmin, r.tmax);
+    return out;
+}
+
+// Traces `rays` through both structures (closest hit, one thread) and sets `name`'s columns: rays
+// per second on both rows, the BSP's nodes and polygons per ray, and the rays whose hits differ.
+void trace_both(const char* name, const std::vector<Ray<double, 3>>& rays,
+                const BspTree<double>& bsp, const TriangleBvh<double>& bvh, bench::Row& bsp_row,
+                bench::Row& bvh_row) {
     std::vector<double> bsp_t(rays.size()), bvh_t(rays.size());
     BspRayStats stats;
     auto t0 = std::chrono::steady_clock::now();
@@ -76,10 +80,22 @@ void compare_with_bvh(const TriangleMesh& mesh, const BspTree<double>& bsp,
         if (std::isinf(bsp_t[i]) != std::isinf(bvh_t[i]) ||
             std::abs(bsp_t[i] - bvh_t[i]) > 1e-9 * std::max(1.0, std::abs(bvh_t[i])))
             ++differ;
-    rows[0].set("r2_rays_per_s", double(rays.size()) / bsp_s);
-    rows[0].set("r2_nodes_per_ray", double(stats.nodes_visited) / double(rays.size()));
-    rows[0].set("r2_polys_per_ray", double(stats.polygons_tested) / double(rays.size()));
-    rows[0].set("r2_hits_differ", differ);
+    const std::string n = name;
+    const double count = double(rays.size());
+    bsp_row.set(n + "_rays_per_s", count / bsp_s);
+    bsp_row.set(n + "_nodes_per_ray", double(stats.nodes_visited) / count);
+    bsp_row.set(n + "_polys_per_ray", double(stats.polygons_tested) / count);
+    bsp_row.set(n + "_hits_differ", differ);
+    bvh_row.set(n + "_rays_per_s", count / bvh_s);
+}
+
+// Adds the BVH's row and both structures' ray throughput on workloads R1 (primary rays of a
+// 256 x 256 camera) and R2 (100,000 random rays in the mesh's box).
+void compare_with_bvh(const TriangleMesh& mesh, const BspTree<double>& bsp,
+                      std::vector<bench::Row>& rows) {
+    TriangleBvh<double> bvh;
+    const double bvh_ms = bench::median_ms(
+        3, [&] { bvh = TriangleBvh<double>(mesh); }, false);
     const auto& b = bvh.bvh();
     const std::size_t bytes = b.nodes.size() * sizeof(b.nodes[0]) +
                               b.primitive_indices.size() * sizeof(std::uint32_t) +
@@ -89,7 +105,8 @@ void compare_with_bvh(const TriangleMesh& mesh, const BspTree<double>& bsp,
     row.set("nodes", (long long)b.nodes.size());
     row.set("polygons", (long long)bvh.triangle_count());
     row.set("memory_kib", double(bytes) / 1024.0);
-    row.set("r2_rays_per_s", double(rays.size()) / bvh_s);
+    trace_both("r1", to_double(camera_rays(mesh.bounds(), 256, 256)), bsp, bvh, rows[0], row);
+    trace_both("r2", to_double(random_rays(mesh.bounds(), 100000, 1)), bsp, bvh, rows[0], row);
     rows.push_back(row);
 }
 
