@@ -2,9 +2,12 @@
 // exit, nothing else is printed after an error, and every command says what it did.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "run_cli.hpp"
@@ -66,6 +69,51 @@ TEST(CommandLine, CollideAndDistanceSayWhatTheyDid) {
                           " --out " + temp_file("d.bin").string());
     EXPECT_EQ(d.status, 0) << d.output;
     EXPECT_NE(d.output.find("1 colliding"), std::string::npos) << d.output;
+}
+
+std::string read_all(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Every volume --bv names gives the same answers (the AABB's) on a pose list where some poses
+// touch, and an unknown name is an error that lists the names.
+TEST(CommandLine, EveryVolumeAnswersAlike) {
+    const float poses[3][12] = {{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0},
+                                {0, -1, 0, 1, 0, 0, 0, 0, 1, 1.5f, 0.3f, 0},
+                                {1, 0, 0, 0, 1, 0, 0, 0, 1, 2.5f, 0, 0}};
+    const auto p = temp_file("poses3.bin");
+    std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(poses), sizeof poses);
+    const std::string meshes = "torus sphere:subdiv=2 --poses " + p.string();
+    std::string first_c, first_d;
+    for (const char* bv : {"aabb", "obb", "rss", "obbrss", "sphere", "kdop18", "hull"}) {
+        const auto c = temp_file(std::string("c_") + bv), d = temp_file(std::string("d_") + bv);
+        const Outcome oc = run("collide " + meshes + " --out " + c.string() + " --bv " + bv);
+        const Outcome od = run("distance " + meshes + " --out " + d.string() + " --bv " + bv);
+        ASSERT_EQ(oc.status, 0) << bv << ": " << oc.output;
+        ASSERT_EQ(od.status, 0) << bv << ": " << od.output;
+        if (first_c.empty()) {
+            first_c = read_all(c);
+            first_d = read_all(d);
+            EXPECT_EQ(first_c.size(), 15u);
+            EXPECT_EQ(first_d.size(), 12u);
+            ASSERT_EQ(first_c.size(), 15u);
+            // Both outcomes occur, so the comparison means something.
+            EXPECT_EQ(first_c[0] + first_c[5] + first_c[10], 2) << "colliding flags";
+        }
+        EXPECT_EQ(read_all(c), first_c) << bv;
+        const std::string dd = read_all(d);
+        ASSERT_EQ(dd.size(), first_d.size()) << bv;
+        for (std::size_t k = 0; k < 3; ++k) {
+            float x, y;
+            std::memcpy(&x, dd.data() + 4 * k, 4);
+            std::memcpy(&y, first_d.data() + 4 * k, 4);
+            EXPECT_NEAR(x, y, 1e-5f * (1 + std::fabs(y))) << bv << " pose " << k;
+        }
+    }
+    const Outcome bad = run("collide " + meshes + " --out /dev/null --bv cone");
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.output.find("hull"), std::string::npos) << bad.output;
 }
 
 TEST(CommandLine, DirectoryAsMeshSaysSo) {
