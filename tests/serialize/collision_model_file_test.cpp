@@ -339,6 +339,11 @@ TEST(CollisionModelFile, CorruptedVolumesFailValidate) {
     const std::size_t tris_at = slots_at + (model.slot_triangles().size() * 4 + 7) / 8 * 8;
     expect_error<O>(edited(file, [&](auto& f) { put_f32(f, tris_at, 5.0f); }), "moved triangle",
                     "");
+    // Coordinates the exact triangle tests cannot take: an Error even without validate().
+    for (const float bad :
+         {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()})
+        expect_error<O>(edited(file, [&](auto& f) { put_f32(f, tris_at + 8, bad); }),
+                        "non-finite corner", "not finite", false);
     expect_error<O>(
         edited(file,
                [&](auto& f) { std::memcpy(f.data() + slots_at, f.data() + slots_at + 4, 4); }),

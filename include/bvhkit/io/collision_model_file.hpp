@@ -8,8 +8,9 @@
 //
 // Loading trusts nothing: the envelope (size, checksum), every count against the bytes there are
 // before anything is allocated, the tree's shape and every index (check_tree_structure), the
-// skipped list and the scale's sign, always; then, unless LoadOptions::validate is false, what
-// the builder guarantees: each triangle once (in the tree or skipped), finite triangles, volumes
+// skipped list, the scale's sign and the triangles' coordinates (finite, |x| <= 2^300, what the
+// exact triangle tests need), always; then, unless LoadOptions::validate is false, what the
+// builder guarantees: each triangle once (in the tree or skipped), volumes
 // that are well formed (finite, sizes >= 0, orthonormal axes) and contain every vertex of the
 // triangles under their node (to a tolerance of a few units in the last place of the model's
 // scale: the fits pad for their own rounding, so a fitted volume passes on any machine), and the
@@ -358,6 +359,16 @@ struct CollisionModelAccess {
         check_skipped(skipped, triangle_count, what);
         if (!(std::isfinite(model.scale_) && model.scale_ >= T(0)))
             fail("the scale is negative or not finite");
+        // The exact triangle tests of collide() need finite coordinates whose products cannot
+        // overflow (a NaN there breaks the expansions' bounds): checked always, like an index.
+        constexpr double coordinate_limit = 0x1p300;
+        for (std::size_t s = 0; s < model.slot_triangles_.size(); ++s)
+            for (const Vec<T, 3>& p : {model.slot_triangles_[s].p0, model.slot_triangles_[s].p1,
+                                       model.slot_triangles_[s].p2})
+                for (std::size_t a = 0; a < 3; ++a)
+                    if (!(std::fabs(double(p[a])) <= coordinate_limit))
+                        fail("the triangle in slot " + std::to_string(s) +
+                             " is not finite or beyond 2^300");
         if (options.validate) validate_model(model, fail);
         return model;
     }
@@ -375,9 +386,6 @@ struct CollisionModelAccess {
             if (seen[p]++) fail("triangle " + std::to_string(p) + " is in two slots");
         for (const std::uint32_t p : model.report_.skipped)
             if (seen[p]) fail("triangle " + std::to_string(p) + " is skipped but in the tree");
-        for (std::size_t s = 0; s < tris.size(); ++s)
-            if (!(finite_vec(tris[s].p0) && finite_vec(tris[s].p1) && finite_vec(tris[s].p2)))
-                fail("the triangle in slot " + std::to_string(s) + " is not finite");
         const T scale = CollisionModel<V>::scale_of(tris);
         if (std::memcmp(&scale, &model.scale_, sizeof(T)) != 0)
             fail("the scale is not the one the triangles give");
