@@ -152,6 +152,38 @@ TEST(CollisionModelFile, RoundTripsDouble) {
     round_trip_all<Aabb<double, 3>>("aabb double");
 }
 
+// Models of degenerate triangles only (points, segments, collinear corners): their fitted volumes
+// are flat or points, and must still pass validate().
+template <class V>
+void degenerate_round_trip() {
+    TriangleMesh mesh;
+    for (int i = 0; i < 40; ++i) {
+        const float x = float(i % 7) * 0.3f, y = float(i % 5) * 0.2f, z = float(i % 3) * 0.1f;
+        const auto at = std::uint32_t(mesh.vertices.size());
+        mesh.vertices.insert(mesh.vertices.end(), {{x, y, z}, {x + 0.1f, y, z}, {x + 0.2f, y, z}});
+        if (i % 3 == 0) mesh.triangles.push_back({at, at, at});          // a point
+        if (i % 3 == 1) mesh.triangles.push_back({at, at + 1, at + 1});  // a segment
+        if (i % 3 == 2) mesh.triangles.push_back({at, at + 1, at + 2});  // collinear
+    }
+    const CollisionModel<V> model(mesh);
+    ASSERT_EQ(model.slot_triangles().size(), 40u);
+    for (const bool validate : {true, false})
+        expect_same_model(collision_model_from_bytes<V>(to_bytes(model), {validate}), model);
+}
+
+TEST(CollisionModelFile, DegenerateTrianglesRoundTrip) {
+    degenerate_round_trip<Aabb<float, 3>>();
+    degenerate_round_trip<Sphere<float>>();
+    degenerate_round_trip<Obb<float>>();
+    degenerate_round_trip<Rss<float>>();
+    degenerate_round_trip<ObbRss<float>>();
+    degenerate_round_trip<Kdop<float, 14>>();
+    degenerate_round_trip<Kdop<float, 18>>();
+    degenerate_round_trip<Kdop<float, 26>>();
+    degenerate_round_trip<Obb<double>>();
+    degenerate_round_trip<Rss<double>>();
+}
+
 // A model refitted to moved vertices saves and loads (with validate) like a built one.
 TEST(CollisionModelFile, RefittedModelRoundTrips) {
     TriangleMesh mesh = make_sphere(2, 0.2f);
