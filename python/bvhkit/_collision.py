@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import hashlib
+import struct
 from typing import Any, List, NamedTuple, Union
 
 import numpy as np
@@ -10,6 +12,96 @@ from . import _arrays as _a
 from . import _bvhkit
 
 VOLUMES = ("obb", "rss", "obbrss", "aabb", "sphere", "kdop18")
+
+# ---------------------------------------------------------------- the container (docs/python.md)
+# Header: magic, version, scalar (1 float32, 2 float64), volume (the C++ file's volume code),
+# reserved, then vertex count, face count, model file size, payload size; an 8-byte BLAKE2b
+# checksum of header and payload; the payload: vertices (little-endian scalars), faces (u32), the
+# model's own file (docs/serialization.md, kind 6), each padded to 8 bytes.
+_MAGIC = b"BVHKCM\x1a\n"
+_VERSION = 1
+_HEADER = struct.Struct("<8sIBBH4Q")
+_HEADER_SIZE = _HEADER.size + 8
+_SCALARS = {1: np.dtype("<f4"), 2: np.dtype("<f8")}
+_VOLUME_CODES = {"aabb": 1, "sphere": 3, "obb": 4, "rss": 5, "obbrss": 6, "kdop18": 8}
+
+load_count: int = 0
+"""How many models this process has loaded (from_bytes, load, unpickling); a diagnostic."""
+
+
+def _pad(n: int) -> int:
+    return -n % 8
+
+
+def _checksum(header: bytes, payload: Any) -> bytes:
+    h = hashlib.blake2b(digest_size=8)
+    h.update(header)
+    h.update(payload)
+    return h.digest()
+
+
+def _encode(dtype: np.dtype, volume: str, state: tuple) -> bytes:
+    vertices, faces, model = state
+    scalar = 1 if dtype == np.float32 else 2
+    sections = [
+        np.ascontiguousarray(vertices, _SCALARS[scalar]).tobytes(),
+        np.ascontiguousarray(faces, "<u4").tobytes(),
+        model,
+    ]
+    payload = b"".join(s + bytes(_pad(len(s))) for s in sections)
+    header = _HEADER.pack(
+        _MAGIC, _VERSION, scalar, _VOLUME_CODES[volume], 0, len(vertices), len(faces),
+        len(model), len(payload)
+    )
+    return header + _checksum(header, payload) + payload
+
+
+def _decode(data: Any, what: str):
+    """(dtype, volume, vertices, faces, model file bytes), checked against the size and the
+    checksum (the model is checked by the C++ loader); ValueError starting with ``what``."""
+
+    def fail(msg: str) -> ValueError:
+        return ValueError(f"{what}: {msg}")
+
+    try:
+        view = memoryview(data).cast("B")
+    except TypeError:
+        raise TypeError(f"{what}: must be bytes-like, not {type(data).__name__}") from None
+    if len(view) < _HEADER_SIZE:
+        raise fail(f"{len(view)} bytes, shorter than the {_HEADER_SIZE}-byte header")
+    magic, version, scalar, volume, reserved, nv, nf, nmodel, npayload = _HEADER.unpack_from(view)
+    if magic != _MAGIC:
+        raise fail("not a bvhkit CollisionModel file (wrong magic)")
+    if version != _VERSION:
+        raise fail(f"format version {version}, this bvhkit reads {_VERSION}")
+    if scalar not in _SCALARS:
+        raise fail(f"unknown scalar code {scalar}")
+    names = {code: name for name, code in _VOLUME_CODES.items()}
+    if volume not in names:
+        raise fail(f"unknown volume code {volume}")
+    if reserved:
+        raise fail("reserved bits set")
+    if npayload != len(view) - _HEADER_SIZE:
+        raise fail(f"the header says {npayload} payload bytes, there are {len(view) - _HEADER_SIZE}")
+    payload = view[_HEADER_SIZE:]
+    if _checksum(bytes(view[: _HEADER.size]), payload) != bytes(view[_HEADER.size : _HEADER_SIZE]):
+        raise fail("checksum mismatch (the data is damaged)")
+    dtype = _SCALARS[scalar]
+    sizes = [3 * nv * dtype.itemsize, 3 * nf * 4, nmodel]
+    # Python integers do not overflow: a forged count just makes this sum too large.
+    if sum(s + _pad(s) for s in sizes) != npayload:
+        raise fail("the section sizes do not add up to the payload")
+    parts = []
+    at = 0
+    for s in sizes:
+        parts.append(payload[at : at + s])
+        if any(payload[at + s : at + s + _pad(s)]):
+            raise fail("non-zero padding")
+        at += s + _pad(s)
+    native = np.dtype(np.float32 if scalar == 1 else np.float64)
+    vertices = np.frombuffer(parts[0], dtype).astype(native).reshape(nv, 3)
+    faces = np.frombuffer(parts[1], "<u4").astype(np.int64).reshape(nf, 3)
+    return native, names[volume], vertices, faces, bytes(parts[2])
 
 
 class CollisionModel:
@@ -42,6 +134,67 @@ class CollisionModel:
         suffix = "f32" if self.dtype == np.float32 else "f64"
         self._impl = getattr(_bvhkit, f"Model_{volume}_{suffix}")(v, f, _a.threads(threads))
         self._vertex_count = len(v)
+
+    # ------------------------------------------------------------------ saving and loading
+
+    def to_bytes(self) -> bytes:
+        """The model as bytes (format: docs/python.md): the mesh (as refitted, if it was), the
+        volume type and the model's tree in the library's file format. Reading it back with
+        :meth:`from_bytes` rebuilds nothing and answers bit for bit as this model does."""
+        return _encode(self.dtype, self.volume, self._impl.state())
+
+    @classmethod
+    def from_bytes(cls, data: Any) -> "CollisionModel":
+        """A model from :meth:`to_bytes`'s bytes. Everything is checked (a checksum over the
+        whole, the sizes, the tree as the library's loader checks it, and that it is the model of
+        the mesh stored beside it); damaged or foreign data raises ValueError."""
+        return cls._from_bytes(data, "data")
+
+    def save(self, path: Any) -> None:
+        """Writes :meth:`to_bytes` to the file ``path``."""
+        import os
+
+        with open(os.fspath(path), "wb") as f:
+            f.write(self.to_bytes())
+
+    @classmethod
+    def load(cls, path: Any) -> "CollisionModel":
+        """A model from a file written by :meth:`save` (ValueError naming the file if damaged)."""
+        import os
+
+        p = os.fspath(path)
+        with open(p, "rb") as f:
+            data = f.read()
+        return cls._from_bytes(data, p)
+
+    @classmethod
+    def _from_bytes(cls, data: Any, what: str) -> "CollisionModel":
+        self = cls.__new__(cls)
+        self._load(data, what)
+        return self
+
+    def _load(self, data: Any, what: str) -> None:
+        global load_count
+        dtype, volume, vertices, faces, model = _decode(data, what)
+        suffix = "f32" if dtype == np.float32 else "f64"
+        try:
+            self._impl = getattr(_bvhkit, f"Model_{volume}_{suffix}")(vertices, faces, model)
+        except ValueError as e:
+            raise ValueError(f"{what}: {e}") from None
+        self.volume = volume
+        self.dtype = dtype
+        self._vertex_count = len(vertices)
+        load_count += 1
+
+    def __getstate__(self) -> dict:
+        """Pickles through :meth:`to_bytes`: the tree travels built."""
+        return {"bvhkit.CollisionModel": self.to_bytes()}
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickles through :meth:`from_bytes`."""
+        if not isinstance(state, dict) or "bvhkit.CollisionModel" not in state:
+            raise ValueError("state: not a pickled bvhkit.CollisionModel")
+        self._load(state["bvhkit.CollisionModel"], "pickled CollisionModel")
 
     def refit(self, vertices: Any) -> None:
         """New positions for the same vertices (same faces): every volume is refitted, the tree's

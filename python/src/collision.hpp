@@ -4,9 +4,13 @@
 // type in collision32.cpp and collision64.cpp, so the two compile side by side.
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstring>
 #include <mutex>
 #include <shared_mutex>
+#include <span>
 
+#include "bvhkit/io/collision_model_file.hpp"
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 #include "bvhkit/query/self_collision.hpp"
@@ -36,10 +40,64 @@ class Model {
         model_ = CollisionModel<V>(mesh_, options);
     }
 
+    /// A model from the parts state() gave (bvhkit/_collision.py holds them in one container):
+    /// the model is loaded from its file, checked as every load is, never rebuilt, and must be
+    /// the model of exactly this mesh: the same face count, each slot's vertex ids and corners
+    /// those of its face, and each face left out a face with a non-finite corner. Any failure is
+    /// a bvhkit::Error (ValueError).
+    Model(const Rows<T, 3>& vertices, const Faces& faces, const nb::bytes& model)
+        : mesh_(make_mesh<T>(vertices, faces)) {
+        // The bytes object stays referenced by the caller and is immutable: safe without the GIL.
+        const std::span<const std::uint8_t> bytes(
+            reinterpret_cast<const std::uint8_t*>(model.c_str()), model.size());
+        nb::gil_scoped_release release;
+        model_ = collision_model_from_bytes<V>(bytes);
+        const auto fail = [](const std::string& m) { throw Error("model: " + m); };
+        if (model_.triangle_count() != mesh_.triangles.size())
+            fail("covers " + std::to_string(model_.triangle_count()) + " faces, the mesh has " +
+                 std::to_string(mesh_.triangles.size()));
+        const auto tris = model_.slot_triangles();
+        const auto ids = model_.slot_vertex_ids();
+        for (std::uint32_t s = 0; s < tris.size(); ++s) {
+            const std::uint32_t f = model_.triangle_id(s);
+            const Triangle<T> t = triangle_at<T>(mesh_, f);
+            if (ids[s] != mesh_.triangles[f] || std::memcmp(&t, &tris[s], sizeof(t)) != 0)
+                fail("slot " + std::to_string(s) + " does not hold face " + std::to_string(f) +
+                     " of the mesh");
+        }
+        for (const std::uint32_t f : model_.skipped()) {
+            const Triangle<T> t = triangle_at<T>(mesh_, f);
+            bool finite = true;
+            for (const Vec<T, 3>& p : {t.p0, t.p1, t.p2})
+                for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(p[a]);
+            if (finite) fail("face " + std::to_string(f) + " is finite but left out");
+        }
+    }
+
+    /// What the loading constructor takes: (vertices, faces int64, model file bytes). One
+    /// consistent snapshot.
+    nb::tuple state() const {
+        std::vector<T> v;
+        std::vector<std::int64_t> f;
+        std::vector<std::uint8_t> file;
+        {
+            nb::gil_scoped_release release;
+            const std::shared_lock<std::shared_mutex> lock(mutex_);
+            v.reserve(3 * mesh_.vertices.size());
+            for (const auto& p : mesh_.vertices) v.insert(v.end(), {p[0], p[1], p[2]});
+            f.reserve(3 * mesh_.triangles.size());
+            for (const auto& t : mesh_.triangles) f.insert(f.end(), {t[0], t[1], t[2]});
+            file = to_bytes(model_);
+        }
+        const std::size_t nv = mesh_.vertices.size(), nf = mesh_.triangles.size();
+        return nb::make_tuple(owned_array(std::move(v), nv, 3), owned_array(std::move(f), nf, 3),
+                              nb::bytes(reinterpret_cast<const char*>(file.data()), file.size()));
+    }
+
     void refit(const Rows<T, 3>& vertices) {
         if (vertices.shape(0) != mesh_.vertices.size())
-            throw Error("vertices: " + std::to_string(vertices.shape(0)) +
-                        " rows, the model has " + std::to_string(mesh_.vertices.size()));
+            throw Error("vertices: " + std::to_string(vertices.shape(0)) + " rows, the model has " +
+                        std::to_string(mesh_.vertices.size()));
         const T* v = vertices.data();
         nb::gil_scoped_release release;
         const std::unique_lock<std::shared_mutex> lock(mutex_);
@@ -90,7 +148,8 @@ class Model {
             CollideResult<T> result;
             const CollideOptions options{CollideMode::AllPairs, DescentRule::Larger, false};
             bvhkit::collide(model_, b.model_, pose, options, result);
-            for (const Contact<T>& c : result.contacts) per[i].push_back({c.triangle_a, c.triangle_b});
+            for (const Contact<T>& c : result.contacts)
+                per[i].push_back({c.triangle_a, c.triangle_b});
             std::sort(per[i].begin(), per[i].end());
         });
         std::vector<std::int64_t> pairs, offsets(k + 1, 0);
@@ -164,23 +223,26 @@ void bind_model(nb::module_& m, const char* name) {
     nb::class_<M>(m, name, "A mesh ready for collision and distance (see bvhkit.CollisionModel).")
         .def(nb::init<const Rows<T, 3>&, const Faces&, unsigned>(), nb::arg("vertices"),
              nb::arg("faces"), nb::arg("threads"), "Builds the model's tree.")
+        .def(nb::init<const Rows<T, 3>&, const Faces&, const nb::bytes&>(), nb::arg("vertices"),
+             nb::arg("faces"), nb::arg("model"),
+             "Loads the model from the parts state() gave (nothing is rebuilt).")
+        .def("state", &M::state, "The mesh and the model's file, for saving.")
         .def("refit", &M::refit, nb::arg("vertices"), "New vertex positions, same faces.")
-        .def("collides", &M::collides, nb::arg("b"), nb::arg("rotations"),
-             nb::arg("translations"), nb::arg("out"), nb::arg("threads"),
+        .def("collides", &M::collides, nb::arg("b"), nb::arg("rotations"), nb::arg("translations"),
+             nb::arg("out"), nb::arg("threads"),
              "Whether b, placed at each pose, intersects this model.")
-        .def("contacts", &M::contacts, nb::arg("b"), nb::arg("rotations"),
-             nb::arg("translations"), nb::arg("threads"),
+        .def("contacts", &M::contacts, nb::arg("b"), nb::arg("rotations"), nb::arg("translations"),
+             nb::arg("threads"),
              "(pairs (p, 2), offsets (k + 1)): the intersecting face pairs at each pose.")
-        .def("distance", &M::distance, nb::arg("b"), nb::arg("rotations"),
-             nb::arg("translations"), nb::arg("absolute_tolerance"),
-             nb::arg("relative_tolerance"), nb::arg("distance"), nb::arg("point_a"),
-             nb::arg("point_b"), nb::arg("face_a"), nb::arg("face_b"), nb::arg("threads"),
+        .def("distance", &M::distance, nb::arg("b"), nb::arg("rotations"), nb::arg("translations"),
+             nb::arg("absolute_tolerance"), nb::arg("relative_tolerance"), nb::arg("distance"),
+             nb::arg("point_a"), nb::arg("point_b"), nb::arg("face_a"), nb::arg("face_b"),
+             nb::arg("threads"),
              "Distance to b at each pose, with the closest points in this model's frame.")
         .def("self_intersections", &M::self_intersections,
              "Intersecting face pairs that share no vertex, (p, 2).")
         .def_prop_ro("triangle_count", &M::triangle_count, "Number of faces.")
         .def_prop_ro("node_count", &M::node_count, "Number of tree nodes.");
 }
-
 
 }  // namespace bvhkit::python

@@ -1,17 +1,22 @@
-// libFuzzer target: the TriangleBvh, ClosestPointMesh, SignedDistanceMesh, WindingNumberMesh and
-// DynamicTree loaders on arbitrary bytes, as they come and again with the checksum recomputed
-// (random bytes almost never carry a valid checksum, and the checks behind it are the ones worth
-// fuzzing). A load may throw bvhkit::Error; a structure it accepts, with or without validate(),
-// must answer queries with indices in range (ASan and UBSan watch the walks).
+// libFuzzer target: the TriangleBvh, ClosestPointMesh, SignedDistanceMesh, WindingNumberMesh,
+// DynamicTree and CollisionModel loaders on arbitrary bytes, as they come and again with the
+// checksum recomputed (random bytes almost never carry a valid checksum, and the checks behind it
+// are the ones worth fuzzing). A load may throw bvhkit::Error; a structure it accepts, with or
+// without validate(), must answer queries with indices in range (ASan and UBSan watch the walks).
 #include <cstdlib>
+#include <limits>
 #include <span>
 #include <vector>
 
 #include "bvhkit/io/closest_point_mesh_file.hpp"
+#include "bvhkit/io/collision_model_file.hpp"
 #include "bvhkit/io/dynamic_tree_file.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/io/winding_number_mesh_file.hpp"
+#include "bvhkit/query/distance.hpp"
+#include "bvhkit/query/pairs_model.hpp"
+#include "bvhkit/query/self_collision.hpp"
 
 namespace {
 
@@ -110,6 +115,69 @@ void load_dynamic_tree_and_use(std::span<const std::uint8_t> bytes) {
     }
 }
 
+/// A CollisionModel the loader accepts must answer collide, distance and self-collision against
+/// itself and a fixed model with triangle indices in range.
+template <class V>
+void load_collision_model_and_query(std::span<const std::uint8_t> bytes) {
+    using T = typename V::Scalar;
+    for (const bool validate : {true, false}) {
+        try {
+            const auto model =
+                bvhkit::collision_model_from_bytes<V>(bytes, bvhkit::LoadOptions{validate});
+            bvhkit::BasicTriangleMesh<T> two;
+            two.vertices = {{T(0), T(0), T(0)},     {T(1), T(0), T(0)},
+                            {T(0), T(1), T(0)},     {T(0.2), T(0.2), T(-1)},
+                            {T(0.3), T(0.2), T(1)}, {T(0.2), T(0.3), T(1)}};
+            two.triangles = {{0, 1, 2}, {3, 4, 5}};
+            const bvhkit::CollisionModel<V> other(two);
+            const std::size_t n = model.triangle_count();
+            bvhkit::Transform<T> pose;
+            pose.rotation = bvhkit::rotation_about(bvhkit::Vec<T, 3>(T(0), T(0), T(1)), T(0.3));
+            pose.translation = {T(0.1), T(0.2), T(0)};
+            bvhkit::CollideResult<T> result;
+            for (const auto& p : {bvhkit::Transform<T>{}, pose}) {
+                bvhkit::collide(model, other, p, {}, result);
+                for (const auto& c : result.contacts)
+                    if (c.triangle_a >= n || c.triangle_b >= 2) std::abort();
+                bvhkit::collide(model, model, p, {}, result);
+                for (const auto& c : result.contacts)
+                    if (c.triangle_a >= n || c.triangle_b >= n) std::abort();
+                const auto d = bvhkit::distance(model, other, p);
+                if (d.distance < std::numeric_limits<T>::infinity() && d.triangle_a >= n)
+                    std::abort();
+            }
+            std::vector<bvhkit::Contact<T>> contacts;
+            bvhkit::self_collide(model, contacts);
+            for (const auto& c : contacts)
+                if (c.triangle_a >= n || c.triangle_b >= n) std::abort();
+        } catch (const bvhkit::Error&) {
+        }
+    }
+}
+
+/// Byte 17 is the volume (docs/serialization.md): load as the file says.
+template <class T>
+void load_collision_model_as_volume(std::span<const std::uint8_t> bytes, std::uint8_t volume) {
+    switch (volume) {
+        case 1:
+            return load_collision_model_and_query<bvhkit::Aabb<T, 3>>(bytes);
+        case 3:
+            return load_collision_model_and_query<bvhkit::Sphere<T>>(bytes);
+        case 4:
+            return load_collision_model_and_query<bvhkit::Obb<T>>(bytes);
+        case 5:
+            return load_collision_model_and_query<bvhkit::Rss<T>>(bytes);
+        case 6:
+            return load_collision_model_and_query<bvhkit::ObbRss<T>>(bytes);
+        case 7:
+            return load_collision_model_and_query<bvhkit::Kdop<T, 14>>(bytes);
+        case 8:
+            return load_collision_model_and_query<bvhkit::Kdop<T, 18>>(bytes);
+        default:
+            return load_collision_model_and_query<bvhkit::Kdop<T, 26>>(bytes);
+    }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -146,6 +214,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (flat && !as_double) load_dynamic_tree_and_use<float, 2>(resealed);
         if (!flat && as_double) load_dynamic_tree_and_use<double, 3>(resealed);
         if (!flat && !as_double) load_dynamic_tree_and_use<float, 3>(resealed);
+    } else if (size > 17 && data[12] == 6) {
+        load_collision_model_and_query<bvhkit::Obb<float>>(raw);
+        if (as_double)
+            load_collision_model_as_volume<double>(resealed, data[17]);
+        else
+            load_collision_model_as_volume<float>(resealed, data[17]);
     } else if (as_double) {
         load_and_query<double>(resealed);
     } else {

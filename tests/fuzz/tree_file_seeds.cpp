@@ -1,7 +1,7 @@
 // Writes the seed corpus of fuzz_tree_file into the folder given: small saved TriangleBvh files
 // (float and double, both triangle layouts, one with skipped triangles, an empty tree),
-// ClosestPointMesh, SignedDistanceMesh, WindingNumberMesh and DynamicTree files, each a few KB so
-// the fuzzer's mutations land on every section.
+// ClosestPointMesh, SignedDistanceMesh, WindingNumberMesh, DynamicTree and CollisionModel files
+// (one per volume type), each a few KB so the fuzzer's mutations land on every section.
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bvhkit/io/closest_point_mesh_file.hpp"
+#include "bvhkit/io/collision_model_file.hpp"
 #include "bvhkit/io/dynamic_tree_file.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
@@ -27,6 +28,18 @@ std::vector<bvhkit::Triangle<T>> grid(int n) {
             out.push_back({{x + s, y, z}, {x + s, y + s, z + s}, {x, y + s, z}});
         }
     return out;
+}
+
+// The triangles as an indexed mesh, three vertices each (what a CollisionModel builds from).
+template <class T>
+bvhkit::BasicTriangleMesh<T> indexed(const std::vector<bvhkit::Triangle<T>>& tris) {
+    bvhkit::BasicTriangleMesh<T> mesh;
+    for (const auto& t : tris) {
+        const auto i = std::uint32_t(mesh.vertices.size());
+        mesh.vertices.insert(mesh.vertices.end(), {t.p0, t.p1, t.p2});
+        mesh.triangles.push_back({i, i + 1, i + 2});
+    }
+    return mesh;
 }
 
 template <class T>
@@ -82,5 +95,25 @@ int main(int argc, char** argv) {
         solid.create(bvhkit::Aabb<double, 3>({0, double(i), 0}, {1, double(i) + 1.5, 1}));
     solid.enlarge(2, bvhkit::Aabb<double, 3>({5, 5, 5}, {6, 6, 6}));
     bvhkit::save(solid, dir / "dynamic_3d_double.bvh");
+    // Collision models: every volume type over the octahedron, one over a grid with skipped
+    // triangles, one in double.
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Aabb<float, 3>>(octahedron),
+                 dir / "collision_aabb.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Sphere<float>>(octahedron),
+                 dir / "collision_sphere.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Obb<float>>(octahedron), dir / "collision_obb.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Rss<float>>(octahedron), dir / "collision_rss.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::ObbRss<float>>(octahedron),
+                 dir / "collision_obbrss.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Kdop<float, 14>>(octahedron),
+                 dir / "collision_kdop14.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Kdop<float, 18>>(octahedron),
+                 dir / "collision_kdop18.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Kdop<float, 26>>(octahedron),
+                 dir / "collision_kdop26.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Obb<float>>(indexed(holes)),
+                 dir / "collision_skipped.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::Obb<double>>(indexed(grid<double>(2))),
+                 dir / "collision_obb_double.bvh");
     return 0;
 }

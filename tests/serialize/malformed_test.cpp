@@ -239,6 +239,7 @@ TEST(TriangleBvhFileHostile, BadHeadersAreErrors) {
     expect_error(with([](RawTree& t) { t.volume = 2; }), "volume", "volume");
     expect_error(with([](RawTree& t) { t.layout = 0; }), "layout 0", "layout");
     expect_error(with([](RawTree& t) { t.layout = 3; }), "layout 3", "layout");
+    expect_error(with([](RawTree& t) { t.layout = 0x41; }), "ray layout 4", "layout");
     expect_error(with([](RawTree& t) { t.reserved = 1; }), "reserved", "reserved");
     expect_error(with([](RawTree& t) { t.payload_adjust = 8; }), "payload too long", "truncated");
     expect_error(with([](RawTree& t) { t.payload_adjust = -8; }), "payload short", "payload");

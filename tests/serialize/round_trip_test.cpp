@@ -10,6 +10,7 @@
 
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
+#include "bvhkit/math/random.hpp"
 #include "bvhkit/mesh/procedural.hpp"
 #include "random_geometry.hpp"
 #include "test_support.hpp"
@@ -119,6 +120,33 @@ TEST(TriangleBvhFile, ProceduralMeshesAndBuildersRoundTrip) {
                 round_trip(TriangleBvh<float>(mesh, options), bounds_of<float>(mesh), what);
                 round_trip(TriangleBvh<double>(mesh, options), bounds_of<double>(mesh), what);
             }
+    }
+}
+
+// The ray layout a tree was built with travels in the layout byte's high half: a tree built to walk
+// the binary tree or four wide walks so after a load, and breaks ties on shared edges the same way
+// (vertical rays through a terrain's grid lines hit two triangles at once).
+TEST(TriangleBvhFile, RayLayoutsRoundTrip) {
+    const TriangleMesh mesh = make_procedural("terrain:n=32");
+    const Aabb3f box = mesh.bounds();
+    for (const RayLayout layout :
+         {RayLayout::Auto, RayLayout::Wide8, RayLayout::Wide4, RayLayout::Binary}) {
+        TriangleBvhOptions options;
+        options.ray_layout = layout;
+        const TriangleBvh<float> tree(mesh, options);
+        const std::string what = "ray layout " + std::to_string(int(layout));
+        round_trip(tree, box, what);
+        const std::vector<std::uint8_t> bytes = to_bytes(tree);
+        EXPECT_EQ(bytes[18], 1 | int(layout) << 4) << what;
+        const TriangleBvh<float> loaded = triangle_bvh_from_bytes<float>(bytes);
+        EXPECT_EQ(loaded.ray_width(), tree.ray_width()) << what;
+        SplitMix64 rng(3);
+        for (std::size_t i = 0; i < scaled(20000, 10); ++i) {
+            const float x = std::round(float(rng.uniform(box.min[0], box.max[0])) * 32) / 32;
+            const float y = float(rng.uniform(box.min[1], box.max[1]));
+            const Ray3f ray(Vec3f(x, y, box.max[2] + 1), Vec3f(0, 0, -1));
+            ASSERT_TRUE(same_hit(loaded.closest_hit(ray), tree.closest_hit(ray))) << what << i;
+        }
     }
 }
 

@@ -41,10 +41,21 @@ enum class FileKind : std::uint32_t {
     ClosestPointMesh = 2,
     SignedDistanceMesh = 3,
     WindingNumberMesh = 4,
-    DynamicTree = 5
+    DynamicTree = 5,
+    CollisionModel = 6
 };
 enum class ScalarCode : std::uint8_t { Float32 = 1, Float64 = 2 };
-enum class VolumeCode : std::uint8_t { Aabb3 = 1, Aabb2 = 2 };
+enum class VolumeCode : std::uint8_t {
+    Aabb3 = 1,
+    Aabb2 = 2,
+    Sphere = 3,
+    Obb = 4,
+    Rss = 5,
+    ObbRss = 6,
+    Kdop14 = 7,
+    Kdop18 = 8,
+    Kdop26 = 9
+};
 
 template <class T>
 constexpr ScalarCode scalar_code() {

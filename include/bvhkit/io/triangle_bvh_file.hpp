@@ -1,9 +1,12 @@
 #pragma once
 // Saving and loading a TriangleBvh (format: docs/serialization.md). The file holds exactly what the
 // tree holds: nodes, slot -> triangle indices, the triangles in slot order in the layout of the
-// tree's triangle test (corners for the watertight test, p0/edges/normal for the fast one), and the
-// skipped triangles. Nothing is rebuilt on load, so a loaded tree answers bit for bit as the saved
-// one, and saving it again gives the same bytes.
+// tree's triangle test (corners for the watertight test, p0/edges/normal for the fast one), the
+// skipped triangles, and the ray layout it was built with (RayLayout, in the layout byte's high
+// half). Nothing is rebuilt on load but the wide ray layout, derived from the loaded tree by the
+// code a build uses (storing it does not pay: docs/serialization.md), so a loaded tree answers bit
+// for bit as the saved one (on a CPU of the same kind: RayLayout::Auto picks by AVX2), and saving
+// it again gives the same bytes.
 //
 // Loading trusts nothing: the envelope (size, checksum) is checked first, every count against the
 // bytes there are before anything is allocated, then the tree's shape and every index
@@ -27,7 +30,9 @@ namespace bvhkit {
 
 namespace serial_detail {
 
-// Layout byte of a TriangleBvh file: which triangle records the payload holds.
+// Layout byte of a TriangleBvh file: the low half says which triangle records the payload holds,
+// the high half the tree's RayLayout (0 Auto, 1 Wide8, 2 Wide4, 3 Binary), so that a tree built
+// to trace with another layout than the default traces (and breaks ties) with it after a load.
 enum class TriangleLayout : std::uint8_t { Corners = 1, Precomputed = 2 };
 
 struct TriangleBvhAccess {
@@ -54,7 +59,9 @@ struct TriangleBvhAccess {
         h.kind = FileKind::TriangleBvh;
         h.scalar = scalar_code<T>();
         h.volume = VolumeCode::Aabb3;
-        h.layout = std::uint8_t(fast ? TriangleLayout::Precomputed : TriangleLayout::Corners);
+        h.layout = std::uint8_t(
+            std::uint8_t(fast ? TriangleLayout::Precomputed : TriangleLayout::Corners) |
+            std::uint8_t(std::uint8_t(tree.ray_layout_) << 4));
         h.counts = {bvh.nodes.size(), bvh.primitive_indices.size(), tree.report_.skipped.size(),
                     tree.triangle_count_};
         return seal_tree_file(h, w.bytes());
@@ -65,8 +72,10 @@ struct TriangleBvhAccess {
         const OpenedTreeFile f = open_tree_file(file, FileKind::TriangleBvh, what);
         const TreeFileHeader& h = f.header;
         check_scalar_and_volume<T>(h, what);
-        const auto layout = TriangleLayout(h.layout);
-        if (layout != TriangleLayout::Corners && layout != TriangleLayout::Precomputed)
+        const auto layout = TriangleLayout(h.layout & 0x0f);
+        const int ray_layout = h.layout >> 4;
+        if ((layout != TriangleLayout::Corners && layout != TriangleLayout::Precomputed) ||
+            ray_layout > int(RayLayout::Binary))
             throw Error(std::string(what) + ": unknown triangle layout " +
                         std::to_string(int(h.layout)));
         const bool fast = layout == TriangleLayout::Precomputed;
@@ -76,6 +85,7 @@ struct TriangleBvhAccess {
         ByteReader r(f.payload, what);
         TriangleBvh<T> tree;
         tree.triangle_test_ = fast ? TriangleTest::Fast : TriangleTest::Watertight;
+        tree.ray_layout_ = RayLayout(ray_layout);
         tree.triangle_count_ = std::size_t(triangle_count);
         auto& bvh = tree.bvh_;
         get_nodes(r, bvh, node_count);

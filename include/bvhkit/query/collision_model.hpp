@@ -17,6 +17,10 @@
 
 namespace bvhkit {
 
+namespace serial_detail {
+struct CollisionModelAccess;  // io/collision_model_file.hpp: saves and loads the private arrays
+}
+
 /// Build options for collision trees: small leaves, as a leaf pair costs count_a * count_b
 /// triangle tests.
 inline BuildOptions collision_build_options() {
@@ -73,21 +77,27 @@ class CollisionModel {
     const std::vector<std::uint32_t>& skipped() const { return report_.skipped; }
     /// Largest |coordinate| of the model plus its box diagonal: the scale of its rounding errors.
     T scale() const { return scale_; }
+    /// scale() of a model with these slot triangles.
+    static T scale_of(std::span<const Triangle<T>> triangles) {
+        Aabb<T, 3> box;
+        for (const Triangle<T>& t : triangles) box.grow(t.p0).grow(t.p1).grow(t.p2);
+        return box.is_empty()
+                   ? T(0)
+                   : max_component(bvhkit::max(box.max, -box.min)) + length(box.max - box.min);
+    }
 
   private:
+    friend struct serial_detail::CollisionModelAccess;
+
     template <IndexedTriangleMesh M>
     void lay_out(const M& mesh, const std::vector<std::uint32_t>& order) {
         slot_triangles_.resize(order.size());
         slot_vertex_ids_.resize(order.size());
-        Aabb<T, 3> box;
         for (std::size_t s = 0; s < order.size(); ++s) {
             slot_triangles_[s] = triangle_at<T>(mesh, order[s]);
             slot_vertex_ids_[s] = mesh.triangle(order[s]);
-            box.grow(slot_triangles_[s].p0).grow(slot_triangles_[s].p1).grow(slot_triangles_[s].p2);
         }
-        scale_ = box.is_empty()
-                     ? T(0)
-                     : max_component(bvhkit::max(box.max, -box.min)) + length(box.max - box.min);
+        scale_ = scale_of(slot_triangles_);
     }
 
     Bvh<V> bvh_;
