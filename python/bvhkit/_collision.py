@@ -11,7 +11,7 @@ import numpy as np
 from . import _arrays as _a
 from . import _bvhkit
 
-VOLUMES = ("obb", "rss", "obbrss", "aabb", "sphere", "kdop18")
+VOLUMES = ("obb", "rss", "obbrss", "aabb", "sphere", "kdop18", "hull")
 
 # ---------------------------------------------------------------- the container (docs/python.md)
 # Header: magic, version, scalar (1 float32, 2 float64), volume (the C++ file's volume code),
@@ -23,7 +23,7 @@ _VERSION = 1
 _HEADER = struct.Struct("<8sIBBH4Q")
 _HEADER_SIZE = _HEADER.size + 8
 _SCALARS = {1: np.dtype("<f4"), 2: np.dtype("<f8")}
-_VOLUME_CODES = {"aabb": 1, "sphere": 3, "obb": 4, "rss": 5, "obbrss": 6, "kdop18": 8}
+_VOLUME_CODES = {"aabb": 1, "sphere": 3, "obb": 4, "rss": 5, "obbrss": 6, "kdop18": 8, "hull": 10}
 
 load_count: int = 0
 """How many models this process has loaded (from_bytes, load, unpickling); a diagnostic."""
@@ -109,9 +109,10 @@ class CollisionModel:
 
     ``vertices``: (n, 3) float32 or float64; ``faces``: (m, 3) int32 or int64. ``volume`` is the
     bounding volume of the tree: ``"obb"`` (oriented boxes, Gottschalk et al. 1996: the fastest
-    for collision), ``"rss"`` (rectangle swept spheres, Larsen et al. 1999: the fastest for
-    distance), ``"obbrss"`` (both in one model: boxes for collision, swept spheres for distance),
-    ``"aabb"``, ``"sphere"`` or ``"kdop18"``. ``dtype``: float32 (default) or float64.
+    for collision), ``"rss"`` (rectangle swept spheres, Larsen et al. 1999), ``"obbrss"`` (both in
+    one model: boxes for collision, swept spheres for distance), ``"hull"`` (convex hulls of at most
+    16 vertices: the slowest to build, the fastest for distance), ``"aabb"``, ``"sphere"`` or
+    ``"kdop18"``. ``dtype``: float32 (default) or float64.
     Both models of a query must have the same volume and dtype.
 
     Faces with a NaN or infinite coordinate are left out; zero-area faces never collide.

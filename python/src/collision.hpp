@@ -15,6 +15,7 @@
 #include "bvhkit/query/pairs_model.hpp"
 #include "bvhkit/query/self_collision.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
+#include "bvhkit/volumes/convex_hull.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
 #include "bvhkit/volumes/obb_rss.hpp"

@@ -10,6 +10,7 @@ void bind_collision32(nb::module_& m) {
     bind_model<Rss<float>>(m, "Model_rss_f32");
     bind_model<ObbRss<float>>(m, "Model_obbrss_f32");
     bind_model<Kdop<float, 18>>(m, "Model_kdop18_f32");
+    bind_model<ConvexHull<float>>(m, "Model_hull_f32");
 }
 
 }  // namespace bvhkit::python

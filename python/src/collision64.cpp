@@ -10,6 +10,7 @@ void bind_collision64(nb::module_& m) {
     bind_model<Rss<double>>(m, "Model_rss_f64");
     bind_model<ObbRss<double>>(m, "Model_obbrss_f64");
     bind_model<Kdop<double, 18>>(m, "Model_kdop18_f64");
+    bind_model<ConvexHull<double>>(m, "Model_hull_f64");
 }
 
 }  // namespace bvhkit::python

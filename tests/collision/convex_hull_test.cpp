@@ -11,6 +11,7 @@
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/math/predicates.hpp"
 #include "bvhkit/math/random.hpp"
+#include "bvhkit/mesh/procedural.hpp"
 #include "bvhkit/query/collision_model.hpp"
 #include "bvhkit/volumes/convex_hull.hpp"
 #include "test_support.hpp"
@@ -247,6 +248,52 @@ TEST(Gjk, PointToHullIsAnUpperBoundAndTight) {
         // Outside: the least triangle distance is the distance, and GJK may only be above it.
         ASSERT_GE(got, double(brute) * (1 - 1e-9) - tol) << "trial " << trial;
         ASSERT_NEAR(got, double(brute), 1e-6 * double(brute) + tol) << "trial " << trial;
+    }
+}
+
+// Points inside the hull (convex combinations, and the vertices of noisy spheres' nodes) are at
+// distance zero up to rounding: GJK must not stop at a worse step (rounding once made it cycle
+// between a face and an edge and report the edge's distance).
+TEST(Gjk, InteriorPointsAreAtZero) {
+    SplitMix64 rng(21);
+    for (int trial = 0; trial < int(scaled(300, 30)); ++trial) {
+        std::vector<Vec3f> s;
+        const std::size_t n = 4 + rng.below(16);
+        for (std::size_t i = 0; i < n; ++i) {
+            const Vec3d r(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+            s.push_back(Vec3f(normalize(r) * (1 + 0.01 * rng.uniform(-1, 1))));
+        }
+        for (int k = 0; k < 20; ++k) {
+            Vec3d p(0.0);
+            double total = 0;
+            for (const Vec3f& q : s) {
+                const double w = rng.uniform(0, 1);
+                p = p + Vec3d(q) * w;
+                total += w;
+            }
+            const Vec3f pf(p * (1 / total));
+            ASSERT_LE(hull_detail::distance_to_hull<float>(pf, s), 1e-6) << "trial " << trial;
+        }
+    }
+}
+
+TEST(ConvexHullVolume, NoisySphereNodesHoldTheirVerticesByGjk) {
+    TriangleMesh m = make_sphere(3);
+    SplitMix64 rng(3);
+    for (auto& v : m.vertices)
+        v = v + Vec3f(float(rng.uniform(-0.01, 0.01)), float(rng.uniform(-0.01, 0.01)),
+                      float(rng.uniform(-0.01, 0.01)));
+    const CollisionModel<ConvexHull<float>> model(m);
+    const auto& bvh = model.bvh();
+    const auto runs = node_slot_runs(bvh);
+    const auto tris = model.slot_triangles();
+    const double tol = 16 * double(std::numeric_limits<float>::epsilon()) * model.scale();
+    for (std::size_t n = 0; n < bvh.nodes.size(); ++n) {
+        const auto& v = bvh.nodes[n].bounds;
+        for (std::uint32_t t = runs[n].first; t < runs[n].second; ++t)
+            for (const Vec3f& p : {tris[t].p0, tris[t].p1, tris[t].p2})
+                ASSERT_LE(hull_detail::distance_to_hull<float>(p, v.vertices()), v.margin + tol)
+                    << "node " << n;
     }
 }
 

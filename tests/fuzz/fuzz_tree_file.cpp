@@ -173,6 +173,8 @@ void load_collision_model_as_volume(std::span<const std::uint8_t> bytes, std::ui
             return load_collision_model_and_query<bvhkit::Kdop<T, 14>>(bytes);
         case 8:
             return load_collision_model_and_query<bvhkit::Kdop<T, 18>>(bytes);
+        case 10:
+            return load_collision_model_and_query<bvhkit::ConvexHull<T>>(bytes);
         default:
             return load_collision_model_and_query<bvhkit::Kdop<T, 26>>(bytes);
     }

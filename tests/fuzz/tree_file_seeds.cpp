@@ -111,6 +111,8 @@ int main(int argc, char** argv) {
                  dir / "collision_kdop18.bvh");
     bvhkit::save(bvhkit::CollisionModel<bvhkit::Kdop<float, 26>>(octahedron),
                  dir / "collision_kdop26.bvh");
+    bvhkit::save(bvhkit::CollisionModel<bvhkit::ConvexHull<float>>(octahedron),
+                 dir / "collision_hull.bvh");
     bvhkit::save(bvhkit::CollisionModel<bvhkit::Obb<float>>(indexed(holes)),
                  dir / "collision_skipped.bvh");
     bvhkit::save(bvhkit::CollisionModel<bvhkit::Obb<double>>(indexed(grid<double>(2))),

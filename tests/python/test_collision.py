@@ -6,7 +6,7 @@ import pytest
 import bvhkit
 from reference import random_soup, triangle_distance, triangles_intersect
 
-VOLUMES = ["obb", "rss", "obbrss", "aabb", "sphere", "kdop18"]
+VOLUMES = ["obb", "rss", "obbrss", "aabb", "sphere", "kdop18", "hull"]
 
 
 def random_rotations(rng, k):
@@ -56,7 +56,7 @@ def test_collide_and_contacts_match_brute_force(volume):
     assert checked > 30 and yes.sum() > 3 and (~yes).sum() > 3
 
 
-@pytest.mark.parametrize("volume", ["rss", "obb"])
+@pytest.mark.parametrize("volume", ["rss", "obb", "hull"])
 def test_distance_matches_brute_force(volume):
     va, fa, vb, fb, rot, trans = setup(2, k=25)
     trans *= 3  # mostly apart

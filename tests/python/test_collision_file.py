@@ -10,7 +10,7 @@ import bvhkit
 from bvhkit import _collision
 from test_collision import random_rotations
 
-VOLUMES = ["obb", "rss", "obbrss", "aabb", "sphere", "kdop18"]
+VOLUMES = ["obb", "rss", "obbrss", "aabb", "sphere", "kdop18", "hull"]
 
 
 def meshes(dtype):

@@ -143,6 +143,7 @@ TEST(CollisionModelFile, RoundTripsEveryVolume) {
     round_trip_all<Kdop<float, 14>>("kdop14 float");
     round_trip_all<Kdop<float, 18>>("kdop18 float");
     round_trip_all<Kdop<float, 26>>("kdop26 float");
+    round_trip_all<ConvexHull<float>>("hull float");
 }
 
 TEST(CollisionModelFile, RoundTripsDouble) {
@@ -180,6 +181,7 @@ TEST(CollisionModelFile, DegenerateTrianglesRoundTrip) {
     degenerate_round_trip<Kdop<float, 14>>();
     degenerate_round_trip<Kdop<float, 18>>();
     degenerate_round_trip<Kdop<float, 26>>();
+    degenerate_round_trip<ConvexHull<float>>();
     degenerate_round_trip<Obb<double>>();
     degenerate_round_trip<Rss<double>>();
 }
@@ -402,6 +404,7 @@ TEST(CollisionModelFile, ShrunkRootOfEveryVolumeFailsValidate) {
     expect_shrunk_root_caught<ObbRss<float>>(15 + 14, false);  // the swept sphere's radius
     expect_shrunk_root_caught<Kdop<float, 14>>(1, false);      // slab 0's hi
     expect_shrunk_root_caught<Kdop<float, 26>>(25, false);     // the last slab's hi
+    expect_shrunk_root_caught<ConvexHull<float>>(49, false);   // the margin (80 triangles: capped)
 }
 
 }  // namespace

@@ -35,6 +35,7 @@
 #include "bvhkit/io/tree_structure.hpp"
 #include "bvhkit/query/collision_model.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
+#include "bvhkit/volumes/convex_hull.hpp"
 #include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
 #include "bvhkit/volumes/obb_rss.hpp"
@@ -240,6 +241,52 @@ requires(K == 14 || K == 18 || K == 26) struct VolumeCodec<Kdop<T, K>> {
     }
 };
 
+/// ConvexHull<T, 16> (files hold the default cap only): the 16 point slots (unused ones zero), the
+/// count as a scalar, the margin, the centre and the reach.
+template <class T>
+struct VolumeCodec<ConvexHull<T, 16>> {
+    using V = ConvexHull<T, 16>;
+    static constexpr VolumeCode code = VolumeCode::ConvexHull16;
+    static constexpr std::size_t scalars = 3 * 16 + 1 + 1 + 3 + 1;
+    static void put(ByteWriter& w, const V& v) {
+        for (const auto& p : v.points) put_vec(w, p);
+        w.scalar(T(v.count)), w.scalar(v.margin), put_vec(w, v.center), w.scalar(v.reach);
+    }
+    static V get(ByteReader& r) {
+        V v;
+        for (auto& p : v.points) p = get_vec<T>(r);
+        const T count = r.scalar<T>();
+        // A count that is not a whole number in [0, 16] is kept out of range for well_formed().
+        v.count = count >= T(0) && count <= T(16) && count == std::floor(count)
+                      ? std::uint32_t(count)
+                      : std::uint32_t(17);
+        v.margin = r.scalar<T>();
+        v.center = get_vec<T>(r);
+        v.reach = r.scalar<T>();
+        return v;
+    }
+    /// Points, margin, centre and reach finite; the reach holds every point plus the margin (the
+    /// bounding-sphere test relies on it), to the rounding of this check.
+    static bool well_formed(const V& v) {
+        if (v.count < 1 || v.count > 16) return false;
+        if (!finite_vec(v.center) || !finite_all({v.margin, v.reach}) || !(v.margin >= T(0)))
+            return false;
+        const double slack = 1 - 4 * double(std::numeric_limits<T>::epsilon());
+        for (std::uint32_t i = 0; i < 16; ++i) {
+            if (!finite_vec(v.points[i])) return false;
+            if (i < v.count && !(length(Vec3d(v.points[i]) - Vec3d(v.center)) + double(v.margin) <=
+                                 double(v.reach) / slack))
+                return false;
+        }
+        return true;
+    }
+    static bool contains(const V& v, const Vec3d& p, double tol) {
+        std::vector<Vec3d> points;
+        for (const auto& q : v.vertices()) points.push_back(Vec3d(q));
+        return hull_detail::distance_to_hull<double>(p, points) <= double(v.margin) + tol;
+    }
+};
+
 inline const char* volume_name(std::uint8_t code) {
     switch (VolumeCode(code)) {
         case VolumeCode::Aabb3:
@@ -260,6 +307,8 @@ inline const char* volume_name(std::uint8_t code) {
             return "Kdop18";
         case VolumeCode::Kdop26:
             return "Kdop26";
+        case VolumeCode::ConvexHull16:
+            return "ConvexHull16";
     }
     return "unknown";
 }

@@ -54,7 +54,8 @@ enum class VolumeCode : std::uint8_t {
     ObbRss = 6,
     Kdop14 = 7,
     Kdop18 = 8,
-    Kdop26 = 9
+    Kdop26 = 9,
+    ConvexHull16 = 10
 };
 
 template <class T>

@@ -52,48 +52,54 @@ struct ConvexHull {
 
 namespace hull_detail {
 
-/// An upper bound of the distance from p to conv(s), by GJK in double; the nearest point found is
-/// a convex combination of s, so its distance can only be too large (the rounding of the
-/// combination is added).
+/// An upper bound of the distance from p to conv(s), by GJK in double: every step's nearest point
+/// is a convex combination of s, so its distance can only be too large (the rounding of the
+/// combination is added); the least of them is returned. GJK stops when the support point adds
+/// nothing (within rounding, or a vertex it holds already: rounding would otherwise make it cycle).
 template <class T>
 double distance_to_hull(const Vec<T, 3>& p, std::span<const Vec<T, 3>> s) {
     const Vec<double, 3> q(p);
+    double scale = length(q);
+    for (const auto& a : s) scale = std::max(scale, length(Vec<double, 3>(a)));
+    const double pad = 16 * std::numeric_limits<double>::epsilon() * scale;
+    // The distance to the point the simplex's weights (clamped, normalised) give.
+    const auto measured = [&](const GjkSimplex<double>& simplex) {
+        Vec<double, 3> x{};
+        double total = 0;
+        const auto weights = simplex.weights();
+        for (std::size_t i = 0; i < weights.size(); ++i) {
+            const double l = std::max(weights[i], 0.0);
+            x += simplex.point_a(i) * l;
+            total += l;
+        }
+        if (!(total > 0)) return std::numeric_limits<double>::infinity();
+        return length(q - x * (1 / total)) * (1 + 1e-15) + pad;
+    };
     GjkSimplex<double> simplex;
     Vec<double, 3> v = Vec<double, 3>(s[0]) - q;
-    double scale = length(q);
+    double best = length(v) * (1 + 1e-15) + pad;
     for (int step = 0; step < 64; ++step) {
-        std::size_t best = 0;
+        std::size_t pick = 0;
         double low = std::numeric_limits<double>::infinity();
         for (std::size_t i = 0; i < s.size(); ++i) {
             const double d = dot(v, Vec<double, 3>(s[i]));
             if (d < low) {
                 low = d;
-                best = i;
+                pick = i;
             }
         }
-        const Vec<double, 3> a(s[best]);
-        scale = std::max(scale, length(a));
+        const Vec<double, 3> a(s[pick]);
         const Vec<double, 3> w = a - q;
         const double v2 = length_squared(v);
-        if (step > 0 && v2 - dot(v, w) <= 1e-12 * v2) break;
+        if (step > 0 && (v2 - dot(v, w) <= 1e-10 * v2 || simplex.holds(w))) break;
         simplex.add(w, a);
         bool inside = false;
         v = simplex.nearest(inside);
-        if (inside) return 16 * std::numeric_limits<double>::epsilon() * scale;
+        if (inside) return pad;
+        best = std::min(best, measured(simplex));
         if (length_squared(v) == 0) break;
     }
-    // The combination's point, recomputed from the weights (clamped, normalised).
-    Vec<double, 3> x{};
-    double total = 0;
-    const auto weights = simplex.weights();
-    for (std::size_t i = 0; i < weights.size(); ++i) {
-        const double l = std::max(weights[i], 0.0);
-        x += simplex.point_a(i) * l;
-        total += l;
-    }
-    if (!(total > 0)) return length(Vec<double, 3>(s[0]) - q) * (1 + 1e-15) + 1e-15 * scale;
-    x = x * (1 / total);
-    return length(q - x) * (1 + 1e-15) + 16 * std::numeric_limits<double>::epsilon() * scale;
+    return best;
 }
 
 /// Rounds a non-negative double up to T.
@@ -136,11 +142,19 @@ std::vector<std::uint32_t> select_farthest(std::span<const Vec<T, 3>> points,
             nearest = std::min(nearest, length(Vec<double, 3>(points[i]) - Vec<double, 3>(k)));
         heap.push({nearest * (1 + 1e-12), i});
     }
+    // A vertex within rounding of the kept hull is not worth keeping; its distance still counts.
+    double size = 0;
+    for (std::uint32_t i : hull) size = std::max(size, length(Vec<double, 3>(points[i])));
+    const double negligible = 64 * std::numeric_limits<double>::epsilon() * size;
+    double worst = 0;
     while (keep.size() < cap && !heap.empty()) {
         const std::uint32_t i = heap.top().second;
         heap.pop();
         const double d = distance_to_hull<T>(points[i], kept);
-        if (d <= 0) continue;
+        if (d <= negligible) {
+            worst = std::max(worst, d);
+            continue;
+        }
         if (heap.empty() || d >= heap.top().first)
             take(i);
         else
@@ -148,7 +162,6 @@ std::vector<std::uint32_t> select_farthest(std::span<const Vec<T, 3>> points,
     }
     // The largest distance left out: stale values bound the true ones from above, so the scan
     // stops at the first one no larger than the largest found.
-    double worst = 0;
     while (!heap.empty() && heap.top().first > worst) {
         worst = std::max(worst, distance_to_hull<T>(points[heap.top().second], kept));
         heap.pop();
@@ -182,9 +195,12 @@ ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin,
     }
     v.margin = margin > 0 ? round_up<T>(margin) : T(0);
     v.center = box.centroid();
-    // The box's half diagonal: it holds every kept vertex, and it never shrinks when volumes
-    // merge, so size() grows from child to parent.
-    const double half = length(Vec<double, 3>(box.max) - Vec<double, 3>(box.min)) * 0.5;
+    // The box's half diagonal, which never shrinks when volumes merge (so size() grows from child
+    // to parent), or, when the centre's rounding (far from the origin) leaves a vertex farther,
+    // that vertex's distance: the sphere holds every kept vertex.
+    double half = length(Vec<double, 3>(box.max) - Vec<double, 3>(box.min)) * 0.5;
+    for (std::uint32_t i = 0; i < v.count; ++i)
+        half = std::max(half, length(Vec<double, 3>(v.points[i]) - Vec<double, 3>(v.center)));
     v.reach = round_up<T>((half + double(v.margin)) * (1 + 1e-12)) * (T(1) + detail::fit_pad<T>);
     return v;
 }
@@ -309,7 +325,8 @@ struct VolumeTraits<ConvexHull<T, Cap>> {
             }
             const Vec<T, 3> w = a.points[ia] - (p.r * b.points[ib] + p.t);
             const T v2 = len * len;
-            if (step > 0 && v2 - dot(v, w) <= T(1e-4) * v2) break;  // as close as it gets
+            // As close as it gets (or a point it holds: rounding would make it cycle).
+            if (step > 0 && (v2 - dot(v, w) <= T(1e-4) * v2 || simplex.holds(w))) break;
             simplex.add(w, a.points[ia]);
             bool inside = false;
             v = simplex.nearest(inside);

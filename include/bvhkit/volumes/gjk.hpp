@@ -64,6 +64,12 @@ class GjkSimplex {
         return a;
     }
     std::span<const T> weights() const { return {lambda_.data(), size_}; }
+    /// True when `w` is one of the simplex's points already (GJK has converged).
+    bool holds(const Vec<T, 3>& w) const {
+        for (std::size_t i = 0; i < size_; ++i)
+            if (w_[i] == w) return true;
+        return false;
+    }
     const Vec<T, 3>& point_a(std::size_t i) const { return a_[i]; }
 
   private:
