@@ -6,6 +6,7 @@
 // slivers, points far from the origin, tiny and huge scales.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "bvhkit/io/read_mesh.hpp"
@@ -372,6 +373,113 @@ TEST(ConvexHullVolume, HardPointSetsAreCovered) {
         // The bounding sphere holds everything too.
         for (const Vec3f& p : s) ASSERT_LE(length(p - v.center), v.reach) << name;
     }
+}
+
+TEST(Quickhull, CollinearPickFromRoundingIsCheckedExactly) {
+    // a, c, b exactly on one line through (1, 3, 5), but the differences from a round
+    // differently per coordinate, so their rounded cross product is not zero and c (on the line)
+    // beat f (off it by one ulp in x) as the third corner: every orientation was zero, the set
+    // "flat", and the planar hull dropped f.
+    const double t0 = 1.5 * 0x1p-52;
+    const Vec3d d(1, 3, 5);
+    for (double dev : {0x1p-53, 0x1p-54}) {
+        Vec3d f = d * 0.25;
+        f[0] += dev;
+        std::vector<Vec3d> p{d * -t0, f, d * 0.5, d};
+        p = hull_detail::sorted_unique(std::move(p));
+        const auto h = quickhull_vertices<double>(p);
+        std::vector<Vec3d> kept;
+        for (std::uint32_t i : h) kept.push_back(p[i]);
+        EXPECT_EQ(h.size(), 3u);
+        EXPECT_NE(std::find(kept.begin(), kept.end(), f), kept.end()) << "dev " << dev;
+    }
+}
+
+/// B placed so that its support point along -n is `target` from A's support point along n:
+/// the cores' distance is then exactly that of those two points (the planes through them
+/// perpendicular to n separate the cores), computed here in long double from the pose as
+/// rounded to T. Whenever it is within the margins and slack, the volumes meet: overlaps() must
+/// say so, and distance_lower_bound must not exceed it less the margins.
+template <class T, std::size_t Cap>
+void touching_poses(SplitMix64& rng, int trials) {
+    using Tr = VolumeTraits<ConvexHull<T, Cap>>;
+    using L = long double;
+    using VL = Vec<L, 3>;
+    auto to_l = [](const Vec<T, 3>& x) { return VL(L(x[0]), L(x[1]), L(x[2])); };
+    auto random_set = [&](int kind) {
+        double off = 0, sc = 1;
+        const int o = int(rng.below(4)), s = int(rng.below(3));
+        off = o == 1 ? 1e5 : o == 2 ? 3e6 : o == 3 ? -1e7 : 0;
+        sc = s == 1 ? 1e-6 : s == 2 && o == 0 ? 1e6 : 1;
+        const Vec3d ax = rng.unit_vector(), by = normalize(cross(ax, rng.unit_vector()));
+        std::vector<Triangle<T>> tris;
+        const int n = 1 + int(rng.below(rng.below(2) ? 12 : 120));
+        std::vector<Vec<T, 3>> p;
+        for (int i = 0; i < n; ++i) {
+            const Vec3d r(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+            Vec3d q = r;
+            if (kind == 1) q = normalize(r);
+            if (kind == 2) q = Vec3d(r[0], r[1] * 1e-5, r[2]);
+            if (kind == 3) q = ax * r[0] + by * r[1];
+            if (kind == 4) q = ax * r[0];
+            if (kind == 5)
+                q = Vec3d(std::floor(r[0] * 2), std::floor(r[1] * 2), std::floor(r[2] * 2));
+            p.push_back(Vec<T, 3>(q * sc + Vec3d(off, -off * 0.5, off * 0.25)));
+        }
+        for (int i = 0; i < n; i += 3) tris.push_back({p[i], p[(i + 1) % n], p[(i + 2) % n]});
+        return Tr::fit(tris);
+    };
+    int met = 0;
+    for (int trial = 0; trial < trials; ++trial) {
+        const auto a = random_set(int(rng.below(6))), b = random_set(int(rng.below(6)));
+        const Vec3d q = rng.unit_vector();
+        const double w = rng.uniform(-1, 1), qn = std::sqrt(w * w + 1);
+        Transform<T> pose;
+        pose.rotation =
+            rotation_from_quaternion<T>(T(w / qn), T(q[0] / qn), T(q[1] / qn), T(q[2] / qn));
+        auto rotated = [&](const Vec<T, 3>& x) {
+            VL y;
+            for (int i = 0; i < 3; ++i) y[i] = dot(to_l(pose.rotation.row[i]), to_l(x));
+            return y;
+        };
+        Vec3d nd = rng.unit_vector();
+        if (rng.below(4) == 0) nd = Vec3d(0.0), nd[rng.below(3)] = 1;  // face to face on grids
+        const VL n{L(nd[0]), L(nd[1]), L(nd[2])};
+        VL pa = to_l(a.points[0]), pb = rotated(b.points[0]);
+        for (const auto& x : a.vertices())
+            if (dot(n, to_l(x)) > dot(n, pa)) pa = to_l(x);
+        for (const auto& x : b.vertices())
+            if (dot(n, rotated(x)) < dot(n, pb)) pb = rotated(x);
+        const T slack =
+            rng.below(2) ? T(0) : T(std::pow(10.0, rng.uniform(-8, 0)) * double(a.reach));
+        const L inflate = L(a.margin) + L(b.margin) + L(slack);
+        const L scale = length(pa) + length(pb) + L(a.reach) + L(b.reach);
+        L target = inflate + L(std::numeric_limits<T>::epsilon()) * scale * L(rng.uniform(-64, 64));
+        if (target < 0) target = -target * L(0.1);
+        const VL t = pa + n * target - pb;
+        pose.translation = Vec<T, 3>(T(t[0]), T(t[1]), T(t[2]));
+        const L gap = length(pb + to_l(pose.translation) - pa) * (1 + 1e-17L) + 1e-18L * scale;
+        const auto prepared = Tr::prepare(pose, slack);
+        if (gap <= inflate) {
+            ++met;
+            ASSERT_TRUE(Tr::overlaps(a, b, prepared))
+                << "trial " << trial << ": gap " << double(gap) << " within " << double(inflate);
+        }
+        ASSERT_LE(L(Tr::distance_lower_bound(a, b, prepared)), std::max(L(0), gap - inflate))
+            << "trial " << trial;
+    }
+    EXPECT_GT(met, 0);
+}
+
+TEST(ConvexHullVolume, TouchingPosesAreNeverApart) {
+    SplitMix64 rng(21);
+    const int trials = int(scaled(400));
+    touching_poses<float, 4>(rng, trials);
+    touching_poses<float, 8>(rng, trials);
+    touching_poses<float, 16>(rng, trials);
+    touching_poses<float, 32>(rng, trials / 2);
+    touching_poses<double, 4>(rng, trials);
+    touching_poses<double, 16>(rng, trials);
 }
 
 }  // namespace
