@@ -278,6 +278,34 @@ TEST(Gjk, InteriorPointsAreAtZero) {
     }
 }
 
+TEST(Gjk, RoundedInsideTestIsCheckedExactly) {
+    // Random slivers in double, the point just outside: GJK's rounded face tests put the origin
+    // inside the tetrahedron and distance_to_hull returned its pad (2.3e-12, 1.9e-13) though the
+    // point lies outside a face by at least the distances below (found with rational arithmetic:
+    // the largest signed distance to a facet plane, a lower bound of the distance).
+    struct Case {
+        Vec3d q;
+        std::vector<Vec3d> s;
+        double at_least;
+    };
+    const std::vector<Case> cases{
+        {{79.520782037245937, -29.592916531077492, 13.230815542446948},
+         {{335.71405244148036, 74.160405537921832, 80.359631830553894},
+          {-557.62647497680837, -287.628919906222, -153.71898106139378},
+          {147.3429943665366, -2.1164516061711964, 31.00677877808166},
+          {57.737806595652984, -102.1094081109344, 143.7154004062171}},
+         9.36e-11},
+        {{16.395144804189275, -14.991500562597004, -46.66923102651883},
+         {{15.753780003919671, -15.475764813852713, -45.420452945014823},
+          {17.023049503455688, -14.517399185594087, -47.891801739198961},
+          {16.205397699734696, -15.134770629588875, -46.299779909061421},
+          {17.340315307454468, -13.935647831356603, -47.336503841886085}},
+         2.16e-12},
+    };
+    for (const Case& c : cases)
+        EXPECT_GE(hull_detail::distance_to_hull<double>(c.q, c.s), c.at_least);
+}
+
 TEST(ConvexHullVolume, NoisySphereNodesHoldTheirVerticesByGjk) {
     TriangleMesh m = make_sphere(3);
     SplitMix64 rng(3);
