@@ -423,6 +423,34 @@ TEST(Quickhull, CollinearPickFromRoundingIsCheckedExactly) {
     }
 }
 
+TEST(ConvexHullVolume, NonFinitePointsAreLeftOut) {
+    // merge() and fit() on points holding NaN or infinity: the sort and the exact predicates
+    // need finite input (a NaN once overflowed a stack buffer in orient3d's expansions).
+    using Tr = VolumeTraits<ConvexHull<float, 16>>;
+    EXPECT_TRUE(Tr::fit(std::span<const Triangle<float>>{}).is_empty());
+    SplitMix64 rng(4);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (int trial = 0; trial < 50; ++trial) {
+        ConvexHull<float, 16> a, b;
+        a.count = b.count = 16;
+        Points finite;
+        for (std::size_t i = 0; i < 16; ++i) {
+            a.points[i] = Vec3f(rng.unit_vector());
+            b.points[i] = Vec3f(rng.unit_vector());
+            finite.push_back(b.points[i]);
+            if (rng.below(3) == 0)
+                a.points[i][rng.below(3)] =
+                    rng.below(2) ? nan : std::numeric_limits<float>::infinity();
+            else
+                finite.push_back(a.points[i]);
+        }
+        const auto m = Tr::merge(a, b);
+        ASSERT_GE(m.count, 1u);
+        for (const Vec3f& p : m.vertices()) ASSERT_TRUE(std::isfinite(length(p)));
+        expect_covers(m, finite, rng, "merge with non-finite points");
+    }
+}
+
 /// A lower bound of the distance from p to conv(s): the largest signed distance to a plane of a
 /// facet of conv(s) (facets found exactly; the plane's distance in long double, less a bound on
 /// its rounding).

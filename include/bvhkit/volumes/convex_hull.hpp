@@ -226,9 +226,15 @@ ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin,
     return v;
 }
 
-/// Sorted, unique copy of `points`.
+/// Sorted, unique copy of `points`, without the non-finite ones: a NaN breaks the sort's
+/// ordering and the exact predicates' expansions (merge() of a volume holding one overflowed a
+/// stack buffer in orient3d), and such a point bounds nothing (CollisionModel skips those
+/// triangles too).
 template <class T>
 std::vector<Vec<T, 3>> sorted_unique(std::vector<Vec<T, 3>> points) {
+    std::erase_if(points, [](const Vec<T, 3>& p) {
+        return !(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
+    });
     std::sort(points.begin(), points.end(),
               [](const Vec<T, 3>& a, const Vec<T, 3>& b) { return lexicographic_less(a, b); });
     points.erase(std::unique(points.begin(), points.end()), points.end());
