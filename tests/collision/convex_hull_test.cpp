@@ -6,6 +6,7 @@
 // slivers, points far from the origin, tiny and huge scales.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "bvhkit/io/read_mesh.hpp"
@@ -277,6 +278,34 @@ TEST(Gjk, InteriorPointsAreAtZero) {
     }
 }
 
+TEST(Gjk, RoundedInsideTestIsCheckedExactly) {
+    // Random slivers in double, the point just outside: GJK's rounded face tests put the origin
+    // inside the tetrahedron and distance_to_hull returned its pad (2.3e-12, 1.9e-13) though the
+    // point lies outside a face by at least the distances below (found with rational arithmetic:
+    // the largest signed distance to a facet plane, a lower bound of the distance).
+    struct Case {
+        Vec3d q;
+        std::vector<Vec3d> s;
+        double at_least;
+    };
+    const std::vector<Case> cases{
+        {{79.520782037245937, -29.592916531077492, 13.230815542446948},
+         {{335.71405244148036, 74.160405537921832, 80.359631830553894},
+          {-557.62647497680837, -287.628919906222, -153.71898106139378},
+          {147.3429943665366, -2.1164516061711964, 31.00677877808166},
+          {57.737806595652984, -102.1094081109344, 143.7154004062171}},
+         9.36e-11},
+        {{16.395144804189275, -14.991500562597004, -46.66923102651883},
+         {{15.753780003919671, -15.475764813852713, -45.420452945014823},
+          {17.023049503455688, -14.517399185594087, -47.891801739198961},
+          {16.205397699734696, -15.134770629588875, -46.299779909061421},
+          {17.340315307454468, -13.935647831356603, -47.336503841886085}},
+         2.16e-12},
+    };
+    for (const Case& c : cases)
+        EXPECT_GE(hull_detail::distance_to_hull<double>(c.q, c.s), c.at_least);
+}
+
 TEST(ConvexHullVolume, NoisySphereNodesHoldTheirVerticesByGjk) {
     TriangleMesh m = make_sphere(3);
     SplitMix64 rng(3);
@@ -372,6 +401,203 @@ TEST(ConvexHullVolume, HardPointSetsAreCovered) {
         // The bounding sphere holds everything too.
         for (const Vec3f& p : s) ASSERT_LE(length(p - v.center), v.reach) << name;
     }
+}
+
+TEST(Quickhull, CollinearPickFromRoundingIsCheckedExactly) {
+    // a, c, b exactly on one line through (1, 3, 5), but the differences from a round
+    // differently per coordinate, so their rounded cross product is not zero and c (on the line)
+    // beat f (off it by one ulp in x) as the third corner: every orientation was zero, the set
+    // "flat", and the planar hull dropped f.
+    const double t0 = 1.5 * 0x1p-52;
+    const Vec3d d(1, 3, 5);
+    for (double dev : {0x1p-53, 0x1p-54}) {
+        Vec3d f = d * 0.25;
+        f[0] += dev;
+        std::vector<Vec3d> p{d * -t0, f, d * 0.5, d};
+        p = hull_detail::sorted_unique(std::move(p));
+        const auto h = quickhull_vertices<double>(p);
+        std::vector<Vec3d> kept;
+        for (std::uint32_t i : h) kept.push_back(p[i]);
+        EXPECT_EQ(h.size(), 3u);
+        EXPECT_NE(std::find(kept.begin(), kept.end(), f), kept.end()) << "dev " << dev;
+    }
+}
+
+TEST(ConvexHullVolume, NonFinitePointsAreLeftOut) {
+    // merge() and fit() on points holding NaN or infinity: the sort and the exact predicates
+    // need finite input (a NaN once overflowed a stack buffer in orient3d's expansions).
+    using Tr = VolumeTraits<ConvexHull<float, 16>>;
+    EXPECT_TRUE(Tr::fit(std::span<const Triangle<float>>{}).is_empty());
+    SplitMix64 rng(4);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (int trial = 0; trial < 50; ++trial) {
+        ConvexHull<float, 16> a, b;
+        a.count = b.count = 16;
+        Points finite;
+        for (std::size_t i = 0; i < 16; ++i) {
+            a.points[i] = Vec3f(rng.unit_vector());
+            b.points[i] = Vec3f(rng.unit_vector());
+            finite.push_back(b.points[i]);
+            if (rng.below(3) == 0)
+                a.points[i][rng.below(3)] =
+                    rng.below(2) ? nan : std::numeric_limits<float>::infinity();
+            else
+                finite.push_back(a.points[i]);
+        }
+        const auto m = Tr::merge(a, b);
+        ASSERT_GE(m.count, 1u);
+        for (const Vec3f& p : m.vertices()) ASSERT_TRUE(std::isfinite(length(p)));
+        expect_covers(m, finite, rng, "merge with non-finite points");
+    }
+}
+
+/// A lower bound of the distance from p to conv(s): the largest signed distance to a plane of a
+/// facet of conv(s) (facets found exactly; the plane's distance in long double, less a bound on
+/// its rounding).
+template <class T>
+long double facet_distance_lower_bound(const Vec<T, 3>& p, std::span<const Vec<T, 3>> s) {
+    using L = long double;
+    using VL = Vec<L, 3>;
+    auto to_l = [](const Vec<T, 3>& x) { return VL(L(x[0]), L(x[1]), L(x[2])); };
+    L best = 0;
+    for (std::size_t i = 0; i < s.size(); ++i)
+        for (std::size_t j = i + 1; j < s.size(); ++j)
+            for (std::size_t k = j + 1; k < s.size(); ++k) {
+                int above = 0, below = 0;
+                for (const auto& x : s) {
+                    const int o = orient3d_sign(s[i], s[j], s[k], x);
+                    above += o > 0;
+                    below += o < 0;
+                }
+                if (above && below) continue;
+                const VL e1 = to_l(s[j]) - to_l(s[i]), e2 = to_l(s[k]) - to_l(s[i]);
+                const VL dp = to_l(p) - to_l(s[i]), n = cross(e1, e2);
+                const L len = length(n);
+                if (!(len > 0)) continue;
+                const L err =
+                    8e-19L * length(e1) * length(e2) * length(dp) / len + 8e-19L * length(dp);
+                L h = dot(n, dp) / len;
+                h = !above && !below ? std::fabs(h) : above ? -h : h;
+                best = std::max(best, h - err);
+            }
+    return best;
+}
+
+TEST(ConvexHullVolume, NeedleFacesAreCoveredInDouble) {
+    // A tetrahedron with a needle-thin face and points just outside that face: all hull vertices,
+    // so a capped volume drops some and its margin comes from distance_to_hull, whose rounded
+    // "inside" once made the margin 9e-15 for a point 6.5e-11 outside the kept hull.
+    SplitMix64 rng(1);
+    for (int trial = 0, trials = int(scaled(4000)); trial < trials; ++trial) {
+        const Vec3d ax = rng.unit_vector(), by = rng.unit_vector();
+        const Vec3d o = rng.unit_vector() * std::pow(10.0, rng.uniform(0, 3));
+        const Vec3d b2 = normalize(cross(ax, by)), b3 = normalize(cross(ax, b2));
+        const double scale = std::pow(10.0, rng.uniform(-2, 3));
+        const double thin = std::pow(10.0, rng.uniform(-14, -4));
+        std::vector<Vec3d> p{
+            ax * -1.0, ax, ax * rng.uniform(-1, 1) + b2 * thin,
+            b3 * rng.uniform(-1, 1) + ax * rng.uniform(-1, 1) + b2 * rng.uniform(-1, 1) * 1e-3};
+        Vec3d n = normalize(cross(p[1] - p[0], p[2] - p[0]));
+        if (dot(n, p[3] - p[0]) > 0) n = -n;
+        for (int k = 0, extra = 1 + int(rng.below(8)); k < extra; ++k) {
+            const Vec3d f =
+                (p[0] * rng.uniform(0, 1) + p[1] * rng.uniform(0, 1)) * 0.5 + p[2] * 0.1;
+            p.push_back(f + n * std::pow(10.0, rng.uniform(-15, -8)));
+        }
+        for (Vec3d& x : p) x = x * scale + o;
+        p = hull_detail::sorted_unique(std::move(p));
+        const auto v = hull_detail::hull_of<double, 4>(p, 0.0);
+        for (const Vec3d& x : p)
+            ASSERT_LE(facet_distance_lower_bound<double>(x, v.vertices()), (long double)v.margin)
+                << "trial " << trial;
+    }
+}
+
+/// B placed so that its support point along -n is `target` from A's support point along n:
+/// the cores' distance is then exactly that of those two points (the planes through them
+/// perpendicular to n separate the cores), computed here in long double from the pose as
+/// rounded to T. Whenever it is within the margins and slack, the volumes meet: overlaps() must
+/// say so, and distance_lower_bound must not exceed it less the margins.
+template <class T, std::size_t Cap>
+void touching_poses(SplitMix64& rng, int trials, int& met) {
+    using Tr = VolumeTraits<ConvexHull<T, Cap>>;
+    using L = long double;
+    using VL = Vec<L, 3>;
+    auto to_l = [](const Vec<T, 3>& x) { return VL(L(x[0]), L(x[1]), L(x[2])); };
+    auto random_set = [&](int kind) {
+        double off = 0, sc = 1;
+        const int o = int(rng.below(4)), s = int(rng.below(3));
+        off = o == 1 ? 1e5 : o == 2 ? 3e6 : o == 3 ? -1e7 : 0;
+        sc = s == 1 ? 1e-6 : s == 2 && o == 0 ? 1e6 : 1;
+        const Vec3d ax = rng.unit_vector(), by = normalize(cross(ax, rng.unit_vector()));
+        std::vector<Triangle<T>> tris;
+        const int n = 1 + int(rng.below(rng.below(2) ? 12 : 120));
+        std::vector<Vec<T, 3>> p;
+        for (int i = 0; i < n; ++i) {
+            const Vec3d r(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+            Vec3d q = r;
+            if (kind == 1) q = normalize(r);
+            if (kind == 2) q = Vec3d(r[0], r[1] * 1e-5, r[2]);
+            if (kind == 3) q = ax * r[0] + by * r[1];
+            if (kind == 4) q = ax * r[0];
+            if (kind == 5)
+                q = Vec3d(std::floor(r[0] * 2), std::floor(r[1] * 2), std::floor(r[2] * 2));
+            p.push_back(Vec<T, 3>(q * sc + Vec3d(off, -off * 0.5, off * 0.25)));
+        }
+        for (int i = 0; i < n; i += 3) tris.push_back({p[i], p[(i + 1) % n], p[(i + 2) % n]});
+        return Tr::fit(tris);
+    };
+    for (int trial = 0; trial < trials; ++trial) {
+        const auto a = random_set(int(rng.below(6))), b = random_set(int(rng.below(6)));
+        const Vec3d q = rng.unit_vector();
+        const double w = rng.uniform(-1, 1), qn = std::sqrt(w * w + 1);
+        Transform<T> pose;
+        pose.rotation =
+            rotation_from_quaternion<T>(T(w / qn), T(q[0] / qn), T(q[1] / qn), T(q[2] / qn));
+        auto rotated = [&](const Vec<T, 3>& x) {
+            VL y;
+            for (int i = 0; i < 3; ++i) y[i] = dot(to_l(pose.rotation.row[i]), to_l(x));
+            return y;
+        };
+        Vec3d nd = rng.unit_vector();
+        if (rng.below(4) == 0) nd = Vec3d(0.0), nd[rng.below(3)] = 1;  // face to face on grids
+        const VL n{L(nd[0]), L(nd[1]), L(nd[2])};
+        VL pa = to_l(a.points[0]), pb = rotated(b.points[0]);
+        for (const auto& x : a.vertices())
+            if (dot(n, to_l(x)) > dot(n, pa)) pa = to_l(x);
+        for (const auto& x : b.vertices())
+            if (dot(n, rotated(x)) < dot(n, pb)) pb = rotated(x);
+        const T slack =
+            rng.below(2) ? T(0) : T(std::pow(10.0, rng.uniform(-8, 0)) * double(a.reach));
+        const L inflate = L(a.margin) + L(b.margin) + L(slack);
+        const L scale = length(pa) + length(pb) + L(a.reach) + L(b.reach);
+        L target = inflate + L(std::numeric_limits<T>::epsilon()) * scale * L(rng.uniform(-64, 64));
+        if (target < 0) target = -target * L(0.1);
+        const VL t = pa + n * target - pb;
+        pose.translation = Vec<T, 3>(T(t[0]), T(t[1]), T(t[2]));
+        const L gap = length(pb + to_l(pose.translation) - pa) * (1 + 1e-17L) + 1e-18L * scale;
+        const auto prepared = Tr::prepare(pose, slack);
+        if (gap <= inflate) {
+            ++met;
+            ASSERT_TRUE(Tr::overlaps(a, b, prepared))
+                << "trial " << trial << ": gap " << double(gap) << " within " << double(inflate);
+        }
+        ASSERT_LE(L(Tr::distance_lower_bound(a, b, prepared)), std::max(L(0), gap - inflate))
+            << "trial " << trial;
+    }
+}
+
+TEST(ConvexHullVolume, TouchingPosesAreNeverApart) {
+    SplitMix64 rng(21);
+    const int trials = int(scaled(400, 5));
+    int met = 0;
+    touching_poses<float, 4>(rng, trials, met);
+    touching_poses<float, 8>(rng, trials, met);
+    touching_poses<float, 16>(rng, trials, met);
+    touching_poses<float, 32>(rng, trials / 2, met);
+    touching_poses<double, 4>(rng, trials, met);
+    touching_poses<double, 16>(rng, trials, met);
+    EXPECT_GT(met, 0) << "no pose within the margins: the test tests nothing";
 }
 
 }  // namespace

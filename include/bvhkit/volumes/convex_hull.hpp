@@ -52,6 +52,23 @@ struct ConvexHull {
 
 namespace hull_detail {
 
+/// Whether q lies in the tetrahedron of the simplex's four points of A, exactly (a flat one
+/// counts as "not known").
+inline bool certainly_inside(const GjkSimplex<double>& simplex, const Vec<double, 3>& q) {
+    if (simplex.size() != 4) return false;
+    static constexpr int faces[4][4] = {{0, 1, 2, 3}, {0, 1, 3, 2}, {0, 2, 3, 1}, {1, 2, 3, 0}};
+    for (const auto& f : faces) {
+        const auto& a = simplex.point_a(std::size_t(f[0]));
+        const auto& b = simplex.point_a(std::size_t(f[1]));
+        const auto& c = simplex.point_a(std::size_t(f[2]));
+        const int opposite = orient3d_sign(a, b, c, simplex.point_a(std::size_t(f[3])));
+        if (opposite == 0) return false;
+        const int side = orient3d_sign(a, b, c, q);
+        if (side != 0 && side != opposite) return false;
+    }
+    return true;
+}
+
 /// An upper bound of the distance from p to conv(s), by GJK in double: every step's nearest point
 /// is a convex combination of s, so its distance can only be too large (the rounding of the
 /// combination is added); the least of them is returned. GJK stops when the support point adds
@@ -95,7 +112,11 @@ double distance_to_hull(const Vec<T, 3>& p, std::span<const Vec<T, 3>> s) {
         simplex.add(w, a);
         bool inside = false;
         v = simplex.nearest(inside);
-        if (inside) return pad;
+        // The rounded face tests of a tetrahedron with a needle-thin face can put the origin
+        // inside while the point lies outside by far more than `pad` (seen: 1e-10 at a scale of
+        // 600 in double): only an exact test may return pad; otherwise the least distance
+        // measured so far stays the (conservative) answer.
+        if (inside) return certainly_inside(simplex, q) ? pad : best;
         best = std::min(best, measured(simplex));
         if (length_squared(v) == 0) break;
     }
@@ -205,9 +226,15 @@ ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin,
     return v;
 }
 
-/// Sorted, unique copy of `points`.
+/// Sorted, unique copy of `points`, without the non-finite ones: a NaN breaks the sort's
+/// ordering and the exact predicates' expansions (merge() of a volume holding one overflowed a
+/// stack buffer in orient3d), and such a point bounds nothing (CollisionModel skips those
+/// triangles too).
 template <class T>
 std::vector<Vec<T, 3>> sorted_unique(std::vector<Vec<T, 3>> points) {
+    std::erase_if(points, [](const Vec<T, 3>& p) {
+        return !(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
+    });
     std::sort(points.begin(), points.end(),
               [](const Vec<T, 3>& a, const Vec<T, 3>& b) { return lexicographic_less(a, b); });
     points.erase(std::unique(points.begin(), points.end()), points.end());

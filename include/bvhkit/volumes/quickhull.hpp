@@ -96,7 +96,10 @@ class Quickhull {
                 s[2] = i;
             }
         }
-        if (best == 0 && !find_off_line(s)) return 1;
+        // The rounded cross product of exactly collinear points need not be zero (the
+        // differences round), so the pick is checked exactly: a collinear s[2] while another
+        // point is off the line would make every orientation below zero and the set "flat".
+        if ((best == 0 || !off_line(s, s[2])) && !find_off_line(s)) return 1;
         const Vec<double, 3> n = cross(ab, point(s[2]) - a);
         best = -1;
         for (std::uint32_t i = 0; i < p_.size(); ++i) {
@@ -115,16 +118,23 @@ class Quickhull {
             }
         return 2;
     }
+    /// Whether point i is off the line through s[0] and s[1], exactly.
+    bool off_line(const std::array<std::uint32_t, 4>& s, std::uint32_t i) const {
+        for (int axis = 0; axis < 3; ++axis)
+            if (projected_orientation(s[0], s[1], i, axis) != 0) return true;
+        return false;
+    }
+    /// The sign of triangle (a, b, c) projected along `axis`, exactly.
+    int projected_orientation(std::uint32_t a, std::uint32_t b, std::uint32_t c, int axis) const {
+        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+        return orient2d_sign(p_[a][u], p_[a][v], p_[b][u], p_[b][v], p_[c][u], p_[c][v]);
+    }
     /// The rounded distance said "on the line"; an exact look for a point off it.
     bool find_off_line(std::array<std::uint32_t, 4>& s) const {
         for (std::uint32_t i = 1; i + 1 < p_.size(); ++i)
-            for (int axis = 0; axis < 3; ++axis) {
-                const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-                if (orient2d_sign(p_[s[0]][u], p_[s[0]][v], p_[s[1]][u], p_[s[1]][v], p_[i][u],
-                                  p_[i][v]) != 0) {
-                    s[2] = i;
-                    return true;
-                }
+            if (off_line(s, i)) {
+                s[2] = i;
+                return true;
             }
         return false;
     }
@@ -132,8 +142,15 @@ class Quickhull {
     /// Coplanar points: the hull in the plane, on the projection along the normal's largest
     /// component (an affine map that is one-to-one on the plane, so the orientations are kept).
     std::vector<std::uint32_t> planar_hull(const std::array<std::uint32_t, 4>& s) const {
+        // The rounded normal of a nearly collinear s[0], s[1], s[2] may be largest along an axis
+        // the plane holds (a projection along it flattens the plane to a line): only axes whose
+        // projection keeps the triangle's area, decided exactly, are candidates.
         const Vec<double, 3> n = cross(point(s[1]) - point(s[0]), point(s[2]) - point(s[0]));
-        const std::size_t drop = largest_axis(abs(n));
+        std::size_t drop = 3;
+        for (std::size_t axis = 0; axis < 3; ++axis)
+            if (projected_orientation(s[0], s[1], s[2], int(axis)) != 0 &&
+                (drop == 3 || std::fabs(n[axis]) > std::fabs(n[drop])))
+                drop = axis;
         const std::size_t u = (drop + 1) % 3, v = (drop + 2) % 3;
         std::vector<std::uint32_t> order = all();
         std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
@@ -195,24 +212,26 @@ class Quickhull {
     void expand() {
         std::vector<std::uint32_t> visible, stack, orphans;
         std::vector<std::uint32_t> starts(p_.size(), UINT32_MAX);
-        std::vector<char> seen;
+        // The round that last reached each face: clearing a flag per face every round made the
+        // rounds quadratic in the faces ever made (160k points on a sphere took 3.5 s).
+        std::vector<std::size_t> seen;
         // Each round makes one more hull vertex, so the rounds are at most the points.
         for (std::size_t f = 0, rounds = 0; f < faces_.size() && rounds <= p_.size(); ++f) {
             if (!faces_[f].alive || faces_[f].outside.empty()) continue;
             ++rounds;
             const std::uint32_t eye = farthest(faces_[f]);
             // The faces the eye sees form one connected patch around face f.
-            seen.assign(faces_.size(), 0);
+            seen.resize(faces_.size(), 0);
             visible.clear();
             stack.assign(1, std::uint32_t(f));
-            seen[f] = 1;
+            seen[f] = rounds;
             while (!stack.empty()) {
                 const std::uint32_t g = stack.back();
                 stack.pop_back();
                 visible.push_back(g);
                 for (std::uint32_t h : faces_[g].nb)
-                    if (!seen[h] && outside(faces_[h], eye)) {
-                        seen[h] = 1;
+                    if (seen[h] != rounds && outside(faces_[h], eye)) {
+                        seen[h] = rounds;
                         stack.push_back(h);
                     }
             }
@@ -221,7 +240,7 @@ class Quickhull {
             for (std::uint32_t g : visible)
                 for (int e = 0; e < 3; ++e) {
                     const std::uint32_t across = faces_[g].nb[e];
-                    if (seen[across]) continue;
+                    if (seen[across] == rounds) continue;
                     const std::uint32_t a = faces_[g].v[e], b = faces_[g].v[(e + 1) % 3];
                     Face nf = make_face(a, b, eye);
                     nf.nb[0] = across;
