@@ -215,10 +215,14 @@ class Quickhull {
         // The round that last reached each face: clearing a flag per face every round made the
         // rounds quadratic in the faces ever made (160k points on a sphere took 3.5 s).
         std::vector<std::size_t> seen;
-        // Each round makes one more hull vertex, so the rounds are at most the points.
-        for (std::size_t f = 0, rounds = 0; f < faces_.size() && rounds <= p_.size(); ++f) {
+        // Each round makes one more hull vertex, so the rounds are at most the points; more would
+        // mean a broken hull, answered by keeping every point.
+        for (std::size_t f = 0, rounds = 0; f < faces_.size(); ++f) {
             if (!faces_[f].alive || faces_[f].outside.empty()) continue;
-            ++rounds;
+            if (++rounds > p_.size()) {
+                broken_ = true;
+                return;
+            }
             const std::uint32_t eye = farthest(faces_[f]);
             // The faces the eye sees form one connected patch around face f.
             seen.resize(faces_.size(), 0);
