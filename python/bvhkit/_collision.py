@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import hashlib
 import struct
 from typing import Any, List, NamedTuple, Union
 
@@ -10,6 +9,7 @@ import numpy as np
 
 from . import _arrays as _a
 from . import _bvhkit
+from ._scene_file import _checksum, _pad  # the same container framing as scenes
 
 VOLUMES = ("obb", "rss", "obbrss", "aabb", "sphere", "kdop18", "hull")
 
@@ -27,17 +27,6 @@ _VOLUME_CODES = {"aabb": 1, "sphere": 3, "obb": 4, "rss": 5, "obbrss": 6, "kdop1
 
 load_count: int = 0
 """How many models this process has loaded (from_bytes, load, unpickling); a diagnostic."""
-
-
-def _pad(n: int) -> int:
-    return -n % 8
-
-
-def _checksum(header: bytes, payload: Any) -> bytes:
-    h = hashlib.blake2b(digest_size=8)
-    h.update(header)
-    h.update(payload)
-    return h.digest()
 
 
 def _encode(dtype: np.dtype, volume: str, state: tuple) -> bytes:
