@@ -9,7 +9,7 @@ import numpy as np
 
 from . import _arrays as _a
 from . import _bvhkit
-from ._scene_file import _checksum, _pad  # the same container framing as scenes
+from ._scene_file import _checksum, _join_sections, _split_sections  # the scenes' framing
 
 VOLUMES = ("obb", "rss", "obbrss", "aabb", "sphere", "kdop18", "hull")
 
@@ -37,7 +37,7 @@ def _encode(dtype: np.dtype, volume: str, state: tuple) -> bytes:
         np.ascontiguousarray(faces, "<u4").tobytes(),
         model,
     ]
-    payload = b"".join(s + bytes(_pad(len(s))) for s in sections)
+    payload = _join_sections(sections)
     header = _HEADER.pack(
         _MAGIC, _VERSION, scalar, _VOLUME_CODES[volume], 0, len(vertices), len(faces),
         len(model), len(payload)
@@ -77,16 +77,7 @@ def _decode(data: Any, what: str):
         raise fail("checksum mismatch (the data is damaged)")
     dtype = _SCALARS[scalar]
     sizes = [3 * nv * dtype.itemsize, 3 * nf * 4, nmodel]
-    # Python integers do not overflow: a forged count just makes this sum too large.
-    if sum(s + _pad(s) for s in sizes) != npayload:
-        raise fail("the section sizes do not add up to the payload")
-    parts = []
-    at = 0
-    for s in sizes:
-        parts.append(payload[at : at + s])
-        if any(payload[at + s : at + s + _pad(s)]):
-            raise fail("non-zero padding")
-        at += s + _pad(s)
+    parts = _split_sections(payload, sizes, fail)
     native = np.dtype(np.float32 if scalar == 1 else np.float64)
     vertices = np.frombuffer(parts[0], dtype).astype(native).reshape(nv, 3)
     faces = np.frombuffer(parts[1], "<u4").astype(np.int64).reshape(nf, 3)

@@ -37,6 +37,27 @@ def _checksum(header: bytes, payload: Any) -> bytes:
     return h.digest()
 
 
+def _join_sections(sections: list) -> bytes:
+    """The sections, each padded with zeros to a multiple of 8 bytes."""
+    return b"".join(s + bytes(_pad(len(s))) for s in sections)
+
+
+def _split_sections(payload: Any, sizes: list, fail: Any) -> list:
+    """The sections of `sizes` bytes out of `payload`, checking that they fill it exactly and that
+    every padding byte is zero; `fail(message)` makes the exception to raise."""
+    # Python integers do not overflow: a forged count just makes this sum too large.
+    if sum(s + _pad(s) for s in sizes) != len(payload):
+        raise fail("the section sizes do not add up to the payload")
+    parts = []
+    at = 0
+    for s in sizes:
+        parts.append(payload[at : at + s])
+        if any(payload[at + s : at + s + _pad(s)]):
+            raise fail("non-zero padding")
+        at += s + _pad(s)
+    return parts
+
+
 def encode(dtype: np.dtype, builder: str, state: tuple) -> bytes:
     """The container's bytes from the scene's ``state()`` (C++: mesh arrays and tree files)."""
     vertices, faces, _ray_test, tree, sdf, winding = state
@@ -51,7 +72,7 @@ def encode(dtype: np.dtype, builder: str, state: tuple) -> bytes:
         sdf or b"",
         winding or b"",
     ]
-    payload = b"".join(s + bytes(_pad(len(s))) for s in sections)
+    payload = _join_sections(sections)
     header = _HEADER.pack(
         MAGIC,
         VERSION,
@@ -116,16 +137,7 @@ def decode(data: Any, what: str) -> Decoded:
         raise fail("flags and section sizes disagree")
     dtype = _SCALARS[scalar]
     sizes = [nname, 3 * nv * dtype.itemsize, 3 * nf * 4, ntree, nsdf, nwinding]
-    # Python integers do not overflow: a forged count just makes this sum too large.
-    if sum(s + _pad(s) for s in sizes) != npayload:
-        raise fail("the section sizes do not add up to the payload")
-    parts = []
-    at = 0
-    for s in sizes:
-        parts.append(payload[at : at + s])
-        if any(payload[at + s : at + s + _pad(s)]):
-            raise fail("non-zero padding")
-        at += s + _pad(s)
+    parts = _split_sections(payload, sizes, fail)
     d = Decoded()
     d.dtype = np.dtype(np.float32 if scalar == 1 else np.float64)
     try:

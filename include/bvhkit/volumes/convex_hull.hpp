@@ -232,9 +232,7 @@ ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin,
 /// triangles too).
 template <class T>
 std::vector<Vec<T, 3>> sorted_unique(std::vector<Vec<T, 3>> points) {
-    std::erase_if(points, [](const Vec<T, 3>& p) {
-        return !(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
-    });
+    std::erase_if(points, [](const Vec<T, 3>& p) { return !is_finite(p); });
     std::sort(points.begin(), points.end(),
               [](const Vec<T, 3>& a, const Vec<T, 3>& b) { return lexicographic_less(a, b); });
     points.erase(std::unique(points.begin(), points.end()), points.end());
@@ -270,8 +268,10 @@ struct VolumeTraits<ConvexHull<T, Cap>> {
                 }
                 points = hull_detail::sorted_unique(std::move(points));
             }
-            for (std::uint32_t i : quickhull_vertices<T>(points)) hulls[n].push_back(points[i]);
-            hulls[n] = hull_detail::sorted_unique(std::move(hulls[n]));
+            // `points` is sorted, so the vertices in index order are sorted too.
+            std::vector<std::uint32_t> vertices = quickhull_vertices<T>(points);
+            std::sort(vertices.begin(), vertices.end());
+            for (std::uint32_t i : vertices) hulls[n].push_back(points[i]);
             node.bounds = hull_detail::hull_of<T, Cap>(hulls[n], 0.0, true);
         }
     }
