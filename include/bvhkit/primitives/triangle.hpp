@@ -44,11 +44,17 @@ struct WatertightRay {
     WatertightRay() = default;
     explicit WatertightRay(const Ray<T, 3>& ray) {
         const Vec<T, 3>& d = ray.direction;
-        kz = std::fabs(d[0]) >= std::fabs(d[1]) ? (std::fabs(d[0]) >= std::fabs(d[2]) ? 0 : 2)
-                                                : (std::fabs(d[1]) >= std::fabs(d[2]) ? 1 : 2);
-        kx = (kz + 1) % 3;
-        ky = (kx + 1) % 3;
-        if (d[kz] < T(0)) std::swap(kx, ky);
+        // kz = d0 >= d1 ? (d0 >= d2 ? 0 : 2) : (d1 >= d2 ? 1 : 2) in magnitudes, and the swap,
+        // without branches: for incoherent rays each would be a coin toss for the predictor.
+        const T a0 = std::fabs(d[0]), a1 = std::fabs(d[1]), a2 = std::fabs(d[2]);
+        const unsigned c01 = a0 >= a1, c02 = a0 >= a2, c12 = a1 >= a2;
+        kz = 2u - 2u * (c01 & c02) - ((c01 ^ 1u) & c12);
+        // (kz + 1) % 3 and (kz + 2) % 3, read from two-bit fields.
+        const std::uint32_t x0 = (0b00'10'01u >> (2u * kz)) & 3u,
+                            y0 = (0b01'00'10u >> (2u * kz)) & 3u;
+        const std::uint32_t swap = (x0 ^ y0) & (0u - std::uint32_t(d[kz] < T(0)));
+        kx = x0 ^ swap;
+        ky = y0 ^ swap;
         valid = d[kz] != T(0) && std::isfinite(d[0]) && std::isfinite(d[1]) && std::isfinite(d[2]);
         // |sx|, |sy| <= 1 by the choice of kz, also for subnormal components; d[kz] itself is
         // used only as a divisor of t (1 / d[kz] overflows for a subnormal d[kz]).

@@ -6,7 +6,7 @@
 //
 // A node holds its children's boxes one array per axis and bound, so one SIMD pass clips the ray
 // against all of them (Wald, Benthin and Boulos 2008; Dammertz et al. 2008). The near and far
-// planes are chosen at compile time per ray octant. The hit children are visited nearest first:
+// planes are chosen once per ray (SlabConstants). The hit children are visited nearest first:
 // the others go on a stack with their entry distances, and an entry farther than the closest hit
 // so far is dropped when popped, without reading its node. A leaf child is a run of
 // TriangleGroup4s, four triangles tested at once (primitives/triangle_group4.hpp) with the answers
@@ -153,16 +153,27 @@ template <int W, class Line>
     return true;
 }
 
-// The ray's constants for the slab test: origin, reciprocal direction, and the reciprocal scaled
-// for the far planes (the conservative rounding of math/ray.hpp).
+// The ray's constants for the slab test: origin, reciprocal direction, the reciprocal scaled for
+// the far planes (the conservative rounding of math/ray.hpp), and which row of RayNode::lo holds
+// each axis's near and far planes. The rows are chosen per ray at run time rather than by one
+// compiled walk per octant: incoherent rays then share one copy of the walk, and pay neither the
+// dispatch's mispredicted indirect jump nor the branches that computed the octant.
 struct SlabConstants {
     float origin[3], inv[3], inv_far[3];
-    explicit SlabConstants(const RaySlabData<float, 3>& slab) {
+    std::uint32_t near[3], far[3];
+    /// For a ray wide_ray_usable accepts: no subnormal direction component, so 1 / d is what
+    /// RaySlabData holds (an infinity for a zero of either sign, finite otherwise).
+    explicit SlabConstants(const Ray<float, 3>& ray) {
         constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
-        for (int a = 0; a < 3; ++a) {
-            origin[a] = slab.origin[a];
-            inv[a] = slab.inv_direction[a];
-            inv_far[a] = slab.inv_direction[a] * s;
+        for (std::uint32_t a = 0; a < 3; ++a) {
+            origin[a] = ray.origin[a];
+            inv[a] = 1.0f / ray.direction[a];
+            inv_far[a] = inv[a] * s;
+            // -0 counts as negative, as in RaySlabData: its -inf reciprocal meets the planes in
+            // the right order.
+            const std::uint32_t negative = std::signbit(ray.direction[a]) ? 3u : 0u;
+            near[a] = a + negative;
+            far[a] = a + 3u - negative;
         }
     }
 };
@@ -170,7 +181,7 @@ struct SlabConstants {
 // The walks: calls on_leaf(first_group, groups), which may shrink ray.tmax and returns true to
 // stop. maxps/minps return their second operand when either is NaN, and the accumulators never
 // are, so a 0 * inf plane distance does not restrict the interval (as in the scalar test).
-template <unsigned O, class OnLeaf, class Stats>
+template <class OnLeaf, class Stats>
 void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k, WideEntry* stack,
            OnLeaf& on_leaf, Stats& stats) {
     __m128 origin[3], inv[3], inv_far[3];
@@ -181,9 +192,10 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
     }
     const RayNode<4>* nodes = tree.nodes.data();
     const TriangleGroup4* groups = tree.groups.data();
-    const auto line = [&](const WideEntry& e) {
-        return e.groups == 0 ? reinterpret_cast<const char*>(nodes + e.child)
-                             : reinterpret_cast<const char*>(groups + e.child);
+    const auto line = [&](const WideEntry& e) {  // both addresses, then a select: no branch
+        const char* node = reinterpret_cast<const char*>(nodes + e.child);
+        const char* group = reinterpret_cast<const char*>(groups + e.child);
+        return e.groups == 0 ? node : group;
     };
     std::uint32_t size = 0;
     WideEntry current{0, 0, ray.tmin};
@@ -196,9 +208,8 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
                 if (c != invalid_index) stats.node();
             __m128 t0 = tmin, t1 = tmax;
             for (int a = 0; a < 3; ++a) {
-                const bool negative = (O >> a) & 1u;
-                const __m128 near = _mm_load_ps(node.lo[negative ? 3 + a : a]);
-                const __m128 far = _mm_load_ps(node.lo[negative ? a : 3 + a]);
+                const __m128 near = _mm_load_ps(node.lo[k.near[a]]);
+                const __m128 far = _mm_load_ps(node.lo[k.far[a]]);
                 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, origin[a]), inv[a]), t0);
                 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, origin[a]), inv_far[a]), t1);
             }
@@ -221,7 +232,7 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
 // walk4 in AVX registers. It is written out again because its AVX intrinsics must sit in a function
 // that carries the target attribute itself (GCC will not inline them into a lambda or a generic
 // helper of the default target), and walk4 must not carry it.
-template <unsigned O, class OnLeaf, class Stats>
+template <class OnLeaf, class Stats>
 [[gnu::target("avx2")]] void walk8(const WideRayBvh<8>& tree, Ray<float, 3>& ray,
                                    const SlabConstants& k, WideEntry* stack, OnLeaf& on_leaf,
                                    Stats& stats) {
@@ -233,9 +244,10 @@ template <unsigned O, class OnLeaf, class Stats>
     }
     const RayNode<8>* nodes = tree.nodes.data();
     const TriangleGroup4* groups = tree.groups.data();
-    const auto line = [&](const WideEntry& e) {
-        return e.groups == 0 ? reinterpret_cast<const char*>(nodes + e.child)
-                             : reinterpret_cast<const char*>(groups + e.child);
+    const auto line = [&](const WideEntry& e) {  // both addresses, then a select: no branch
+        const char* node = reinterpret_cast<const char*>(nodes + e.child);
+        const char* group = reinterpret_cast<const char*>(groups + e.child);
+        return e.groups == 0 ? node : group;
     };
     std::uint32_t size = 0;
     WideEntry current{0, 0, ray.tmin};
@@ -248,9 +260,8 @@ template <unsigned O, class OnLeaf, class Stats>
                 if (c != invalid_index) stats.node();
             __m256 t0 = tmin, t1 = tmax;
             for (int a = 0; a < 3; ++a) {
-                const bool negative = (O >> a) & 1u;
-                const __m256 near = _mm256_load_ps(node.lo[negative ? 3 + a : a]);
-                const __m256 far = _mm256_load_ps(node.lo[negative ? a : 3 + a]);
+                const __m256 near = _mm256_load_ps(node.lo[k.near[a]]);
+                const __m256 far = _mm256_load_ps(node.lo[k.far[a]]);
                 t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, origin[a]), inv[a]), t0);
                 t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, origin[a]), inv_far[a]), t1);
             }
@@ -270,24 +281,20 @@ template <unsigned O, class OnLeaf, class Stats>
 }
 #endif
 
-/// The walk of `tree` for `ray`, instantiated per ray octant.
+/// The walk of `tree` for `ray`.
 template <int W, class OnLeaf, class Stats>
 void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, OnLeaf&& on_leaf,
                        Stats& stats) {
-    const RaySlabData<float, 3> slab(ray);
-    const SlabConstants k(slab);
-    WideStack<W> stack;  // one for the eight octant instances (see query/ray.hpp)
-    slab.with_octant([&](auto octant) {
-        constexpr unsigned O = decltype(octant)::value;
-        if constexpr (W == 4) {
-            walk4<O>(tree, ray, k, stack, on_leaf, stats);
-        } else {
-            static_assert(W == 8);
+    const SlabConstants k(ray);
+    WideStack<W> stack;
+    if constexpr (W == 4) {
+        walk4(tree, ray, k, stack, on_leaf, stats);
+    } else {
+        static_assert(W == 8);
 #if BVHKIT_RAY_AVX2
-            walk8<O>(tree, ray, k, stack, on_leaf, stats);
+        walk8(tree, ray, k, stack, on_leaf, stats);
 #endif
-        }
-    });
+    }
 }
 
 }  // namespace detail
