@@ -79,13 +79,16 @@ class TriangleBvh {
         if constexpr (std::is_same_v<T, float>) {
             if (traces_wide() && wide_ray_usable(ray)) {
                 TriangleHit<float> h;
-                std::uint32_t slot;
+                const TriangleGroup4* group;
+                int lane;
                 const WatertightRay<float> prep(ray);
                 const bool hit = wide8_.empty()
-                                     ? closest_hit_wide(wide4_, ray, prep, h, slot, stats)
-                                     : closest_hit_wide(wide8_, ray, prep, h, slot, stats);
+                                     ? closest_hit_wide(wide4_, ray, prep, h, group, lane, stats)
+                                     : closest_hit_wide(wide8_, ray, prep, h, group, lane, stats);
                 if (!hit) return Hit<T>{};
-                return Hit<T>{h.t, bvh_.primitive_indices[slot], h.u, h.v, exact_[slot].normal()};
+                // The groups hold the primitive index and a copy of the corners: the same normal
+                // as exact_'s, from the line just tested.
+                return Hit<T>{h.t, group->slot[lane], h.u, h.v, group->triangle(lane).normal()};
             }
         }
 #endif
@@ -236,10 +239,11 @@ class TriangleBvh {
                 bvh_.empty())
                 return;
             const auto at = [&](std::uint32_t slot) { return exact_[slot]; };
+            const auto index = [&](std::uint32_t slot) { return bvh_.primitive_indices[slot]; };
             if (ray_layout_ != RayLayout::Wide4 && cpu_has_avx2())
-                wide8_ = make_wide_ray_bvh<8>(bvh_, at);
+                wide8_ = make_wide_ray_bvh<8>(bvh_, at, index);
             else
-                wide4_ = make_wide_ray_bvh<4>(bvh_, at);
+                wide4_ = make_wide_ray_bvh<4>(bvh_, at, index);
         }
 #endif
     }

@@ -31,6 +31,14 @@ struct alignas(16) TriangleGroup4 {
             for (int a = 0; a < 3; ++a) corner[3 * k + a][lane] = (*p[k])[a];
         slot[lane] = index;
     }
+    /// The triangle in `lane`, as set.
+    Triangle<float> triangle(int lane) const {
+        Triangle<float> t;
+        Vec<float, 3>* p[3] = {&t.p0, &t.p1, &t.p2};
+        for (int k = 0; k < 3; ++k)
+            for (int a = 0; a < 3; ++a) (*p[k])[a] = corner[3 * k + a][lane];
+        return t;
+    }
     /// An empty lane: never tested.
     void clear(int lane) {
         for (auto& c : corner) c[lane] = 0.0f;

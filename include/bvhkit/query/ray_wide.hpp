@@ -63,9 +63,11 @@ inline bool cpu_has_avx2() {
 #endif
 }
 
-/// The ray layout of width W of a binary tree whose leaf slot s holds triangle_at_slot(s).
-template <int W, class TriangleAtSlot>
-WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&& triangle_at_slot) {
+/// The ray layout of width W of a binary tree whose leaf slot s holds triangle_at_slot(s); its
+/// groups name that triangle index_at_slot(s) (TriangleGroup4::slot), which a hit reports.
+template <int W, class TriangleAtSlot, class IndexAtSlot>
+WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&& triangle_at_slot,
+                                IndexAtSlot&& index_at_slot) {
     WideRayBvh<W> out;
     // A subtree of up to 8 triangles becomes one leaf child of one or two groups: fewer levels
     // means fewer dependent cache misses, which outweighs the extra triangle lanes. 1M random rays,
@@ -93,7 +95,7 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
             if (s == invalid_index)
                 out.groups[g].clear(lane);
             else
-                out.groups[g].set(lane, triangle_at_slot(s), s);
+                out.groups[g].set(lane, triangle_at_slot(s), index_at_slot(s));
         }
     return out;
 }
@@ -299,14 +301,17 @@ void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, OnLeaf&& o
 
 }  // namespace detail
 
-/// Closest hit through a wide tree: `hit_slot` receives the leaf slot of the hit triangle, or
-/// invalid_index on a miss. The ray must be one wide_ray_usable accepts, and an eight-wide tree
-/// needs cpu_has_avx2().
+/// Closest hit through a wide tree: on a hit, `hit_group` and `hit_lane` say where the triangle
+/// lies (its index is hit_group->slot[hit_lane], its corners hit_group->triangle(hit_lane): both
+/// at hand in a line the test just read, where the caller's own arrays would cost two more cache
+/// misses); hit_group is null on a miss. The ray must be one wide_ray_usable accepts, and an
+/// eight-wide tree needs cpu_has_avx2().
 template <int W, class Stats = NoStats>
 bool closest_hit_wide(const WideRayBvh<W>& tree, Ray<float, 3> ray,
                       const WatertightRay<float>& prep, TriangleHit<float>& best,
-                      std::uint32_t& hit_slot, Stats&& stats = {}) {
-    hit_slot = invalid_index;
+                      const TriangleGroup4*& hit_group, int& hit_lane, Stats&& stats = {}) {
+    hit_group = nullptr;
+    hit_lane = 0;
     const WatertightRay4 r4(prep);
     const TriangleGroup4* groups = tree.groups.data();
     detail::traverse_wide_ray(
@@ -317,14 +322,15 @@ bool closest_hit_wide(const WideRayBvh<W>& tree, Ray<float, 3> ray,
                 intersect_watertight4(r4, groups[g], ray.tmin, ray.tmax,
                                       [&](int lane, const TriangleHit<float>& h) {
                                           best = h;
-                                          hit_slot = groups[g].slot[lane];
+                                          hit_group = groups + g;
+                                          hit_lane = lane;
                                           return h.t;
                                       });
             }
             return false;
         },
         stats);
-    return hit_slot != invalid_index;
+    return hit_group != nullptr;
 }
 
 /// Any hit through a wide tree (same conditions as closest_hit_wide).
