@@ -127,6 +127,10 @@ void check_collapse(const Bvh<Aabb<T, 3>>& bvh, const std::vector<Aabb<T, 3>>& b
     const WideBvh<T, 8> wide8 = collapse_to_wide<T, 8>(bvh, leaf_limit);
     ASSERT_NO_THROW(validate(wide8, slot_boxes));
     EXPECT_EQ(wide8.group_count(), wide.group_count());
+    // Lanes filled by opening small subtrees too (the eight-wide ray layout): still every slot
+    // once, inside its boxes, and no node fuller than its width.
+    ASSERT_NO_THROW(validate(collapse_to_wide<T, 8>(bvh, leaf_limit, true), slot_boxes));
+    ASSERT_NO_THROW(validate(collapse_to_wide<T, 4>(bvh, leaf_limit, true), slot_boxes));
     if (wide.empty()) return;
     // Binary leaves reached from the root: first slot -> count.
     std::map<std::uint32_t, std::uint32_t> binary_leaves;

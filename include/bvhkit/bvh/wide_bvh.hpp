@@ -64,8 +64,8 @@ std::vector<std::uint32_t> primitives_under(const Bvh<Aabb<T, 3>>& bvh) {
 }
 
 /// The children a wide node takes for binary node b (which opens): its two children, then, while
-/// fewer than W, the one of largest area among those that open is replaced by its two children.
-/// Returns how many lanes were filled.
+/// fewer than W, the one of largest area among those that `opens` accepts is replaced by its two
+/// children. Returns how many lanes were filled.
 template <int W, class T, class Opens>
 int pick_lanes(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t b, Opens&& opens,
                std::uint32_t (&lanes)[W]) {
@@ -111,9 +111,15 @@ void append_leaf_groups(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t n,
 
 /// Collapses `bvh` into a WideBvh<T, W>. An inner binary node takes up to W children by opening,
 /// of its children and grandchildren, the one of largest area until W or none is left to open;
-/// a subtree of at most `leaf_limit` primitives becomes one leaf child.
+/// a subtree of at most `leaf_limit` primitives becomes one leaf child. With `fill_lanes`, any
+/// inner binary node may open to fill a node's lanes, also one of at most `leaf_limit` primitives
+/// (whose halves then become two leaf children): the nodes come out full, as a builder that
+/// splits the largest child until the node is full makes them, where without it a node whose
+/// children are all small enough to be leaves stays at two or three lanes (igea, eight wide,
+/// leaf_limit 8: 3.7 lanes a node on average without, 6.9 with).
 template <class T, int W = 4>
-WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4) {
+WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4,
+                               bool fill_lanes = false) {
     WideBvh<T, W> out;
     if (bvh.empty()) return out;
     const auto& nodes = bvh.nodes;
@@ -121,6 +127,7 @@ WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_li
     const auto opens = [&](std::uint32_t n) {
         return !nodes[n].is_leaf() && under[n] > leaf_limit;
     };
+    const auto fills = [&](std::uint32_t n) { return !nodes[n].is_leaf(); };
     out.group_slots.reserve(bvh.primitive_indices.size() + bvh.primitive_indices.size() / 2);
     std::vector<std::uint32_t> todo;
     // Work items: (binary node, wide node to fill). Preorder, so a parent precedes its children.
@@ -132,7 +139,9 @@ WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_li
         work.pop_back();
         std::uint32_t lanes[W];
         lanes[0] = b;
-        const int size = opens(b) ? wide_detail::pick_lanes<W>(bvh, b, opens, lanes) : 1;
+        const int size = !opens(b)    ? 1
+                         : fill_lanes ? wide_detail::pick_lanes<W>(bvh, b, fills, lanes)
+                                      : wide_detail::pick_lanes<W>(bvh, b, opens, lanes);
         WideNode<T, W> node{};
         for (int c = 0; c < W; ++c) {
             node.child[c] = invalid_index;
