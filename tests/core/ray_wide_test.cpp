@@ -177,9 +177,25 @@ TEST(WideRays, RefitKeepsTheWideLayoutInStep) {
     expect_same(wide, flat, tris, rays_for(tris, test::scaled(5000), 5));
 }
 
+#if BVHKIT_RAY_AVX2
+// The two-group AVX test (the eight-wide walk's), in a function that carries its target.
+[[gnu::target("avx2")]] void test_two_groups(const WatertightRay<float>& prep,
+                                             const TriangleGroup4& a, const TriangleGroup4& b,
+                                             float tmin, float tmax, bool (&got)[8],
+                                             TriangleHit<float> (&hit)[8]) {
+    const float open = tmax;
+    intersect_watertight4x2(prep, a, b, tmin, tmax, [&](int lane, const TriangleHit<float>& h) {
+        got[lane] = true;
+        hit[lane] = h;
+        return open;  // keep the whole range open
+    });
+}
+#endif
+
 // Every lane of the four-abreast test against the scalar test, with the whole range open (so that
 // every hit is reported), on triangles and rays chosen to sit at the edge of the float filter:
-// rays through vertices and edges, needles, zero-area triangles, coordinates from 1e-30 to 1e30.
+// rays through vertices and edges, needles, zero-area triangles, coordinates from 1e-30 to 1e30;
+// and the two-group AVX test against the four-abreast one.
 TEST(WideRays, FourAbreastTestEqualsTheScalarTest) {
     test::Random rng(11);
     const std::size_t n = test::scaled(200000);
@@ -235,6 +251,24 @@ TEST(WideRays, FourAbreastTestEqualsTheScalarTest) {
             if (group.slot[lane] == invalid_index) {
                 ASSERT_FALSE(got[lane]) << "a padding lane hit";
             }
+#if BVHKIT_RAY_AVX2
+        // Two groups abreast in AVX (here the same group twice): each half answers as the
+        // four-abreast test.
+        if (cpu_has_avx2()) {
+            bool got8[8] = {};
+            TriangleHit<float> hit8[8];
+            test_two_groups(prep, group, group, ray.tmin, ray.tmax, got8, hit8);
+            for (int lane = 0; lane < 8; ++lane) {
+                ASSERT_EQ(got8[lane], got[lane & 3]) << "case " << i << " lane " << lane;
+                if (got8[lane]) {
+                    ASSERT_TRUE(same_bits(hit8[lane].t, got_hit[lane & 3].t) &&
+                                same_bits(hit8[lane].u, got_hit[lane & 3].u) &&
+                                same_bits(hit8[lane].v, got_hit[lane & 3].v))
+                        << "case " << i << " lane " << lane;
+                }
+            }
+        }
+#endif
     }
     EXPECT_GT(hits, n / 4);
 }

@@ -17,6 +17,7 @@
 // since an ignored axis could let them into an empty lane.
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "bvhkit/bvh/wide_bvh.hpp"
@@ -281,7 +282,7 @@ template <class OnLeaf, class Stats>
                 continue;
             }
         } else {
-            if (on_leaf(current.child, current.groups)) return;
+            if (on_leaf.wide8(current.child, current.groups)) return;
             tmax = _mm256_set1_ps(ray.tmax);
         }
         if (!pop(stack, size, ray.tmax, current)) return;
@@ -307,6 +308,99 @@ void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, OnLeaf&& o
 
 }  // namespace detail
 
+namespace detail {
+
+// The leaf tests of the two queries: operator() for walk4, wide8 for walk8, which tests a leaf's
+// groups two at a time in AVX registers (intersect_watertight4x2); named structs rather than
+// lambdas because wide8 must carry the AVX2 target itself to be inlined into walk8.
+template <class Stats>
+struct ClosestLeaves {
+    const TriangleGroup4* groups;
+    const WatertightRay4& r4;
+    Ray<float, 3>& ray;
+    TriangleHit<float>& best;
+    const TriangleGroup4*& hit_group;
+    int& hit_lane;
+    Stats& stats;
+
+    bool operator()(std::uint32_t first, std::uint32_t count) {
+        for (std::uint32_t g = first; g < first + count; ++g) {
+            count_lanes(groups[g], stats);
+            intersect_watertight4(r4, groups[g], ray.tmin, ray.tmax,
+                                  [&](int lane, const TriangleHit<float>& h) {
+                                      best = h;
+                                      hit_group = groups + g;
+                                      hit_lane = lane;
+                                      return h.t;
+                                  });
+        }
+        return false;
+    }
+#if BVHKIT_RAY_AVX2
+    [[gnu::target("avx2"), gnu::always_inline]] inline bool wide8(std::uint32_t first,
+                                                                  std::uint32_t count) {
+        const std::uint32_t end = first + count;
+        std::uint32_t g = first;
+        for (; g + 1 < end; g += 2) {
+            count_lanes(groups[g], stats);
+            count_lanes(groups[g + 1], stats);
+            intersect_watertight4x2(r4.ray, groups[g], groups[g + 1], ray.tmin, ray.tmax,
+                                    [&](int lane, const TriangleHit<float>& h) {
+                                        best = h;
+                                        hit_group = groups + g + std::uint32_t(lane >> 2);
+                                        hit_lane = lane & 3;
+                                        return h.t;
+                                    });
+        }
+        if (g < end) return (*this)(g, 1);
+        return false;
+    }
+#endif
+};
+
+template <class Stats>
+struct AnyLeaves {
+    const TriangleGroup4* groups;
+    const WatertightRay4& r4;
+    const Ray<float, 3>& ray;
+    bool& found;
+    Stats& stats;
+
+    bool operator()(std::uint32_t first, std::uint32_t count) {
+        for (std::uint32_t g = first; g < first + count && !found; ++g) {
+            count_lanes(groups[g], stats);
+            float tmax = ray.tmax;
+            intersect_watertight4(r4, groups[g], ray.tmin, tmax,
+                                  [&](int, const TriangleHit<float>& h) {
+                                      found = true;
+                                      return h.t;
+                                  });
+        }
+        return found;
+    }
+#if BVHKIT_RAY_AVX2
+    [[gnu::target("avx2"), gnu::always_inline]] inline bool wide8(std::uint32_t first,
+                                                                  std::uint32_t count) {
+        const std::uint32_t end = first + count;
+        std::uint32_t g = first;
+        for (; g + 1 < end && !found; g += 2) {
+            count_lanes(groups[g], stats);
+            count_lanes(groups[g + 1], stats);
+            float tmax = ray.tmax;
+            intersect_watertight4x2(r4.ray, groups[g], groups[g + 1], ray.tmin, tmax,
+                                    [&](int, const TriangleHit<float>& h) {
+                                        found = true;
+                                        return h.t;
+                                    });
+        }
+        if (g < end && !found) return (*this)(g, 1);
+        return found;
+    }
+#endif
+};
+
+}  // namespace detail
+
 /// Closest hit through a wide tree: on a hit, `hit_group` and `hit_lane` say where the triangle
 /// lies (its index is hit_group->slot[hit_lane], its corners hit_group->triangle(hit_lane): both
 /// at hand in a line the test just read, where the caller's own arrays would cost two more cache
@@ -319,23 +413,9 @@ bool closest_hit_wide(const WideRayBvh<W>& tree, Ray<float, 3> ray,
     hit_group = nullptr;
     hit_lane = 0;
     const WatertightRay4 r4(prep);
-    const TriangleGroup4* groups = tree.groups.data();
-    detail::traverse_wide_ray(
-        tree, ray,
-        [&](std::uint32_t first, std::uint32_t count) {
-            for (std::uint32_t g = first; g < first + count; ++g) {
-                detail::count_lanes(groups[g], stats);
-                intersect_watertight4(r4, groups[g], ray.tmin, ray.tmax,
-                                      [&](int lane, const TriangleHit<float>& h) {
-                                          best = h;
-                                          hit_group = groups + g;
-                                          hit_lane = lane;
-                                          return h.t;
-                                      });
-            }
-            return false;
-        },
-        stats);
+    detail::ClosestLeaves<std::remove_reference_t<Stats>> leaves{
+        tree.groups.data(), r4, ray, best, hit_group, hit_lane, stats};
+    detail::traverse_wide_ray(tree, ray, leaves, stats);
     return hit_group != nullptr;
 }
 
@@ -344,23 +424,10 @@ template <int W, class Stats = NoStats>
 bool any_hit_wide(const WideRayBvh<W>& tree, Ray<float, 3> ray, const WatertightRay<float>& prep,
                   Stats&& stats = {}) {
     const WatertightRay4 r4(prep);
-    const TriangleGroup4* groups = tree.groups.data();
     bool found = false;
-    detail::traverse_wide_ray(
-        tree, ray,
-        [&](std::uint32_t first, std::uint32_t count) {
-            for (std::uint32_t g = first; g < first + count && !found; ++g) {
-                detail::count_lanes(groups[g], stats);
-                float tmax = ray.tmax;
-                intersect_watertight4(r4, groups[g], ray.tmin, tmax,
-                                      [&](int, const TriangleHit<float>& h) {
-                                          found = true;
-                                          return h.t;
-                                      });
-            }
-            return found;
-        },
-        stats);
+    detail::AnyLeaves<std::remove_reference_t<Stats>> leaves{tree.groups.data(), r4, ray, found,
+                                                             stats};
+    detail::traverse_wide_ray(tree, ray, leaves, stats);
     return found;
 }
 #endif
