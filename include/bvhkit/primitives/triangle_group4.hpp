@@ -119,11 +119,11 @@ template <class OnHit>
 /// (no FMA: the target does not enable it, so nothing is contracted), and the surviving lanes are
 /// finished by watertight_finish in the order a0..a3, b0..b3, with tmax shrinking as they hit:
 /// the same calls, with the same answers, as testing `a` and then `b`. on_hit(lane, hit) gets
-/// lanes 0-7.
+/// lanes 0-7. Only the lanes set in `lanes` are tested (0x0F: `a` alone, with b = a).
 template <class OnHit>
 [[gnu::target("avx2"), gnu::always_inline]] inline void intersect_watertight4x2(
     const WatertightRay<float>& s, const TriangleGroup4& a, const TriangleGroup4& b, float tmin,
-    float& tmax, OnHit&& on_hit) {
+    float& tmax, OnHit&& on_hit, unsigned lanes = 0xFFu) {
     const __m256 ox = _mm256_set1_ps(s.ox), oy = _mm256_set1_ps(s.oy), oz = _mm256_set1_ps(s.oz);
     const __m256 sx = _mm256_set1_ps(s.sx), sy = _mm256_set1_ps(s.sy);
     __m256 x[3], y[3], z[3];
@@ -158,7 +158,7 @@ template <class OnHit>
     const __m256i pad = _mm256_cmpeq_epi32(slots, _mm256_set1_epi32(-1));
     unsigned live = ~unsigned(_mm256_movemask_ps(_mm256_or_ps(_mm256_and_ps(negative, positive),
                                                               _mm256_castsi256_ps(pad)))) &
-                    0xFFu;
+                    lanes;
     if (live == 0) return;
     alignas(32) float v[9][8];
     for (int k = 0; k < 3; ++k) {

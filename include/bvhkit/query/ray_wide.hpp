@@ -372,20 +372,22 @@ struct ClosestLeaves {
 #if BVHKIT_RAY_AVX2
     [[gnu::target("avx2"), gnu::always_inline]] inline bool wide8(std::uint32_t first,
                                                                   std::uint32_t count) {
+        // Two groups a pass; an odd last one alone, in the lower half.
         const std::uint32_t end = first + count;
-        std::uint32_t g = first;
-        for (; g + 1 < end; g += 2) {
+        for (std::uint32_t g = first; g < end; g += 2) {
+            const bool pair = g + 1 < end;
             count_lanes(groups[g], stats);
-            count_lanes(groups[g + 1], stats);
-            intersect_watertight4x2(r4.ray, groups[g], groups[g + 1], ray.tmin, ray.tmax,
-                                    [&](int lane, const TriangleHit<float>& h) {
-                                        best = h;
-                                        hit_group = groups + g + std::uint32_t(lane >> 2);
-                                        hit_lane = lane & 3;
-                                        return h.t;
-                                    });
+            if (pair) count_lanes(groups[g + 1], stats);
+            intersect_watertight4x2(
+                r4.ray, groups[g], groups[pair ? g + 1 : g], ray.tmin, ray.tmax,
+                [&](int lane, const TriangleHit<float>& h) {
+                    best = h;
+                    hit_group = groups + g + std::uint32_t(lane >> 2);
+                    hit_lane = lane & 3;
+                    return h.t;
+                },
+                pair ? 0xFFu : 0x0Fu);
         }
-        if (g < end) return (*this)(g, 1);
         return false;
     }
 #endif
@@ -416,18 +418,19 @@ struct AnyLeaves {
     [[gnu::target("avx2"), gnu::always_inline]] inline bool wide8(std::uint32_t first,
                                                                   std::uint32_t count) {
         const std::uint32_t end = first + count;
-        std::uint32_t g = first;
-        for (; g + 1 < end && !found; g += 2) {
+        for (std::uint32_t g = first; g < end && !found; g += 2) {
+            const bool pair = g + 1 < end;
             count_lanes(groups[g], stats);
-            count_lanes(groups[g + 1], stats);
+            if (pair) count_lanes(groups[g + 1], stats);
             float tmax = ray.tmax;
-            intersect_watertight4x2(r4.ray, groups[g], groups[g + 1], ray.tmin, tmax,
-                                    [&](int, const TriangleHit<float>& h) {
-                                        found = true;
-                                        return h.t;
-                                    });
+            intersect_watertight4x2(
+                r4.ray, groups[g], groups[pair ? g + 1 : g], ray.tmin, tmax,
+                [&](int, const TriangleHit<float>& h) {
+                    found = true;
+                    return h.t;
+                },
+                pair ? 0xFFu : 0x0Fu);
         }
-        if (g < end && !found) return (*this)(g, 1);
         return found;
     }
 #endif
