@@ -227,7 +227,7 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
     }
     const RayNode<4>* nodes = tree.nodes.data();
     const TriangleGroup4* groups = tree.groups.data();
-    const auto line = [&](const WideEntry& e) {  // both addresses, then a select: no branch
+    const auto line = [&](const WideEntry& e) {  // both addresses, then a select
         const char* node = reinterpret_cast<const char*>(nodes + e.child);
         const char* group = reinterpret_cast<const char*>(groups + e.child);
         return e.groups == 0 ? node : group;
@@ -282,7 +282,7 @@ template <class OnLeaf, class Stats>
     }
     const RayNode<8>* nodes = tree.nodes.data();
     const TriangleGroup4* groups = tree.groups.data();
-    const auto line = [&](const WideEntry& e) {  // both addresses, then a select: no branch
+    const auto line = [&](const WideEntry& e) {  // both addresses, then a select
         const char* node = reinterpret_cast<const char*>(nodes + e.child);
         const char* group = reinterpret_cast<const char*>(groups + e.child);
         return e.groups == 0 ? node : group;
