@@ -71,17 +71,15 @@ template <int W, class TriangleAtSlot, class IndexAtSlot>
 WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&& triangle_at_slot,
                                 IndexAtSlot&& index_at_slot) {
     WideRayBvh<W> out;
-    // Four wide: a subtree of up to 8 triangles becomes one leaf child of one or two groups:
-    // fewer levels means fewer dependent cache misses, which outweighs the extra triangle lanes.
-    // 1M random rays, four wide, closest hit, ms, leaf limit 2 / 4 / 8 / 16: igea 861 / 736 / 637
-    // / 583, spot 296 (4) / 268 (8) / 273 (16); the binary walk 853 and 380.
-    // Eight wide: every node's lanes filled (collapse_to_wide's fill_lanes), and a lane of up to
-    // 24 triangles not opened further is a leaf child. Against leaf limit 8 without filling (3.7
-    // lanes a node on igea, 16k nodes): 1M random rays, closest hit, against Embree 3 in the same
-    // run, igea 0.72-0.81x -> 0.88-0.97x, bunny 0.69x -> 0.74-0.77x, spot, dragon and teapot
-    // +1-4%; leaf limits 16-32 measured within noise of 24.
-    const WideBvh<float, W> wide =
-        W == 8 ? collapse_to_wide<float, W>(bvh, 24, true) : collapse_to_wide<float, W>(bvh, 8);
+    // Every node's lanes filled (collapse_to_wide's fill_lanes), and a lane of up to 24
+    // triangles not opened further is a leaf child. Against leaf limit 8 without filling (3.7
+    // lanes an eight-wide node on igea, 16k nodes, 4.2 MB), 1M random rays, closest hit, against
+    // Embree 3 in the same run: eight wide, igea 0.72-0.81x -> 0.88-0.97x, bunny 0.69x ->
+    // 0.74-0.77x, spot, dragon and teapot +1-4%; four wide, igea 0.67-0.71x -> 0.79-0.80x
+    // (occlusion 0.74-0.78x -> 0.91-1.04x), bunny, spot and dragon within noise. Leaf limits 16-32
+    // measured within noise of 24. (Four wide without filling, leaf limit 2 / 4 / 8 / 16, ms: igea
+    // 861 / 736 / 637 / 583, spot 296 (4) / 268 (8) / 273 (16); the binary walk 853 and 380.)
+    const WideBvh<float, W> wide = collapse_to_wide<float, W>(bvh, 24, true);
     out.nodes.resize(wide.nodes.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
     for (std::size_t i = 0; i < wide.nodes.size(); ++i) {
