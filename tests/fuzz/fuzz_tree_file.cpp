@@ -3,6 +3,7 @@
 // checksum recomputed (random bytes almost never carry a valid checksum, and the checks behind it
 // are the ones worth fuzzing). A load may throw bvhkit::Error; a structure it accepts, with or
 // without validate(), must answer queries with indices in range (ASan and UBSan watch the walks).
+#include <cstdint>
 #include <cstdlib>
 #include <limits>
 #include <span>
@@ -20,30 +21,47 @@
 
 namespace {
 
+// Rays that touch the tree; every index they return must be in range.
+template <class T, class Tree>
+void query_triangle_tree(const Tree& tree) {
+    const bvhkit::Vec<T, 3> origins[] = {{T(-2), T(0.1), T(0.2)}, {T(0.3), T(0.2), T(0.1)}};
+    const bvhkit::Vec<T, 3> directions[] = {{T(1), T(0), T(0)}, {T(0.1), T(-1), T(0.3)}};
+    for (const auto& o : origins)
+        for (const auto& d : directions) {
+            const bvhkit::Ray<T, 3> ray(o, d);
+            const bvhkit::Hit<T> hit = tree.closest_hit(ray);
+            if (hit && hit.primitive >= tree.triangle_count()) std::abort();
+            (void)tree.any_hit(ray);
+            tree.all_hits(ray, [&](const bvhkit::Hit<T>& h) {
+                if (h.primitive >= tree.triangle_count()) std::abort();
+                return true;
+            });
+        }
+    for (const std::uint32_t s : tree.skipped())
+        if (s >= tree.triangle_count()) std::abort();
+}
+
+// Both loaders must accept the same files: the copying one and the in-place one (map_triangle_bvh).
 template <class T>
 void load_and_query(std::span<const std::uint8_t> bytes) {
     for (const bool validate : {true, false}) {
+        bool copied = false, in_place = false;
         try {
-            const bvhkit::TriangleBvh<T> tree =
-                bvhkit::triangle_bvh_from_bytes<T>(bytes, bvhkit::LoadOptions{validate});
-            const bvhkit::Vec<T, 3> origins[] = {{T(-2), T(0.1), T(0.2)}, {T(0.3), T(0.2), T(0.1)}};
-            const bvhkit::Vec<T, 3> directions[] = {{T(1), T(0), T(0)}, {T(0.1), T(-1), T(0.3)}};
-            for (const auto& o : origins)
-                for (const auto& d : directions) {
-                    const bvhkit::Ray<T, 3> ray(o, d);
-                    const bvhkit::Hit<T> hit = tree.closest_hit(ray);
-                    if (hit && hit.primitive >= tree.triangle_count()) std::abort();
-                    (void)tree.any_hit(ray);
-                    tree.all_hits(ray, [&](const bvhkit::Hit<T>& h) {
-                        if (h.primitive >= tree.triangle_count()) std::abort();
-                        return true;
-                    });
-                }
-            for (const std::uint32_t s : tree.skipped())
-                if (s >= tree.triangle_count()) std::abort();
+            query_triangle_tree<T>(
+                bvhkit::triangle_bvh_from_bytes<T>(bytes, bvhkit::LoadOptions{validate}));
+            copied = true;
         } catch (const bvhkit::Error&) {
             // Rejected cleanly.
         }
+        try {
+            query_triangle_tree<T>(
+                bvhkit::view_triangle_bvh<T>(bytes, bvhkit::LoadOptions{validate}));
+            in_place = true;
+        } catch (const bvhkit::Error&) {
+        }
+        // Bytes not 8-byte aligned are refused in place by design.
+        const bool aligned = reinterpret_cast<std::uintptr_t>(bytes.data()) % 8 == 0;
+        if (aligned && copied != in_place) std::abort();
     }
 }
 
