@@ -3,10 +3,16 @@
 // as single rays, bytes that are not aligned are an Error, a moved-from tree is empty.
 #include <gtest/gtest.h>
 
+#if defined(__unix__)
+#include <sys/stat.h>
+#endif
+
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "bvhkit/io/mapped_triangle_bvh.hpp"
 #include "bvhkit/mesh/procedural.hpp"
@@ -91,6 +97,62 @@ TEST(MappedTriangleBvh, BatchesAnswerAsSingleRays) {
     std::vector<Hit<float>> short_hits(rays.size() - 1);
     EXPECT_THROW(tree.trace(rays, short_hits), Error);
 }
+
+// save() writes a new file and renames it over the old one, so a tree mapped from the old file
+// keeps its checked bytes (rewriting in place would show unchecked bytes to its walks).
+TEST(MappedTriangleBvh, SavingOverAMappedFileLeavesTheMappedTreeWhole) {
+    TempFile file("resaved.bvh");
+    save(TriangleBvh<float>(make_sphere(1)), file.path);
+    const auto mapped = map_triangle_bvh<float>(file.path);
+    const auto rays = random_rays<float>(500, Aabb3f({-2, -2, -2}, {2, 2, 2}), 4);
+    std::vector<Hit<float>> before(rays.size());
+    mapped.trace(rays, before, 1);
+    save(TriangleBvh<float>(make_procedural("torus:u=64,v=32")), file.path);  // larger, other
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const Hit<float> h = mapped.closest_hit(rays[i]);
+        ASSERT_EQ(h.primitive, before[i].primitive) << i;
+        ASSERT_EQ(h.t, before[i].t) << i;
+    }
+    EXPECT_NE(map_triangle_bvh<float>(file.path).triangle_count(), mapped.triangle_count());
+    // No temporary file is left beside it.
+    std::size_t files = 0;
+    for (const auto& e : std::filesystem::directory_iterator(file.path.parent_path()))
+        files += e.path().filename().string().rfind(file.path.filename().string(), 0) == 0;
+    EXPECT_EQ(files, 1u);
+}
+
+// A temporary buffer would be freed before the first query: view_triangle_bvh refuses it.
+template <class Bytes>
+concept ViewableFrom = requires(Bytes&& b) {
+    view_triangle_bvh<float>(std::forward<Bytes>(b));
+};
+static_assert(ViewableFrom<std::vector<std::uint8_t>&>);
+static_assert(ViewableFrom<const std::vector<std::uint8_t>&>);
+static_assert(!ViewableFrom<std::vector<std::uint8_t>>);
+
+TEST(MappedTriangleBvh, SpecialFilesAreErrorsNamingThem) {
+    const auto dir = std::filesystem::temp_directory_path();
+    for (const std::filesystem::path& p :
+         {dir, std::filesystem::path("/dev/null"), std::filesystem::path("/proc/self/status"),
+          dir / "bvhkit_no_such_file.bvh"}) {
+        if (!std::filesystem::exists(p) && p.filename() != "bvhkit_no_such_file.bvh") continue;
+        try {
+            (void)map_triangle_bvh<float>(p);
+            ADD_FAILURE() << p << " mapped";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+        }
+    }
+}
+
+#if defined(__unix__)
+// Opening a FIFO for reading waits for a writer; the map must not.
+TEST(MappedTriangleBvh, AFifoIsAnErrorNotAHang) {
+    TempFile fifo("fifo");
+    ASSERT_EQ(::mkfifo(fifo.path.c_str(), 0600), 0);
+    EXPECT_THROW((void)map_triangle_bvh<float>(fifo.path), Error);
+}
+#endif
 
 TEST(MappedTriangleBvh, BytesNotAlignedAreAnError) {
     const auto bytes = to_bytes(TriangleBvh<double>(make_sphere(1)));

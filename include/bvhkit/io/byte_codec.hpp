@@ -93,7 +93,9 @@ class ByteReader {
     }
     /// `count` records of U where they lie, without a copy (a mapped load), then the padding to
     /// `alignment`. U must be a little-endian record laid out as the file's; the bytes must be
-    /// aligned for U (an Error otherwise). The caller checks the machine is little-endian.
+    /// aligned for U (an Error otherwise). The caller checks the machine is little-endian. U is
+    /// trivially copyable and only read, the case C++23's std::start_lifetime_as_array makes
+    /// formal; GCC and Clang read such bytes as the records they hold.
     template <class U>
     std::span<const U> records_in_place(std::size_t count, std::size_t alignment) {
         if (count > remaining() / sizeof(U)) fail("unexpected end of data");

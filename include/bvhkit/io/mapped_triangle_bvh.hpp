@@ -23,6 +23,7 @@
 #include <span>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "bvhkit/io/mapped_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
@@ -64,14 +65,23 @@ class MappedTriangleBvh {
     /// Batches, as TriangleBvh::trace and occluded (0 threads = every core).
     void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
                unsigned threads = 0) const {
-        for_each_ray(rays, hits, Executor(threads), "MappedTriangleBvh::trace: hits",
+        trace(rays, hits, Executor(threads));
+    }
+    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
+               const Executor& exec) const {
+        for_each_ray(rays, hits, exec, "MappedTriangleBvh::trace: hits",
                      [&](const Ray<T, 3>& ray) { return closest_hit(ray); });
     }
     void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
                   unsigned threads = 0) const {
-        for_each_ray(rays, occluded, Executor(threads), "MappedTriangleBvh::occluded: occluded",
+        this->occluded(rays, occluded, Executor(threads));
+    }
+    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
+                  const Executor& exec) const {
+        for_each_ray(rays, occluded, exec, "MappedTriangleBvh::occluded: occluded",
                      [&](const Ray<T, 3>& ray) { return std::uint8_t(any_hit(ray) ? 1 : 0); });
     }
+    static constexpr std::size_t batch_grain = ray_batch_grain;
 
     /// The tree, in place in the file.
     BvhView<Aabb<T, 3>> bvh() const { return rays_.bvh(); }
@@ -178,7 +188,8 @@ MappedTriangleBvh<T> map_triangle_bvh(const std::filesystem::path& path,
 }
 
 /// The same over bytes the caller keeps alive and unchanged while the result is used (to_bytes'
-/// output, a mapping of its own); their first byte must be 8-byte aligned (an Error otherwise).
+/// output, a mapping of its own); their first byte must be aligned for T (an Error otherwise;
+/// a std::vector's data always is).
 template <class T>
 MappedTriangleBvh<T> view_triangle_bvh(std::span<const std::uint8_t> bytes,
                                        const LoadOptions& options = {}) {
@@ -186,5 +197,9 @@ MappedTriangleBvh<T> view_triangle_bvh(std::span<const std::uint8_t> bytes,
     serial_detail::MappedTriangleBvhAccess::open(tree, bytes, options);
     return tree;
 }
+/// A temporary buffer would be gone before the first query: keep it in a variable.
+template <class T>
+MappedTriangleBvh<T> view_triangle_bvh(std::vector<std::uint8_t>&& bytes,
+                                       const LoadOptions& options = {}) = delete;
 
 }  // namespace bvhkit
