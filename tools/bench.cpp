@@ -1,10 +1,12 @@
-// `bvhkit bench rays|dynamic|nearest|collide ...`: the same-run comparisons against the peers.
+// `bvhkit bench rays|dynamic|nearest|collide|files ...`: the same-run comparisons against the
+// peers.
 #include <cstdio>
 #include <filesystem>
 #include <string_view>
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "file_bench.hpp"
 #include "nearest_bench.hpp"
 #include "output.hpp"
 #include "ray_bench.hpp"
@@ -90,6 +92,37 @@ int bench_nearest(int argc, char** argv) {
     return 0;
 }
 
+constexpr const char* kFilesHelp =
+    R"(usage: bvhkit bench files [MESH ...] [--json] [--reps N] [--rays N]
+
+Saved trees (docs/serialization.md): for a TriangleBvh<float> over each mesh, the median times of
+build, save, load (copied into memory) and map (read in place), with and without validation; what
+one load and one map add to the process's resident memory (anon_mb: its own; file_mb: file pages,
+shared with the page cache), measured on Linux; and R (random) rays through the mapped tree, the
+same tree in memory walked binary, and the default tree (wide) in memory. Default meshes: the
+shared bunny and igea when present.
+
+  --json          print a JSON array of rows instead of a table
+  --reps N        repetitions per figure (default 5)
+  --rays N        random rays (default 200000)
+)";
+
+int bench_files(int argc, char** argv) {
+    const Args args(argc, argv, {"--reps", "--rays"}, {"--json"});
+    if (args.help()) {
+        std::fputs(kFilesHelp, stdout);
+        return 0;
+    }
+    bench::FileBenchOptions o;
+    o.meshes = args.positional();
+    if (o.meshes.empty()) o.meshes = default_bench_meshes();
+    o.repetitions = int(args.integer("--reps", 5, 1, 1000));
+    o.random_rays = std::size_t(args.integer("--rays", 200000, 1, 100000000));
+    const auto rows = bench::run_file_bench(o, args.flag("--json") ? nullptr : stderr);
+    print_rows(rows, args.flag("--json"));
+    return 0;
+}
+
 }  // namespace
 
 int bench_command(int argc, char** argv) {
@@ -98,8 +131,9 @@ int bench_command(int argc, char** argv) {
     if (what == "dynamic") return bench_dynamic_command(argc - 1, argv + 1);
     if (what == "collide") return bench_collide_command(argc - 1, argv + 1);
     if (what == "nearest") return bench_nearest(argc - 1, argv + 1);
+    if (what == "files") return bench_files(argc - 1, argv + 1);
     std::fprintf(what == "--help" || what == "-h" ? stdout : stderr,
-                 "usage: bvhkit bench rays|dynamic|nearest|collide [...]   (bvhkit bench "
+                 "usage: bvhkit bench rays|dynamic|nearest|collide|files [...]   (bvhkit bench "
                  "WORKLOAD --help for each)\n");
     return what == "--help" || what == "-h" ? 0 : 2;
 }

@@ -14,6 +14,7 @@
 #include "bvhkit/error.hpp"
 #include "bvhkit/io/closest_point_mesh_file.hpp"
 #include "bvhkit/io/collision_model_file.hpp"
+#include "bvhkit/io/mapped_triangle_bvh.hpp"
 #include "bvhkit/io/ray_files.hpp"
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"

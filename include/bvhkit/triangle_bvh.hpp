@@ -21,17 +21,13 @@
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/ray.hpp"
 #include "bvhkit/query/ray_wide.hpp"
+#include "bvhkit/query/triangle_rays.hpp"
 
 namespace bvhkit {
 
 namespace serial_detail {
 struct TriangleBvhAccess;  // io/triangle_bvh_file.hpp: saves and loads the private arrays
 }
-
-enum class TriangleTest {
-    Watertight,  // Woop, Benthin, Wald 2013: never misses through a shared edge (default)
-    Fast,        // Moller-Trumbore on precomputed edges: a ray can slip through a shared edge
-};
 
 /// Which tree rays walk. The wide layouts serve float trees with the watertight test, on x86
 /// (query/ray_wide.hpp); anything else walks the binary tree.
@@ -92,9 +88,7 @@ class TriangleBvh {
             }
         }
 #endif
-        if (triangle_test_ == TriangleTest::Watertight)
-            return bvhkit::closest_hit(bvh_, ray, WatertightTest{exact_.data(), ray}, stats);
-        return bvhkit::closest_hit(bvh_, ray, FastTest{fast_.data()}, stats);
+        return binary_rays().closest_hit(ray, stats);
     }
 
     bool any_hit(const Ray<T, 3>& ray) const {
@@ -108,18 +102,13 @@ class TriangleBvh {
                 return wide8_.empty() ? any_hit_wide(wide4_, ray, WatertightRay<float>(ray), stats)
                                       : any_hit_wide(wide8_, ray, WatertightRay<float>(ray), stats);
 #endif
-        if (triangle_test_ == TriangleTest::Watertight)
-            return bvhkit::any_hit(bvh_, ray, WatertightTest{exact_.data(), ray}, stats);
-        return bvhkit::any_hit(bvh_, ray, FastTest{fast_.data()}, stats);
+        return binary_rays().any_hit(ray, stats);
     }
 
     /// on_hit(const Hit<T>&) -> bool (true to go on); hits come in no particular order.
     template <class OnHit, class Stats = NoStats>
     void all_hits(const Ray<T, 3>& ray, OnHit&& on_hit, Stats&& stats = {}) const {
-        if (triangle_test_ == TriangleTest::Watertight)
-            bvhkit::all_hits(bvh_, ray, WatertightTest{exact_.data(), ray}, on_hit, stats);
-        else
-            bvhkit::all_hits(bvh_, ray, FastTest{fast_.data()}, on_hit, stats);
+        binary_rays().all_hits(ray, on_hit, stats);
     }
 
     /// Batch tracing: hits[i] = closest_hit(rays[i]), on `threads` threads (0 = every core, 1 =
@@ -132,10 +121,8 @@ class TriangleBvh {
     }
     void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
                const Executor& exec) const {
-        check_batch(rays.size(), hits.size(), "TriangleBvh::trace: hits");
-        exec.parallel_for(rays.size(), batch_grain, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) hits[i] = closest_hit(rays[i]);
-        });
+        for_each_ray(rays, hits, exec, "TriangleBvh::trace: hits",
+                     [&](const Ray<T, 3>& ray) { return closest_hit(ray); });
     }
     /// Batch occlusion: occluded[i] = any_hit(rays[i]) (1 or 0), as trace() runs.
     void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
@@ -144,14 +131,10 @@ class TriangleBvh {
     }
     void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
                   const Executor& exec) const {
-        check_batch(rays.size(), occluded.size(), "TriangleBvh::occluded: occluded");
-        exec.parallel_for(rays.size(), batch_grain, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) occluded[i] = any_hit(rays[i]) ? 1 : 0;
-        });
+        for_each_ray(rays, occluded, exec, "TriangleBvh::occluded: occluded",
+                     [&](const Ray<T, 3>& ray) { return std::uint8_t(any_hit(ray) ? 1 : 0); });
     }
-    /// Rays per task of the batch calls: large enough to pay for a task, small enough to balance
-    /// incoherent rays over the cores.
-    static constexpr std::size_t batch_grain = 256;
+    static constexpr std::size_t batch_grain = ray_batch_grain;
 
     TriangleTest triangle_test() const {
         return triangle_test_;
@@ -191,10 +174,11 @@ class TriangleBvh {
   private:
     friend struct serial_detail::TriangleBvhAccess;
 
-    static void check_batch(std::size_t rays, std::size_t out, const char* what) {
-        if (rays != out)
-            throw Error(std::string(what) + " holds " + std::to_string(out) + " entries for " +
-                        std::to_string(rays) + " rays");
+    // The binary walk over this tree's own arrays.
+    TriangleRays<T> binary_rays() const {
+        if (triangle_test_ == TriangleTest::Watertight)
+            return TriangleRays<T>(bvh_view(bvh_), std::span<const Triangle<T>>(exact_));
+        return TriangleRays<T>(bvh_view(bvh_), std::span<const PrecomputedTriangle<T>>(fast_));
     }
 
     template <class TriangleAt>
@@ -247,27 +231,6 @@ class TriangleBvh {
         }
 #endif
     }
-
-    // The leaf tests (query/ray.hpp): the watertight one carries its per-ray constants, made once
-    // per query.
-    struct WatertightTest {
-        const Triangle<T>* tris;
-        WatertightRay<T> prepared;
-        WatertightTest(const Triangle<T>* t, const Ray<T, 3>& ray) : tris(t), prepared(ray) {}
-        bool operator()(std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) const {
-            const Triangle<T>& tri = tris[slot];
-            return intersect_watertight(prepared, tri.p0, tri.p1, tri.p2, ray.tmin, ray.tmax, h);
-        }
-        Vec<T, 3> normal(std::uint32_t slot) const { return tris[slot].normal(); }
-    };
-    struct FastTest {
-        const PrecomputedTriangle<T>* tris;
-        bool operator()(std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) const {
-            return tris[slot].intersect(ray, ray.tmax, h);
-        }
-        // n = (p0 - p1) x (p2 - p0) = -(p1 - p0) x (p2 - p0).
-        Vec<T, 3> normal(std::uint32_t slot) const { return tris[slot].n * T(-1); }
-    };
 
     AabbBvh<T, 3> bvh_;
     std::vector<PrecomputedTriangle<T>> fast_;  // leaf-slot order, only for the fast test

@@ -3,7 +3,10 @@
 // segment a crossing pair reports.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "bvhkit/io/read_mesh.hpp"
+#include "bvhkit/mesh/procedural.hpp"
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/query/self_collision.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
@@ -153,6 +156,37 @@ TEST(Degenerate, IdenticalPosesTouchEverywhere) {
     check_identity<Rss<float>>(m);
     check_identity<Kdop<float, 18>>(m);
     check_identity<ConvexHull<float>>(m);
+}
+
+/// Refit with a NaN or infinite vertex in a triangle of the tree: an Error, and the model keeps
+/// answering as before (no NaN volume culls or admits pairs).
+template <class V>
+void check_non_finite_refit() {
+    TriangleMesh mesh = make_procedural("sphere:subdiv=2");
+    CollisionModel<V> model(mesh);
+    const Transform<float> pose{Mat3<float>{}, Vec3f(0.5f, 0, 0)};
+    const bool before = collides(model, model, pose);
+    const float d_before =
+        distance(model, model, Transform<float>{Mat3<float>{}, Vec3f(3, 0, 0)}).distance;
+    for (const float bad :
+         {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+        TriangleMesh moved = mesh;
+        moved.vertices[5][1] = bad;
+        EXPECT_THROW(model.refit(moved), Error);
+    }
+    EXPECT_EQ(collides(model, model, pose), before);
+    EXPECT_TRUE(before);
+    EXPECT_EQ(distance(model, model, Transform<float>{Mat3<float>{}, Vec3f(3, 0, 0)}).distance,
+              d_before);
+}
+
+TEST(Degenerate, RefitWithANonFiniteVertexIsAnError) {
+    check_non_finite_refit<Aabb3f>();
+    check_non_finite_refit<Sphere<float>>();
+    check_non_finite_refit<Obb<float>>();
+    check_non_finite_refit<Rss<float>>();
+    check_non_finite_refit<Kdop<float, 18>>();
+    check_non_finite_refit<ConvexHull<float>>();
 }
 
 /// A tetrahedron and a copy placed by an exact translation so that they touch at one vertex, or

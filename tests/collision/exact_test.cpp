@@ -3,6 +3,8 @@
 // against the integer determinant.
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "bvhkit/math/predicates.hpp"
 #include "bvhkit/primitives/triangle_triangle.hpp"
 #include "bvhkit/query/self_collision.hpp"
@@ -53,6 +55,32 @@ TEST(ExactPredicates, Orient3dExactOnTinyDeterminants) {
     EXPECT_EQ(orient2d_sign(0.0, 0.0, 1e-300, 1e-300, 1.0, 1.0), 0);
     EXPECT_EQ(orient2d_sign(0.1, 0.1, 0.2, 0.2, 0.3, 0.3), 0);  // on y = x
     EXPECT_EQ(orient2d_sign(0.1, 0.1, 0.2, 0.2, 0.3, std::nextafter(0.3, 1.0)), 1);
+}
+
+// No exact sign exists for a NaN or infinite coordinate, or where the products overflow: the
+// answer is 0, and the exact stage (whose expansions would overflow their buffers on a NaN) is
+// never reached; ASan watches.
+TEST(ExactPredicates, NonFiniteInputGivesZero) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double inf = std::numeric_limits<double>::infinity();
+    const Vec3d a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0};
+    for (const double bad : {nan, inf, -inf}) {
+        for (int k = 0; k < 3; ++k) {
+            Vec3d d{0.25, 0.25, 1};
+            d[k] = bad;
+            EXPECT_EQ(orient3d_sign(a, b, c, d), 0) << bad << " at " << k;
+            EXPECT_EQ(orient3d_sign(d, b, c, a), 0) << bad << " at " << k;
+            const Vec3d ds[3] = {d, d, d};
+            int out[3] = {9, 9, 9};
+            orient3d_signs(a, b, c, ds, out);
+            EXPECT_EQ(out[0], 0);
+        }
+        EXPECT_EQ(orient2d_sign(0.0, 0.0, 1.0, 0.0, bad, 1.0), 0) << bad;
+    }
+    const Vec3f fnan{std::numeric_limits<float>::quiet_NaN(), 0, 0};
+    EXPECT_EQ(orient3d_sign(Vec3f{0, 0, 0}, Vec3f{1, 0, 0}, Vec3f{0, 1, 0}, fnan), 0);
+    // Beyond the range: the products overflow.
+    EXPECT_EQ(orient3d_sign(a, Vec3d{1e300, 0, 0}, Vec3d{0, 1e300, 0}, Vec3d{0, 0, 1e300}), 0);
 }
 
 template <class T>

@@ -1,16 +1,20 @@
-// libFuzzer target: the TriangleBvh, ClosestPointMesh, SignedDistanceMesh, WindingNumberMesh,
-// DynamicTree and CollisionModel loaders on arbitrary bytes, as they come and again with the
-// checksum recomputed (random bytes almost never carry a valid checksum, and the checks behind it
-// are the ones worth fuzzing). A load may throw bvhkit::Error; a structure it accepts, with or
-// without validate(), must answer queries with indices in range (ASan and UBSan watch the walks).
+// libFuzzer target: the TriangleBvh (copied and in place), ClosestPointMesh, SignedDistanceMesh,
+// WindingNumberMesh, DynamicTree and CollisionModel loaders on arbitrary bytes, as they come and
+// again with the checksum recomputed (random bytes almost never carry a valid checksum, and the
+// checks behind it are the ones worth fuzzing). A load may throw bvhkit::Error; a structure it
+// accepts, with or without validate(), must answer queries with indices in range (ASan and UBSan
+// watch the walks).
+#include <cstdint>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include "bvhkit/io/closest_point_mesh_file.hpp"
 #include "bvhkit/io/collision_model_file.hpp"
 #include "bvhkit/io/dynamic_tree_file.hpp"
+#include "bvhkit/io/mapped_triangle_bvh.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/io/winding_number_mesh_file.hpp"
@@ -20,30 +24,48 @@
 
 namespace {
 
+// Rays that touch the tree; every index they return must be in range.
+template <class T, class Tree>
+void query_triangle_tree(const Tree& tree) {
+    const bvhkit::Vec<T, 3> origins[] = {{T(-2), T(0.1), T(0.2)}, {T(0.3), T(0.2), T(0.1)}};
+    const bvhkit::Vec<T, 3> directions[] = {{T(1), T(0), T(0)}, {T(0.1), T(-1), T(0.3)}};
+    for (const auto& o : origins)
+        for (const auto& d : directions) {
+            const bvhkit::Ray<T, 3> ray(o, d);
+            const bvhkit::Hit<T> hit = tree.closest_hit(ray);
+            if (hit && hit.primitive >= tree.triangle_count()) std::abort();
+            (void)tree.any_hit(ray);
+            tree.all_hits(ray, [&](const bvhkit::Hit<T>& h) {
+                if (h.primitive >= tree.triangle_count()) std::abort();
+                return true;
+            });
+        }
+    for (const std::uint32_t s : tree.skipped())
+        if (s >= tree.triangle_count()) std::abort();
+}
+
+// Both loaders must accept the same files: the copying one and the in-place one (map_triangle_bvh).
+// The queries run outside the try: an Error from a query would be a finding, not a rejection.
 template <class T>
 void load_and_query(std::span<const std::uint8_t> bytes) {
     for (const bool validate : {true, false}) {
+        std::optional<bvhkit::TriangleBvh<T>> copied;
+        std::optional<bvhkit::MappedTriangleBvh<T>> in_place;
         try {
-            const bvhkit::TriangleBvh<T> tree =
-                bvhkit::triangle_bvh_from_bytes<T>(bytes, bvhkit::LoadOptions{validate});
-            const bvhkit::Vec<T, 3> origins[] = {{T(-2), T(0.1), T(0.2)}, {T(0.3), T(0.2), T(0.1)}};
-            const bvhkit::Vec<T, 3> directions[] = {{T(1), T(0), T(0)}, {T(0.1), T(-1), T(0.3)}};
-            for (const auto& o : origins)
-                for (const auto& d : directions) {
-                    const bvhkit::Ray<T, 3> ray(o, d);
-                    const bvhkit::Hit<T> hit = tree.closest_hit(ray);
-                    if (hit && hit.primitive >= tree.triangle_count()) std::abort();
-                    (void)tree.any_hit(ray);
-                    tree.all_hits(ray, [&](const bvhkit::Hit<T>& h) {
-                        if (h.primitive >= tree.triangle_count()) std::abort();
-                        return true;
-                    });
-                }
-            for (const std::uint32_t s : tree.skipped())
-                if (s >= tree.triangle_count()) std::abort();
+            copied.emplace(
+                bvhkit::triangle_bvh_from_bytes<T>(bytes, bvhkit::LoadOptions{validate}));
         } catch (const bvhkit::Error&) {
             // Rejected cleanly.
         }
+        try {
+            in_place.emplace(bvhkit::view_triangle_bvh<T>(bytes, bvhkit::LoadOptions{validate}));
+        } catch (const bvhkit::Error&) {
+        }
+        if (copied) query_triangle_tree<T>(*copied);
+        if (in_place) query_triangle_tree<T>(*in_place);
+        // Bytes not aligned for the records are refused in place by design.
+        const bool aligned = reinterpret_cast<std::uintptr_t>(bytes.data()) % alignof(T) == 0;
+        if (aligned && copied.has_value() != in_place.has_value()) std::abort();
     }
 }
 

@@ -1,12 +1,15 @@
 // TriangleBvh files that lie: every truncation, random byte flips (caught by the checksum), flips
 // with the checksum recomputed (caught by the structure checks, or loading a tree that validates
 // and answers queries), and hand-made hostile headers and trees. Every failure must be a
-// bvhkit::Error; the sanitizer build checks that nothing reads out of range meanwhile.
+// bvhkit::Error; the sanitizer build checks that nothing reads out of range meanwhile. Each file
+// goes through both loaders, the copying one and the in-place one (view_triangle_bvh, what
+// map_triangle_bvh runs), which must accept and refuse the same files.
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <limits>
 
+#include "bvhkit/io/mapped_triangle_bvh.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/math/random.hpp"
 #include "bvhkit/mesh/procedural.hpp"
@@ -26,8 +29,8 @@ std::size_t flip_count() {
 }
 
 // Queries that touch every part of a loaded tree; ASan/UBSan judge them.
-template <class T>
-std::size_t exercise(const TriangleBvh<T>& tree, std::uint64_t seed) {
+template <template <class> class Tree, class T>  // TriangleBvh or MappedTriangleBvh
+std::size_t exercise(const Tree<T>& tree, std::uint64_t seed) {
     std::size_t n = 0;
     for (const auto& ray : random_rays<T>(8, Aabb<T, 3>({-1, -1, -1}, {1, 1, 1}), seed)) {
         n += bool(tree.closest_hit(ray));
@@ -52,6 +55,13 @@ void expect_error(std::span<const std::uint8_t> bytes, const std::string& what,
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find(message_part), std::string::npos)
             << what << ": " << e.what();
+    }
+    try {
+        (void)view_triangle_bvh<float>(bytes, LoadOptions{validate});
+        ADD_FAILURE() << what << ": viewed in place";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(message_part), std::string::npos)
+            << what << " (in place): " << e.what();
     }
 }
 
@@ -98,13 +108,22 @@ TEST(TriangleBvhFileMalformed, ResealedByteFlipsGiveErrorsOrUsableTrees) {
             }
             serial_detail::reseal_tree_file(bad);
             for (const bool validate : {true, false}) {
+                bool copied = false, in_place = false;
                 try {
                     const TriangleBvh<float> tree =
                         triangle_bvh_from_bytes<float>(bad, LoadOptions{validate});
                     ++loaded[validate];
+                    copied = true;
                     (void)exercise(tree, round);
                 } catch (const Error&) {
                 }
+                try {
+                    const auto tree = view_triangle_bvh<float>(bad, LoadOptions{validate});
+                    in_place = true;
+                    (void)exercise(tree, round);
+                } catch (const Error&) {
+                }
+                EXPECT_EQ(copied, in_place) << "round " << round << ", validate " << validate;
             }
         }
         // Flips in coordinates that stay inside their boxes load; most others must not.
@@ -214,8 +233,10 @@ TEST(TriangleBvhFileHostile, HandMadeValidFilesLoad) {
     EXPECT_EQ(h.primitive, 1u);  // slot 0 holds triangle 1
     EXPECT_EQ(h.t, 0.5f);
     // The deepest tree the traversals accept: depth max_bvh_depth.
-    const auto deep = triangle_bvh_from_bytes<float>(chain(max_bvh_depth).bytes());
+    const auto deep_bytes = chain(max_bvh_depth).bytes();
+    const auto deep = triangle_bvh_from_bytes<float>(deep_bytes);
     EXPECT_GT(exercise(deep, 1), 0u);
+    EXPECT_EQ(exercise(view_triangle_bvh<float>(deep_bytes), 1), exercise(deep, 1));
     RawTree skipped = two_leaves();
     skipped.skipped = {0, 2};
     skipped.prims = {1, 3};
@@ -359,6 +380,7 @@ TEST(TriangleBvhFileHostile, BadGeometryIsCaughtByValidation) {
         expect_error(bytes, "validate on", "validate");
         const TriangleBvh<float> tree = triangle_bvh_from_bytes<float>(bytes, LoadOptions{false});
         (void)exercise(tree, i);
+        (void)exercise(view_triangle_bvh<float>(bytes, LoadOptions{false}), i);
     }
 }
 

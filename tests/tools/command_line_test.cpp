@@ -43,8 +43,26 @@ TEST(CommandLine, VersionFlag) {
 TEST(CommandLine, BenchHelpListsEveryWorkload) {
     const Outcome o = run("bench --help");
     EXPECT_EQ(o.status, 0);
-    for (const char* w : {"rays", "dynamic", "nearest", "collide"})
+    for (const char* w : {"rays", "dynamic", "nearest", "collide", "files"})
         EXPECT_NE(o.output.find(w), std::string::npos) << w << " missing from: " << o.output;
+}
+
+// The saved-tree benchmark on a small mesh: every operation gets a row, and the mapped tree and
+// the trees in memory hit the same rays.
+TEST(CommandLine, BenchFilesMeasuresEveryOperation) {
+    const Outcome o = run("bench files sphere:subdiv=3 --reps 1 --rays 2000 --json");
+    ASSERT_EQ(o.status, 0) << o.output;
+    for (const char* op : {"\"build\"", "\"save\"", "\"load\"", "\"map\"", "\"map-novalidate\"",
+                           "\"R2-mapped\"", "\"R2-memory-binary\"", "\"R2-memory-default\""})
+        EXPECT_NE(o.output.find(op), std::string::npos) << op << " missing from: " << o.output;
+    // Three R2 rows with one hit count between them.
+    const auto first = o.output.find("\"hits\"");
+    ASSERT_NE(first, std::string::npos) << o.output;
+    const std::string hits = o.output.substr(first, o.output.find_first_of(",}", first) - first);
+    std::size_t count = 0;
+    for (auto at = o.output.find(hits); at != std::string::npos; at = o.output.find(hits, at + 1))
+        ++count;
+    EXPECT_EQ(count, 3u) << hits << " in: " << o.output;
 }
 
 TEST(CommandLine, CollideWithOneMeshSaysWhatIsWrong) {

@@ -9,6 +9,7 @@
 // pass). A leaf names a run [first, first + count) of `primitive_indices`; count == 0 marks an
 // internal node. With Aabb<float, 3> a node is 32 bytes: two cache-line halves per sibling pair.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "bvhkit/bvh/node_allocator.hpp"
@@ -43,6 +44,23 @@ struct Bvh {
     bool empty() const { return nodes.empty(); }
     const Node& root() const { return nodes.front(); }
 };
+
+/// A Bvh's two arrays seen in place, owned elsewhere: a Bvh's own (bvh_view()) or a mapped file's
+/// (io/mapped_triangle_bvh.hpp). The ray walk and the structure checks read trees through it.
+template <class Volume>
+struct BvhView {
+    using VolumeType = Volume;
+    using Node = BvhNode<Volume>;
+    std::span<const Node> nodes;
+    std::span<const std::uint32_t> primitive_indices;
+    bool empty() const { return nodes.empty(); }
+    const Node& root() const { return nodes.front(); }
+};
+
+template <class Volume>
+BvhView<Volume> bvh_view(const Bvh<Volume>& bvh) {
+    return {bvh.nodes, bvh.primitive_indices};
+}
 
 template <class T, std::size_t N>
 using AabbBvh = Bvh<Aabb<T, N>>;

@@ -24,8 +24,8 @@ namespace bvhkit {
 /// runs non-empty and tiling the slots exactly. A tree that passes cannot make a walk read out of
 /// range, overflow its stack or loop. fail(message) must throw; on_slot(node, slot) and
 /// on_child(node, child) add the caller's checks. Linear; two bytes per node and per slot.
-template <class Volume, class Fail, class OnSlot, class OnChild>
-void check_structure(const Bvh<Volume>& bvh, Fail&& fail, OnSlot&& on_slot, OnChild&& on_child) {
+template <class Tree, class Fail, class OnSlot, class OnChild>  // Tree: a Bvh or a BvhView
+void check_structure(const Tree& bvh, Fail&& fail, OnSlot&& on_slot, OnChild&& on_child) {
     const std::size_t node_count = bvh.nodes.size(), slot_count = bvh.primitive_indices.size();
     if (node_count == 0) {
         if (slot_count) fail("no nodes but " + std::to_string(slot_count) + " primitive slots");
@@ -72,7 +72,7 @@ void check_structure(const Bvh<Volume>& bvh, Fail&& fail, OnSlot&& on_slot, OnCh
 /// lost the NaN that made the build skip it); any primitive whose box is non-finite or empty may be
 /// absent without being listed (the builders' rule); every other one must be in the tree.
 template <class T, std::size_t N>
-void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
+void validate(BvhView<Aabb<T, N>> bvh, std::span<const Aabb<T, N>> primitive_boxes,
               std::span<const std::uint32_t> skipped) {
     auto fail = [](const std::string& what) { throw Error("Bvh::validate: " + what); };
     std::vector<std::uint8_t> primitive_seen(primitive_boxes.size(), 0);
@@ -115,14 +115,15 @@ void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_
 }
 
 template <class T, std::size_t N>
-void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes) {
-    validate(bvh, primitive_boxes, std::span<const std::uint32_t>{});
+void validate(const Bvh<Aabb<T, N>>& bvh, std::span<const Aabb<T, N>> primitive_boxes,
+              std::span<const std::uint32_t> skipped = {}) {
+    validate(bvh_view(bvh), primitive_boxes, skipped);
 }
 
 template <class T, std::size_t N>
 void validate(const Bvh<Aabb<T, N>>& bvh, const std::vector<Aabb<T, N>>& primitive_boxes,
               std::span<const std::uint32_t> skipped = {}) {
-    validate(bvh, std::span<const Aabb<T, N>>(primitive_boxes), skipped);
+    validate(bvh_view(bvh), std::span<const Aabb<T, N>>(primitive_boxes), skipped);
 }
 
 }  // namespace bvhkit

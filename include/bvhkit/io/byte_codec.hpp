@@ -91,6 +91,21 @@ class ByteReader {
         while (pos_ % alignment)
             if (u8() != 0) fail("non-zero padding byte");
     }
+    /// `count` records of U where they lie, without a copy (a mapped load), then the padding to
+    /// `alignment`. U must be a little-endian record laid out as the file's; the bytes must be
+    /// aligned for U (an Error otherwise). The caller checks the machine is little-endian. U is
+    /// trivially copyable and only read, the case C++23's std::start_lifetime_as_array makes
+    /// formal; GCC and Clang read such bytes as the records they hold.
+    template <class U>
+    std::span<const U> records_in_place(std::size_t count, std::size_t alignment) {
+        if (count > remaining() / sizeof(U)) fail("unexpected end of data");
+        const std::uint8_t* at = bytes_.data() + pos_;
+        if (reinterpret_cast<std::uintptr_t>(at) % alignof(U))
+            fail("section not aligned to " + std::to_string(alignof(U)) + " bytes in memory");
+        pos_ += count * sizeof(U);
+        skip_padding(alignment);
+        return {reinterpret_cast<const U*>(at), count};
+    }
     [[noreturn]] void fail(const std::string& message) const {
         throw Error(std::string(what_) + ": " + message + " (at byte " + std::to_string(pos_) +
                     ")");

@@ -96,7 +96,7 @@ struct ClosestPointMeshAccess {
             fail("the longest edge is negative or not finite");
         if (options.validate) {
             validate_loaded(
-                bvh, std::size_t(triangle_count), skipped,
+                bvh_view(bvh), std::size_t(triangle_count), skipped,
                 [&](std::uint32_t s, const auto&) { return mesh.tris_[s].bounds(); }, what);
             // As build() computes it, over the tree's triangles only: the file's may be longer.
             double longest2 = 0;

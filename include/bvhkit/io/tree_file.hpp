@@ -5,6 +5,8 @@
 // single count is used: the size the header claims against the bytes there are, and the checksum
 // over header and payload, so a truncated or corrupted file is an Error before any allocation.
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -185,13 +187,32 @@ auto load_file(const std::filesystem::path& path, FromBytes&& from_bytes) {
     }
 }
 
+/// Writes a new file next to `path` and renames it over `path`: the old file is never rewritten in
+/// place, so a process that has it mapped (map_triangle_bvh) keeps reading the bytes it checked,
+/// and a failed write leaves the old file whole.
 inline void write_file_bytes(const std::filesystem::path& path,
                              std::span<const std::uint8_t> bytes) {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error("cannot create " + path.string());
-    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    out.close();
-    if (!out) throw Error("cannot write " + path.string());
+    static std::atomic<std::uint64_t> counter{0};
+    std::filesystem::path temp = path;
+    temp += ".tmp-" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) +
+            "-" + std::to_string(counter++);
+    std::error_code ec;
+    {
+        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+        if (!out) throw Error("cannot create " + path.string());
+        out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+        out.close();
+        if (!out) {
+            std::filesystem::remove(temp, ec);
+            throw Error("cannot write " + path.string());
+        }
+    }
+    std::filesystem::rename(temp, path, ec);
+    if (ec) {
+        std::error_code ignored;
+        std::filesystem::remove(temp, ignored);
+        throw Error("cannot write " + path.string() + ": " + ec.message());
+    }
 }
 
 }  // namespace serial_detail

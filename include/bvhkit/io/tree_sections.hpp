@@ -119,7 +119,7 @@ inline void check_skipped(std::span<const std::uint32_t> skipped, std::uint64_t 
 /// a slot; triangles absent from the tree get the empty box (allowed absent). The tree must have
 /// passed check_tree_structure.
 template <class T, class SlotBox>
-void validate_loaded(const AabbBvh<T, 3>& bvh, std::size_t triangle_count,
+void validate_loaded(BvhView<Aabb<T, 3>> bvh, std::size_t triangle_count,
                      std::span<const std::uint32_t> skipped, SlotBox slot_box, const char* what) {
     std::vector<Aabb<T, 3>> boxes(triangle_count);
     for (const auto& n : bvh.nodes)
@@ -127,7 +127,7 @@ void validate_loaded(const AabbBvh<T, 3>& bvh, std::size_t triangle_count,
             for (std::uint32_t s = n.first; s < n.first + n.count; ++s)
                 boxes[bvh.primitive_indices[s]] = slot_box(s, n);
     try {
-        validate(bvh, boxes, skipped);
+        validate(bvh, std::span<const Aabb<T, 3>>(boxes), skipped);
     } catch (const Error& e) {
         throw Error(std::string(what) + ": " + e.what());
     }

@@ -18,8 +18,8 @@ namespace bvhkit::serial_detail {
 /// Children in range and after their parent, every node reached exactly once from the root (no
 /// cycle, no shared child), depth <= max_bvh_depth, leaf runs non-empty and tiling the slots
 /// exactly, every primitive index < primitive_count (callers index their own arrays with it).
-template <class Volume>
-void check_tree_structure(const Bvh<Volume>& bvh, std::uint64_t primitive_count, const char* what) {
+template <class Tree>  // a Bvh or a BvhView
+void check_tree_structure(const Tree& bvh, std::uint64_t primitive_count, const char* what) {
     auto fail = [&](const std::string& m) { throw Error(std::string(what) + ": " + m); };
     for (std::size_t s = 0; s < bvh.primitive_indices.size(); ++s)
         if (bvh.primitive_indices[s] >= primitive_count)

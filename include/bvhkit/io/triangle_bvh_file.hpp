@@ -35,6 +35,51 @@ namespace serial_detail {
 // to trace with another layout than the default traces (and breaks ties) with it after a load.
 enum class TriangleLayout : std::uint8_t { Corners = 1, Precomputed = 2 };
 
+// What the header of a TriangleBvh file says, every count checked against the payload.
+struct TriangleBvhFileHeader {
+    OpenedTreeFile file;
+    bool fast = false;  // precomputed triangles (the fast test) rather than corners
+    RayLayout ray_layout = RayLayout::Auto;
+};
+
+template <class T>
+TriangleBvhFileHeader open_triangle_bvh_file(std::span<const std::uint8_t> bytes,
+                                             const char* what) {
+    TriangleBvhFileHeader out{open_tree_file(bytes, FileKind::TriangleBvh, what)};
+    const TreeFileHeader& h = out.file.header;
+    check_scalar_and_volume<T>(h, what);
+    const auto layout = TriangleLayout(h.layout & 0x0f);
+    const int ray_layout = h.layout >> 4;
+    if ((layout != TriangleLayout::Corners && layout != TriangleLayout::Precomputed) ||
+        ray_layout > int(RayLayout::Binary))
+        throw Error(std::string(what) + ": unknown triangle layout " +
+                    std::to_string(int(h.layout)));
+    out.fast = layout == TriangleLayout::Precomputed;
+    out.ray_layout = RayLayout(ray_layout);
+    check_tree_counts(h, node_record_bytes<T>, (out.fast ? 12 : 9) * sizeof(T), 0, what);
+    return out;
+}
+
+// The checks on a loaded tree, wherever its arrays lie: shape and indices always, then validate()
+// unless opted out. The fast layout keeps no corners (p0 - e1 need not round back to p1): there a
+// triangle's box is its leaf's, and a leaf's enclosure of its triangles goes unchecked.
+template <class T>
+void check_loaded_triangle_tree(const TriangleRays<T>& rays, std::span<const Triangle<T>> corners,
+                                std::uint64_t triangle_count,
+                                std::span<const std::uint32_t> skipped, const LoadOptions& options,
+                                const char* what) {
+    check_tree_structure(rays.bvh(), triangle_count, what);
+    check_skipped(skipped, triangle_count, what);
+    if (options.validate)
+        validate_loaded(
+            rays.bvh(), std::size_t(triangle_count), skipped,
+            [&](std::uint32_t s, const auto& leaf) {
+                return rays.triangle_test() == TriangleTest::Fast ? leaf.bounds
+                                                                  : corners[s].bounds();
+            },
+            what);
+}
+
 struct TriangleBvhAccess {
     static constexpr const char* what = "TriangleBvh file";
 
@@ -69,23 +114,14 @@ struct TriangleBvhAccess {
 
     template <class T>
     static TriangleBvh<T> load(std::span<const std::uint8_t> file, const LoadOptions& options) {
-        const OpenedTreeFile f = open_tree_file(file, FileKind::TriangleBvh, what);
-        const TreeFileHeader& h = f.header;
-        check_scalar_and_volume<T>(h, what);
-        const auto layout = TriangleLayout(h.layout & 0x0f);
-        const int ray_layout = h.layout >> 4;
-        if ((layout != TriangleLayout::Corners && layout != TriangleLayout::Precomputed) ||
-            ray_layout > int(RayLayout::Binary))
-            throw Error(std::string(what) + ": unknown triangle layout " +
-                        std::to_string(int(h.layout)));
-        const bool fast = layout == TriangleLayout::Precomputed;
-        check_tree_counts(h, node_record_bytes<T>, (fast ? 12 : 9) * sizeof(T), 0, what);
-        const auto [node_count, slot_count, skipped_count, triangle_count] = h.counts;
+        const TriangleBvhFileHeader f = open_triangle_bvh_file<T>(file, what);
+        const bool fast = f.fast;
+        const auto [node_count, slot_count, skipped_count, triangle_count] = f.file.header.counts;
 
-        ByteReader r(f.payload, what);
+        ByteReader r(f.file.payload, what);
         TriangleBvh<T> tree;
         tree.triangle_test_ = fast ? TriangleTest::Fast : TriangleTest::Watertight;
-        tree.ray_layout_ = RayLayout(ray_layout);
+        tree.ray_layout_ = f.ray_layout;
         tree.triangle_count_ = std::size_t(triangle_count);
         auto& bvh = tree.bvh_;
         get_nodes(r, bvh, node_count);
@@ -102,17 +138,8 @@ struct TriangleBvhAccess {
         auto& skipped = tree.report_.skipped;
         get_u32s(r, skipped, skipped_count);
 
-        check_tree_structure(bvh, triangle_count, what);
-        check_skipped(skipped, triangle_count, what);
-        // The fast layout keeps no corners (p0 - e1 need not round back to p1): there a
-        // triangle's box is its leaf's, and a leaf's enclosure of its triangles goes unchecked.
-        if (options.validate)
-            validate_loaded(
-                bvh, tree.triangle_count_, skipped,
-                [&](std::uint32_t s, const auto& leaf) {
-                    return fast ? leaf.bounds : tree.exact_[s].bounds();
-                },
-                what);
+        check_loaded_triangle_tree<T>(tree.binary_rays(), tree.exact_, triangle_count, skipped,
+                                      options, what);
         tree.make_ray_layout();  // derived, not stored: the structure was checked above
         return tree;
     }

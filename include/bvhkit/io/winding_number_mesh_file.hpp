@@ -73,7 +73,7 @@ struct WindingNumberMeshAccess {
         check_skipped(skipped, triangle_count, what);
         if (options.validate)
             validate_loaded(
-                mesh.bvh_, std::size_t(triangle_count), skipped,
+                bvh_view(mesh.bvh_), std::size_t(triangle_count), skipped,
                 [&](std::uint32_t s, const auto&) { return mesh.tris_[s].bounds(); }, what);
         mesh.derive_dipoles();
         return mesh;

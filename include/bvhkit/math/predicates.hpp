@@ -10,6 +10,8 @@
 // below 2^129 and products of three below 2^390; the smallest product error term is above 2^-600,
 // so nothing overflows or underflows). Double input is exact while every coordinate difference is
 // zero or of magnitude in [2^-300, 2^300] (nothing overflows, no error term underflows).
+// Outside the range, a NaN or infinite coordinate, or products that overflow, the sign is 0: a
+// defined answer where no exact one exists (the expansions must never see a NaN or an infinity).
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -176,6 +178,7 @@ inline int orient2d_sign(double ax, double ay, double bx, double by, double cx, 
     const double bound = exact::orient2d_bound * (std::fabs(l) + std::fabs(r));
     if (det > bound) return 1;
     if (-det > bound) return -1;
+    if (!std::isfinite(bound)) return 0;  // a NaN or infinite input, or an overflow
     return exact::orient2d_exact(ax, ay, bx, by, cx, cy);
 }
 
@@ -197,6 +200,7 @@ int orient3d_sign(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, co
     const double bound = exact::orient3d_bound * permanent;
     if (det > bound) return 1;
     if (-det > bound) return -1;
+    if (!std::isfinite(bound)) return 0;  // a NaN or infinite input, or an overflow
     return exact::orient3d_exact(Vec<double, 3>(a), Vec<double, 3>(b), Vec<double, 3>(c),
                                  Vec<double, 3>(d));
 }
@@ -222,8 +226,10 @@ void orient3d_signs(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, 
             exact::orient3d_bound * (m0 * std::fabs(wx) + m1 * std::fabs(wy) + m2 * std::fabs(wz));
         out[i] = det > bound    ? 1
                  : -det > bound ? -1
-                                : exact::orient3d_exact(Vec<double, 3>(a), Vec<double, 3>(b),
-                                                        Vec<double, 3>(c), Vec<double, 3>(d[i]));
+                 : !std::isfinite(bound)
+                     ? 0  // a NaN or infinite input, or an overflow
+                     : exact::orient3d_exact(Vec<double, 3>(a), Vec<double, 3>(b),
+                                             Vec<double, 3>(c), Vec<double, 3>(d[i]));
     }
 }
 

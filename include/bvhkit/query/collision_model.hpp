@@ -53,7 +53,9 @@ class CollisionModel {
     }
 
     /// After the mesh's vertices moved (same triangles in the same order): new triangles, every
-    /// volume refitted in one pass, same tree shape.
+    /// volume refitted in one pass, same tree shape. A triangle of the tree with a NaN or infinite
+    /// coordinate is an Error (the model is left unchanged); triangles left out at the build stay
+    /// out.
     template <IndexedTriangleMesh M>
     void refit(const M& mesh) {
         if (mesh.triangle_count() != triangle_count_)
@@ -61,6 +63,12 @@ class CollisionModel {
                         std::to_string(mesh.triangle_count()) +
                         " triangles, the model was built over " + std::to_string(triangle_count_));
         check_triangle_indices(mesh);
+        // The tree's shape is kept, so a triangle in it cannot be left out as a build would leave
+        // it: an Error, and the model stays as it was.
+        for (const std::uint32_t t : bvh_.primitive_indices)
+            if (!triangle_at<T>(mesh, t).bounds().is_finite())
+                throw Error("CollisionModel::refit: triangle " + std::to_string(t) +
+                            " has a non-finite coordinate (a new model would leave it out)");
         lay_out(mesh, bvh_.primitive_indices);
         refit_volumes(bvh_, std::span<const Triangle<T>>(slot_triangles_));
     }

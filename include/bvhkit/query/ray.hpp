@@ -7,6 +7,8 @@
 // child remembers its entry distance, so once a closer hit has shrunk tmax the popped subtree is
 // skipped without touching its node.
 //
+// Each takes the tree as a BvhView (a Bvh's own arrays, or a mapped file's) or as a Bvh.
+//
 // Primitive tests are the caller's: `test(slot, ray, hit)` tests the primitive in leaf slot `slot`
 // (bvh.primitive_indices[slot] is the caller's index) against `ray`, whose tmax is the closest hit
 // so far, and on a hit fills `hit` and returns true. TriangleBvh (triangle_bvh.hpp) and the span
@@ -16,6 +18,7 @@
 // A ray that is not traceable (math/ray.hpp: a NaN or infinite origin or direction component, a
 // zero direction, or tmin > tmax or NaN) misses at once, without visiting a node.
 #include <span>
+#include <utility>
 
 #include "bvhkit/bvh/bvh.hpp"
 #include "bvhkit/bvh/traversal_stack.hpp"
@@ -31,8 +34,7 @@ namespace bvhkit {
 /// may shrink ray.tmax and returns true to stop the walk. The loop is instantiated once per ray
 /// octant, so the slab test's choice of near and far planes is made at compile time.
 template <class T, std::size_t N, class OnLeaf, class Stats = NoStats>
-void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, OnLeaf&& on_leaf,
-                  Stats&& stats = {}) {
+void traverse_ray(BvhView<Aabb<T, N>> bvh, Ray<T, N>& ray, OnLeaf&& on_leaf, Stats&& stats = {}) {
     if (bvh.empty() || !is_traceable(ray)) return;
     const RaySlabData<T, N> slab(ray);
     struct Entry {
@@ -108,7 +110,7 @@ Hit<T, N> make_hit(const Test& test, std::uint32_t slot, std::uint32_t primitive
 }  // namespace detail
 
 template <class T, std::size_t N, class Test, class Stats = NoStats>
-Hit<T, N> closest_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats&& stats = {}) {
+Hit<T, N> closest_hit(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, Stats&& stats = {}) {
     // The test's output is a local of the leaf loop, which the compiler keeps in registers; the
     // best hit is copied out only on a hit (3.5% on R1 against one record shared by reference).
     struct Best {
@@ -136,7 +138,7 @@ Hit<T, N> closest_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, St
 
 /// Any hit (occlusion): true as soon as some primitive is hit within [tmin, tmax].
 template <class T, std::size_t N, class Test, class Stats = NoStats>
-bool any_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats&& stats = {}) {
+bool any_hit(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, Stats&& stats = {}) {
     bool found = false;
     traverse_ray(
         bvh, ray,
@@ -155,7 +157,7 @@ bool any_hit(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, Stats&& sta
 /// All hits within [tmin, tmax], in no particular order: on_hit(const Hit<T, N>&) returns true to
 /// go on, false to stop.
 template <class T, std::size_t N, class Test, class OnHit, class Stats = NoStats>
-void all_hits(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, OnHit&& on_hit,
+void all_hits(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, OnHit&& on_hit,
               Stats&& stats = {}) {
     TriangleHit<T> h;
     traverse_ray(
@@ -170,6 +172,24 @@ void all_hits(const Bvh<Aabb<T, N>>& bvh, Ray<T, N> ray, Test&& test, OnHit&& on
             return false;
         },
         stats);
+}
+
+// The same four over a Bvh's own arrays.
+template <class T, std::size_t N, class... Args>
+void traverse_ray(const Bvh<Aabb<T, N>>& bvh, Ray<T, N>& ray, Args&&... args) {
+    traverse_ray(bvh_view(bvh), ray, std::forward<Args>(args)...);
+}
+template <class T, std::size_t N, class... Args>
+Hit<T, N> closest_hit(const Bvh<Aabb<T, N>>& bvh, const Ray<T, N>& ray, Args&&... args) {
+    return closest_hit(bvh_view(bvh), ray, std::forward<Args>(args)...);
+}
+template <class T, std::size_t N, class... Args>
+bool any_hit(const Bvh<Aabb<T, N>>& bvh, const Ray<T, N>& ray, Args&&... args) {
+    return any_hit(bvh_view(bvh), ray, std::forward<Args>(args)...);
+}
+template <class T, std::size_t N, class... Args>
+void all_hits(const Bvh<Aabb<T, N>>& bvh, const Ray<T, N>& ray, Args&&... args) {
+    all_hits(bvh_view(bvh), ray, std::forward<Args>(args)...);
 }
 
 /// The primitive test for a span of RayPrimitives indexed as the tree was built over them.

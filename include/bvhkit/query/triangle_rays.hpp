@@ -1,0 +1,104 @@
+#pragma once
+// TriangleRays<T>: closest hit, any hit and all hits on a binary tree over triangles stored in leaf
+// slot order, read in place. It owns nothing: TriangleBvh walks its own arrays with it when rays
+// take the binary tree, and MappedTriangleBvh (io/mapped_triangle_bvh.hpp) walks a mapped file's.
+//
+// The triangles are either their corners (the watertight test, Woop, Benthin and Wald 2013) or
+// p0, edges and normal (the fast Moller-Trumbore test); see primitives/triangle.hpp.
+#include <span>
+#include <string>
+
+#include "bvhkit/error.hpp"
+#include "bvhkit/exec/executor.hpp"
+#include "bvhkit/primitives/triangle.hpp"
+#include "bvhkit/query/ray.hpp"
+
+namespace bvhkit {
+
+enum class TriangleTest {
+    Watertight,  // Woop, Benthin, Wald 2013: never misses through a shared edge (default)
+    Fast,        // Moller-Trumbore on precomputed edges: a ray can slip through a shared edge
+};
+
+template <class T>
+class TriangleRays {
+  public:
+    TriangleRays() = default;
+    /// Watertight test over corners, `corners[slot]` the triangle in leaf slot `slot`.
+    TriangleRays(BvhView<Aabb<T, 3>> bvh, std::span<const Triangle<T>> corners)
+        : bvh_(bvh), corners_(corners.data()), test_(TriangleTest::Watertight) {}
+    /// Fast test over precomputed triangles, by leaf slot.
+    TriangleRays(BvhView<Aabb<T, 3>> bvh, std::span<const PrecomputedTriangle<T>> precomputed)
+        : bvh_(bvh), precomputed_(precomputed.data()), test_(TriangleTest::Fast) {}
+
+    template <class Stats = NoStats>
+    Hit<T> closest_hit(const Ray<T, 3>& ray, Stats&& stats = {}) const {
+        if (test_ == TriangleTest::Watertight)
+            return bvhkit::closest_hit(bvh_, ray, WatertightTest{corners_, ray}, stats);
+        return bvhkit::closest_hit(bvh_, ray, FastTest{precomputed_}, stats);
+    }
+    template <class Stats = NoStats>
+    bool any_hit(const Ray<T, 3>& ray, Stats&& stats = {}) const {
+        if (test_ == TriangleTest::Watertight)
+            return bvhkit::any_hit(bvh_, ray, WatertightTest{corners_, ray}, stats);
+        return bvhkit::any_hit(bvh_, ray, FastTest{precomputed_}, stats);
+    }
+    /// on_hit(const Hit<T>&) -> bool (true to go on); hits come in no particular order.
+    template <class OnHit, class Stats = NoStats>
+    void all_hits(const Ray<T, 3>& ray, OnHit&& on_hit, Stats&& stats = {}) const {
+        if (test_ == TriangleTest::Watertight)
+            bvhkit::all_hits(bvh_, ray, WatertightTest{corners_, ray}, on_hit, stats);
+        else
+            bvhkit::all_hits(bvh_, ray, FastTest{precomputed_}, on_hit, stats);
+    }
+
+    BvhView<Aabb<T, 3>> bvh() const { return bvh_; }
+    TriangleTest triangle_test() const { return test_; }
+
+  private:
+    // The leaf tests (query/ray.hpp): the watertight one carries its per-ray constants, made once
+    // per query.
+    struct WatertightTest {
+        const Triangle<T>* tris;
+        WatertightRay<T> prepared;
+        WatertightTest(const Triangle<T>* t, const Ray<T, 3>& ray) : tris(t), prepared(ray) {}
+        bool operator()(std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) const {
+            const Triangle<T>& tri = tris[slot];
+            return intersect_watertight(prepared, tri.p0, tri.p1, tri.p2, ray.tmin, ray.tmax, h);
+        }
+        Vec<T, 3> normal(std::uint32_t slot) const { return tris[slot].normal(); }
+    };
+    struct FastTest {
+        const PrecomputedTriangle<T>* tris;
+        bool operator()(std::uint32_t slot, const Ray<T, 3>& ray, TriangleHit<T>& h) const {
+            return tris[slot].intersect(ray, ray.tmax, h);
+        }
+        // n = (p0 - p1) x (p2 - p0) = -(p1 - p0) x (p2 - p0).
+        Vec<T, 3> normal(std::uint32_t slot) const { return tris[slot].n * T(-1); }
+    };
+
+    BvhView<Aabb<T, 3>> bvh_;
+    const Triangle<T>* corners_ = nullptr;
+    const PrecomputedTriangle<T>* precomputed_ = nullptr;
+    TriangleTest test_ = TriangleTest::Watertight;
+};
+
+/// Rays per task of the batch calls (TriangleBvh::trace, MappedTriangleBvh::trace): large enough
+/// to pay for a task, small enough to balance incoherent rays over the cores.
+inline constexpr std::size_t ray_batch_grain = 256;
+
+/// out[i] = answer(rays[i]) on the executor's threads, in fixed chunks of ray_batch_grain, so the
+/// answers equal one-by-one calls for any thread count. Throws Error (naming `what`) when the
+/// spans differ in length.
+template <class Ray, class Out, class Answer>
+void for_each_ray(std::span<const Ray> rays, std::span<Out> out, const Executor& exec,
+                  const char* what, Answer&& answer) {
+    if (rays.size() != out.size())
+        throw Error(std::string(what) + " holds " + std::to_string(out.size()) + " entries for " +
+                    std::to_string(rays.size()) + " rays");
+    exec.parallel_for(rays.size(), ray_batch_grain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) out[i] = answer(rays[i]);
+    });
+}
+
+}  // namespace bvhkit
