@@ -50,7 +50,7 @@ struct TriangleBvhOptions : BuildOptions {
 };
 
 template <class T>
-class TriangleBvh {
+class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
   public:
     TriangleBvh() = default;
 
@@ -111,30 +111,7 @@ class TriangleBvh {
         binary_rays().all_hits(ray, on_hit, stats);
     }
 
-    /// Batch tracing: hits[i] = closest_hit(rays[i]), on `threads` threads (0 = every core, 1 =
-    /// the calling thread; several only when bvhkit has oneTBB). Rays go in fixed chunks of
-    /// batch_grain and each answer is its ray's alone, so the answers equal the one-by-one calls
-    /// for any thread count. Throws Error when the spans differ in length.
-    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
-               unsigned threads = 0) const {
-        trace(rays, hits, Executor(threads));
-    }
-    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
-               const Executor& exec) const {
-        for_each_ray(rays, hits, exec, "TriangleBvh::trace: hits",
-                     [&](const Ray<T, 3>& ray) { return closest_hit(ray); });
-    }
-    /// Batch occlusion: occluded[i] = any_hit(rays[i]) (1 or 0), as trace() runs.
-    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
-                  unsigned threads = 0) const {
-        this->occluded(rays, occluded, Executor(threads));
-    }
-    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
-                  const Executor& exec) const {
-        for_each_ray(rays, occluded, exec, "TriangleBvh::occluded: occluded",
-                     [&](const Ray<T, 3>& ray) { return std::uint8_t(any_hit(ray) ? 1 : 0); });
-    }
-    static constexpr std::size_t batch_grain = ray_batch_grain;
+    // Batches: trace() and occluded(), from RayBatches (query/triangle_rays.hpp).
 
     TriangleTest triangle_test() const {
         return triangle_test_;

@@ -36,7 +36,7 @@ struct MappedTriangleBvhAccess;
 }
 
 template <class T>
-class MappedTriangleBvh {
+class MappedTriangleBvh : public RayBatches<MappedTriangleBvh<T>, T> {
   public:
     MappedTriangleBvh() = default;  // no tree: every ray misses
     // Move-only; a moved-from tree is empty (its views go with the mapping).
@@ -62,26 +62,7 @@ class MappedTriangleBvh {
         rays_.all_hits(ray, on_hit, stats);
     }
 
-    /// Batches, as TriangleBvh::trace and occluded (0 threads = every core).
-    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
-               unsigned threads = 0) const {
-        trace(rays, hits, Executor(threads));
-    }
-    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
-               const Executor& exec) const {
-        for_each_ray(rays, hits, exec, "MappedTriangleBvh::trace: hits",
-                     [&](const Ray<T, 3>& ray) { return closest_hit(ray); });
-    }
-    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
-                  unsigned threads = 0) const {
-        this->occluded(rays, occluded, Executor(threads));
-    }
-    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
-                  const Executor& exec) const {
-        for_each_ray(rays, occluded, exec, "MappedTriangleBvh::occluded: occluded",
-                     [&](const Ray<T, 3>& ray) { return std::uint8_t(any_hit(ray) ? 1 : 0); });
-    }
-    static constexpr std::size_t batch_grain = ray_batch_grain;
+    // Batches: trace() and occluded(), from RayBatches (query/triangle_rays.hpp).
 
     /// The tree, in place in the file.
     BvhView<Aabb<T, 3>> bvh() const { return rays_.bvh(); }

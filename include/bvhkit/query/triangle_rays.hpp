@@ -83,22 +83,53 @@ class TriangleRays {
     TriangleTest test_ = TriangleTest::Watertight;
 };
 
-/// Rays per task of the batch calls (TriangleBvh::trace, MappedTriangleBvh::trace): large enough
-/// to pay for a task, small enough to balance incoherent rays over the cores.
+/// Rays per task of the batch calls: large enough to pay for a task, small enough to balance
+/// incoherent rays over the cores.
 inline constexpr std::size_t ray_batch_grain = 256;
 
-/// out[i] = answer(rays[i]) on the executor's threads, in fixed chunks of ray_batch_grain, so the
-/// answers equal one-by-one calls for any thread count. Throws Error (naming `what`) when the
-/// spans differ in length.
-template <class Ray, class Out, class Answer>
-void for_each_ray(std::span<const Ray> rays, std::span<Out> out, const Executor& exec,
-                  const char* what, Answer&& answer) {
-    if (rays.size() != out.size())
-        throw Error(std::string(what) + " holds " + std::to_string(out.size()) + " entries for " +
-                    std::to_string(rays.size()) + " rays");
-    exec.parallel_for(rays.size(), ray_batch_grain, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) out[i] = answer(rays[i]);
-    });
-}
+/// The batch calls of a tree with closest_hit(ray) and any_hit(ray) (TriangleBvh,
+/// MappedTriangleBvh derive from it): trace() sets hits[i] = closest_hit(rays[i]), occluded()
+/// sets occluded[i] = any_hit(rays[i]) (1 or 0), on `threads` threads (0 = every core, 1 = the
+/// calling thread; several only when bvhkit has oneTBB) or on an Executor. Rays go in fixed chunks
+/// of batch_grain and each answer is its ray's alone, so the answers equal the one-by-one calls
+/// for any thread count. An Error when the spans differ in length.
+template <class Tree, class T>
+class RayBatches {
+  public:
+    static constexpr std::size_t batch_grain = ray_batch_grain;
+
+    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
+               unsigned threads = 0) const {
+        trace(rays, hits, Executor(threads));
+    }
+    void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
+               const Executor& exec) const {
+        for_each(rays, hits, exec, "trace: hits",
+                 [&](const Ray<T, 3>& ray) { return tree().closest_hit(ray); });
+    }
+    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
+                  unsigned threads = 0) const {
+        this->occluded(rays, occluded, Executor(threads));
+    }
+    void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
+                  const Executor& exec) const {
+        for_each(rays, occluded, exec, "occluded: occluded",
+                 [&](const Ray<T, 3>& ray) { return std::uint8_t(tree().any_hit(ray) ? 1 : 0); });
+    }
+
+  private:
+    const Tree& tree() const { return static_cast<const Tree&>(*this); }
+
+    template <class Out, class Answer>
+    static void for_each(std::span<const Ray<T, 3>> rays, std::span<Out> out, const Executor& exec,
+                         const char* what, Answer&& answer) {
+        if (rays.size() != out.size())
+            throw Error(std::string(what) + " holds " + std::to_string(out.size()) +
+                        " entries for " + std::to_string(rays.size()) + " rays");
+        exec.parallel_for(rays.size(), batch_grain, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) out[i] = answer(rays[i]);
+        });
+    }
+};
 
 }  // namespace bvhkit
