@@ -125,6 +125,9 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
 
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
+    /// A triangle of the tree with a NaN or infinite coordinate is an Error, and the tree is left
+    /// as it was (its boxes would be NaN, and rays would miss it without a word); triangles left
+    /// out at the build stay out.
     template <IndexedTriangleMesh M>
     void refit(const M& mesh) {
         if (mesh.triangle_count() != triangle_count_)
@@ -133,6 +136,10 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
                         " triangles, the tree was built over " + std::to_string(triangle_count_));
         check_triangle_indices(mesh);
         const auto triangle = [&](std::size_t i) { return triangle_at<T>(mesh, i); };
+        for (const std::uint32_t t : bvh_.primitive_indices)
+            if (!triangle(t).bounds().is_finite())
+                throw Error("TriangleBvh::refit: triangle " + std::to_string(t) +
+                            " has a non-finite coordinate (a new tree would leave it out)");
         bvhkit::refit(bvh_, [&](std::uint32_t i) { return triangle(i).bounds(); });
         lay_out(triangle);
     }

@@ -102,9 +102,7 @@ class Model {
         const T* v = vertices.data();
         nb::gil_scoped_release release;
         const std::unique_lock<std::shared_mutex> lock(mutex_);
-        for (std::size_t i = 0; i < mesh_.vertices.size(); ++i)
-            mesh_.vertices[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
-        model_.refit(mesh_);
+        refit_vertices(mesh_.vertices, v, [&] { model_.refit(mesh_); });
     }
 
     /// Calls per_pose(i, pose) for every pose of B in A's frame (this is A), without the GIL.

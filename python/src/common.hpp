@@ -121,13 +121,29 @@ void run_batch(std::size_t count, std::size_t grain, unsigned threads, Body&& bo
 
 /// A (rows, cols) numpy array that owns `values` (rows * cols of them).
 template <class X>
-nb::ndarray<nb::numpy, X> owned_array(std::vector<X>&& values, std::size_t rows,
-                                      std::size_t cols) {
+nb::ndarray<nb::numpy, X> owned_array(std::vector<X>&& values, std::size_t rows, std::size_t cols) {
     auto* heap = new std::vector<X>(std::move(values));
     heap->reserve(1);  // a valid data pointer for an empty array
     nb::capsule owner(heap, [](void* p) noexcept { delete static_cast<std::vector<X>*>(p); });
     if (cols == 0) return nb::ndarray<nb::numpy, X>(heap->data(), {rows}, owner);
     return nb::ndarray<nb::numpy, X>(heap->data(), {rows, cols}, owner);
+}
+
+/// Gives `vertices` the (n, 3) rows at `rows` and calls refit(). When refit throws (a non-finite
+/// coordinate in a triangle of the tree), the old vertices go back, so the object stays as it was,
+/// and the Error names the argument.
+template <class T, class Refit>
+void refit_vertices(std::vector<Vec<T, 3>>& vertices, const T* rows, Refit&& refit) {
+    std::vector<Vec<T, 3>> moved(vertices.size());
+    for (std::size_t i = 0; i < moved.size(); ++i)
+        moved[i] = {rows[3 * i], rows[3 * i + 1], rows[3 * i + 2]};
+    vertices.swap(moved);
+    try {
+        refit();
+    } catch (const Error& e) {
+        vertices.swap(moved);
+        throw Error(std::string("vertices: ") + e.what());
+    }
 }
 
 void bind_scene(nb::module_& m);

@@ -209,8 +209,7 @@ class Scene {
         const T* v = vertices.data();
         nb::gil_scoped_release release;
         const std::unique_lock<std::shared_mutex> lock(mutex_);
-        for (std::size_t i = 0; i < mesh_.vertices.size(); ++i) mesh_.vertices[i] = row(v, i);
-        rays_.refit(mesh_);
+        refit_vertices(mesh_.vertices, v, [&] { rays_.refit(mesh_); });
         // The proximity structures are rebuilt when next asked for.
         sdf_.reset();
         winding_.reset();

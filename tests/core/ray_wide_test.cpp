@@ -177,6 +177,33 @@ TEST(WideRays, RefitKeepsTheWideLayoutInStep) {
     expect_same(wide, flat, tris, rays_for(tris, test::scaled(5000), 5));
 }
 
+// A NaN or infinite vertex in a triangle of the tree makes refit an Error for every layout, and
+// the tree answers afterwards exactly as before it (a NaN box would make rays miss silently).
+TEST(WideRays, RefitWithANonFiniteVertexIsAnError) {
+    const TriangleMesh mesh = make_sphere(3);
+    const auto tris = placed(mesh, 1, 0);
+    const auto rays = rays_for(tris, test::scaled(2000), 7);
+    for (const RayLayout layout : {RayLayout::Binary, RayLayout::Wide4, RayLayout::Wide8}) {
+        TriangleBvhOptions options;
+        options.ray_layout = layout;
+        for (const float bad :
+             {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+            TriangleBvh<float> tree(mesh, options);
+            const TriangleBvh<float> untouched(mesh, options);
+            TriangleMesh moved = mesh;
+            for (auto& v : moved.vertices) v = v * 1.5f;
+            moved.vertices[mesh.triangles[7][1]][2] = bad;
+            EXPECT_THROW(tree.refit(moved), Error);
+            SCOPED_TRACE("layout " + std::to_string(int(layout)));
+            for (const Ray<float, 3>& ray : rays) {
+                const Hit<float> a = tree.closest_hit(ray), b = untouched.closest_hit(ray);
+                ASSERT_EQ(a.primitive, b.primitive);
+                ASSERT_EQ(a.t, b.t);
+            }
+        }
+    }
+}
+
 #if BVHKIT_RAY_AVX2
 // The two-group AVX test (the eight-wide walk's), in a function that carries its target.
 [[gnu::target("avx2")]] void test_two_groups(const WatertightRay<float>& prep,

@@ -1,5 +1,7 @@
 """Rays against a numpy Moller-Trumbore brute force in float64."""
 
+import pickle
+
 import numpy as np
 import pytest
 
@@ -109,6 +111,29 @@ def test_watertight_ray_through_shared_edge():
         scene = bvhkit.TriangleMesh(v, f, dtype=dtype, ray_test="watertight")
         assert np.all(scene.intersect(o, d).face >= 0)
         assert np.all(scene.occluded(o, d))
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_refit_with_a_non_finite_vertex_is_an_error_and_changes_nothing(bad):
+    v, f = bvhkit.load_mesh("sphere:subdiv=2")
+    o = np.array([[0, 0, -5.0], [0.1, 0.2, -5.0]])
+    d = np.array([[0, 0, 1.0], [0, 0, 1.0]])
+    scene = bvhkit.TriangleMesh(v, f)
+    model = bvhkit.CollisionModel(v, f)
+    before = scene.intersect(o, d).t
+    moved = v * 2
+    moved[f[5, 1], 0] = bad
+    with pytest.raises(ValueError, match="vertices"):
+        scene.refit(moved)
+    with pytest.raises(ValueError, match="vertices"):
+        model.refit(moved)
+    assert np.array_equal(scene.intersect(o, d).t, before)
+    # The vertices kept are the old ones: a pickled copy and a second refit see no NaN.
+    assert np.array_equal(pickle.loads(pickle.dumps(scene)).intersect(o, d).t, before)
+    scene.refit(v * 2)
+    model.refit(v * 2)
+    assert abs(scene.intersect(o, d).t[0] - 3) < 1e-5
+    assert bvhkit.collide(model, model, np.eye(3)[None], np.zeros((1, 3)))[0]
 
 
 def test_refit_moves_the_hits():
