@@ -18,6 +18,7 @@
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/io/winding_number_mesh_file.hpp"
+#include "bvhkit/query/point_order.hpp"
 #include "bvhkit/query/signed_distance.hpp"
 #include "bvhkit/query/winding_number.hpp"
 #include "bvhkit/triangle_bvh.hpp"
@@ -143,12 +144,17 @@ class Scene {
     void points(const Rows<T, 3>& pts, unsigned threads, bool need_sdf, bool need_winding,
                 PerPoint&& per_point) const {
         const T* p = pts.data();
+        const std::size_t k = pts.shape(0);
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock(mutex_);
         prepare(need_sdf, need_winding);
-        run_batch(pts.shape(0), 256, threads, [&](std::size_t b, std::size_t e) {
+        // A large batch is answered in spatial order (bvhkit/query/point_order.hpp): neighbours
+        // find the tree's nodes in cache. Each point's answer is its own, whatever the order.
+        const std::vector<std::uint32_t> order = batch_order(
+            k, [&](std::size_t i) { return row(p, i); }, Executor(1));
+        run_batch(k, 256, threads, [&](std::size_t b, std::size_t e) {
             NearestScratch<T> scratch;
-            for (std::size_t i = b; i < e; ++i) per_point(i, row(p, i), scratch);
+            for (std::size_t j = b; j < e; ++j) per_point(order[j], row(p, order[j]), scratch);
         });
     }
 

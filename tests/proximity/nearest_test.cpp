@@ -161,7 +161,11 @@ TEST(Nearest, EmptyOneAndRadiusLimit) {
 TEST(Nearest, BatchEqualsSingleForAnyThreads) {
     const auto tris = test::random_soup<float>(test::scaled(20000, 10), 8);
     const ClosestPointMesh<float> mesh(tris);
-    const auto points = query_points(tris, test::scaled(20000, 10), 9);
+    // Past spatial_order_from, so the batch is answered in spatial order; with non-finite points.
+    auto points = query_points(tris, test::scaled(20000, 4), 9);
+    ASSERT_GE(points.size(), spatial_order_from);
+    points[17] = {std::numeric_limits<float>::quiet_NaN(), 0, 0};
+    points[18] = {0, 0, std::numeric_limits<float>::infinity()};
     std::vector<MeshPoint<float>> serial(points.size()), parallel(points.size());
     mesh.closest_points(points, serial, 1);
     mesh.closest_points(points, parallel, 0);

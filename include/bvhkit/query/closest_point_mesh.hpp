@@ -31,6 +31,7 @@
 #include "bvhkit/primitives/triangle_pack.hpp"
 #include "bvhkit/query/nearest.hpp"
 #include "bvhkit/query/nearest_wide.hpp"
+#include "bvhkit/query/point_order.hpp"
 
 namespace bvhkit {
 
@@ -185,9 +186,10 @@ class ClosestPointMesh {
         if (out.size() < points.size())
             throw Error("ClosestPointMesh::closest_points: " + std::to_string(points.size()) +
                         " points but room for " + std::to_string(out.size()));
-        exec.parallel_for(points.size(), 1024, [&](std::size_t b, std::size_t e) {
+        // In spatial order (query/point_order.hpp): neighbours find the same nodes in cache.
+        for_point_chunks(points, exec, 1024, [&](std::span<const std::uint32_t> chunk) {
             NearestScratch<T> scratch;
-            for (std::size_t i = b; i < e; ++i) out[i] = closest_point(points[i], scratch);
+            for (const std::uint32_t i : chunk) out[i] = closest_point(points[i], scratch);
         });
     }
 

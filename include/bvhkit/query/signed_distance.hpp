@@ -141,9 +141,9 @@ class SignedDistanceMesh {
         if (out.size() < points.size())
             throw Error("SignedDistanceMesh::signed_distances: " + std::to_string(points.size()) +
                         " points but room for " + std::to_string(out.size()));
-        exec.parallel_for(points.size(), 1024, [&](std::size_t b, std::size_t e) {
+        for_point_chunks(points, exec, 1024, [&](std::span<const std::uint32_t> chunk) {
             NearestScratch<T> scratch;
-            for (std::size_t i = b; i < e; ++i) out[i] = signed_distance(points[i], scratch);
+            for (const std::uint32_t i : chunk) out[i] = signed_distance(points[i], scratch);
         });
     }
 

@@ -36,6 +36,7 @@
 #include "bvhkit/error.hpp"
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
+#include "bvhkit/query/point_order.hpp"
 
 namespace bvhkit {
 
@@ -190,8 +191,8 @@ class WindingNumberMesh {
         if (out.size() < points.size())
             throw Error("WindingNumberMesh::fast: " + std::to_string(points.size()) +
                         " points but room for " + std::to_string(out.size()));
-        exec.parallel_for(points.size(), 512, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) out[i] = fast(points[i], beta, order);
+        for_point_chunks(points, exec, 512, [&](std::span<const std::uint32_t> chunk) {
+            for (const std::uint32_t i : chunk) out[i] = fast(points[i], beta, order);
         });
     }
 

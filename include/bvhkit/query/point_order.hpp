@@ -1,0 +1,93 @@
+#pragma once
+// spatial_order: the indices of a batch of query points sorted along a Morton curve over the
+// batch's bounding box, so that points answered one after another lie close together and find
+// the tree's nodes and triangles still in cache. Closest points for 200,000 random points around
+// igea took a quarter less time in this order, the sort included (docs/proximity.md); a grid in
+// row order gained a few per cent. Rays gained nothing from the like (docs/rays.md).
+//
+// The sort is a radix sort of 32-bit keys (ten bits an axis), stable, so points in one cell keep
+// their order and the result is the same on every run and thread count. Points with a NaN or
+// infinite coordinate go last.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "bvhkit/build/morton.hpp"
+#include "bvhkit/error.hpp"
+#include "bvhkit/exec/executor.hpp"
+#include "bvhkit/primitives/hit.hpp"  // invalid_index
+
+namespace bvhkit {
+
+/// The order in which to answer n points, point(i) giving point i (a Vec<T, 3>): a permutation
+/// of 0 .. n - 1; see above.
+template <class PointAt>
+std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const Executor& exec) {
+    using V = std::remove_cvref_t<decltype(point(std::size_t(0)))>;
+    if (n >= std::size_t(invalid_index))
+        throw Error("spatial_order: " + std::to_string(n) +
+                    " points, more than 32-bit indices hold");
+    Aabb<typename V::Scalar, 3> bounds;
+    for (std::size_t i = 0; i < n; ++i)
+        if (const V p = point(i); is_finite(p)) bounds.grow(p);
+    // Item: key in the high half, index in the low half. morton_code gives 21 bits an axis;
+    // its top ten of each make a 30-bit key, and a non-finite point the key 2^30.
+    std::vector<std::uint64_t> items(n), spare(n);
+    exec.parallel_for(n, 4096, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            const V p = point(i);
+            const std::uint64_t key =
+                is_finite(p) ? morton_code(p, bounds) >> 33 : std::uint64_t(1) << 30;
+            items[i] = key << 32 | i;
+        }
+    });
+    // Least significant digit first, eight bits a pass, over the key's 31 bits.
+    for (int shift = 32; shift < 64; shift += 8) {
+        std::array<std::size_t, 257> start{};
+        for (const std::uint64_t item : items) ++start[(item >> shift & 255) + 1];
+        if (start[(items.empty() ? 0 : (items[0] >> shift & 255)) + 1] == n) continue;  // one digit
+        for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
+        for (const std::uint64_t item : items) spare[start[item >> shift & 255]++] = item;
+        items.swap(spare);
+    }
+    std::vector<std::uint32_t> order(n);
+    for (std::size_t k = 0; k < n; ++k) order[k] = std::uint32_t(items[k]);
+    return order;
+}
+template <class T>
+std::vector<std::uint32_t> spatial_order(std::span<const Vec<T, 3>> points, const Executor& exec) {
+    return spatial_order(
+        points.size(), [&](std::size_t i) { return points[i]; }, exec);
+}
+
+/// Batches from this many points on are answered in spatial_order; smaller ones as they come
+/// (their sort would cost about what it saves).
+inline constexpr std::size_t spatial_order_from = 4096;
+
+/// The order to answer a batch of n points in: spatial_order from spatial_order_from points on,
+/// else 0 .. n - 1.
+template <class PointAt>
+std::vector<std::uint32_t> batch_order(std::size_t n, PointAt&& point, const Executor& exec) {
+    if (n >= spatial_order_from) return spatial_order(n, point, exec);
+    std::vector<std::uint32_t> order(n);
+    for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    return order;
+}
+
+/// Calls chunk(indices) for consecutive runs of at most `grain` point indices of batch_order,
+/// covering every point once, spread over `exec`. A body that writes only the results of the
+/// indices it is given answers the same for every thread count and either order.
+template <class T, class Chunk>
+void for_point_chunks(std::span<const Vec<T, 3>> points, const Executor& exec, std::size_t grain,
+                      Chunk&& chunk) {
+    const std::vector<std::uint32_t> order = batch_order(
+        points.size(), [&](std::size_t i) { return points[i]; }, exec);
+    exec.parallel_for(order.size(), grain, [&](std::size_t b, std::size_t e) {
+        chunk(std::span<const std::uint32_t>(order.data() + b, e - b));
+    });
+}
+
+}  // namespace bvhkit
