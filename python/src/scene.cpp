@@ -139,6 +139,12 @@ class Scene {
         });
     }
 
+    /// A thread's storage for point queries: the walk's, and the previous point's closest point,
+    /// which the next walk starts from (the points come in spatial order).
+    struct PointScratch {
+        NearestScratch<T> nearest;
+        MeshPoint<T> previous;
+    };
     /// Calls per_point(i, p, scratch) for each point, on `threads` threads, without the GIL.
     template <class PerPoint>
     void points(const Rows<T, 3>& pts, unsigned threads, bool need_sdf, bool need_winding,
@@ -153,7 +159,7 @@ class Scene {
         const std::vector<std::uint32_t> order = batch_order(
             k, [&](std::size_t i) { return row(p, i); }, Executor(1));
         run_batch(k, 256, threads, [&](std::size_t b, std::size_t e) {
-            NearestScratch<T> scratch;
+            PointScratch scratch;
             for (std::size_t j = b; j < e; ++j) per_point(order[j], row(p, order[j]), scratch);
         });
     }
@@ -170,7 +176,8 @@ class Scene {
         T *dp = distance.data(), *cp = closest.data(), *bp = barycentric.data();
         std::int64_t* fp = face.data();
         points(pts, threads, true, false, [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
-            const MeshPoint<T> c = sdf_->closest_point_mesh().closest_point(p, scratch, max2);
+            const MeshPoint<T> c = scratch.previous = sdf_->closest_point_mesh().closest_point(
+                p, scratch.previous, scratch.nearest, max2);
             const T nan = std::numeric_limits<T>::quiet_NaN();
             dp[i] = c ? std::sqrt(c.distance_squared) : std::numeric_limits<T>::infinity();
             for (int a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;
@@ -187,11 +194,15 @@ class Scene {
         if (sign == "pseudonormal") {
             points(pts, threads, true, false,
                    [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
-                       op[i] = sdf_->signed_distance(p, scratch).distance;
+                       const SignedDistance<T> r =
+                           sdf_->signed_distance(p, scratch.previous, scratch.nearest);
+                       scratch.previous = r.closest;
+                       op[i] = r.distance;
                    });
         } else if (sign == "winding_number") {
             points(pts, threads, true, true, [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
-                const MeshPoint<T> c = sdf_->closest_point_mesh().closest_point(p, scratch);
+                const MeshPoint<T> c = scratch.previous =
+                    sdf_->closest_point_mesh().closest_point(p, scratch.previous, scratch.nearest);
                 const T d = c ? std::sqrt(c.distance_squared) : std::numeric_limits<T>::infinity();
                 op[i] = winding_->inside(p) ? -d : d;
             });

@@ -602,6 +602,54 @@ void fuzz_closest_point(std::uint64_t seed) {
     }
 }
 
+// closest_point(p, near, ...) gives closest_point(p)'s answer bit for bit whatever `near` is: the
+// previous point's answer (as the batches use it), a far point's, none, an index out of range, a
+// triangle left out for a NaN corner; on slivers, far from the origin, at tiny and huge scales, in
+// float and double, with and without a radius limit. The walk from the root is itself judged
+// against an exact reference in the tests above, so equality here carries that over.
+template <class T>
+void check_walks_from_a_start(const std::vector<Triangle<T>>& tris, std::uint64_t seed) {
+    const ClosestPointMesh<T> mesh(tris);
+    const auto points = query_points(tris, test::scaled(3000, 10), seed);
+    NearestScratch<T> scratch;
+    test::Random rng(seed);
+    MeshPoint<T> previous;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const Vec<T, 3>& p = points[i];
+        const T limit = i % 5 == 0 ? T(rng.uniform(0, 0.1)) : std::numeric_limits<T>::infinity();
+        const MeshPoint<T> want = mesh.closest_point(p, scratch, limit);
+        MeshPoint<T> far_answer = mesh.closest_point(points[(i * 7919) % points.size()]);
+        MeshPoint<T> out_of_range;
+        out_of_range.triangle = std::uint32_t(tris.size() + 5);
+        MeshPoint<T> skipped;
+        skipped.triangle = 0;  // left out of the tree: its corner is NaN
+        for (const MeshPoint<T>& near :
+             {previous, far_answer, MeshPoint<T>{}, out_of_range, skipped}) {
+            const MeshPoint<T> got = mesh.closest_point(p, near, scratch, limit);
+            ASSERT_EQ(got.triangle, want.triangle) << i;
+            ASSERT_EQ(got.distance_squared, want.distance_squared) << i;
+            ASSERT_EQ(got.point, want.point) << i;
+            ASSERT_EQ(got.u, want.u) << i;
+            ASSERT_EQ(got.v, want.v) << i;
+        }
+        previous = want;
+    }
+}
+
+TEST(NearestWide, WalksFromAStartingTriangleGiveTheSameAnswers) {
+    const auto with_a_nan = [](auto tris) {
+        tris[0].p1[2] =
+            std::numeric_limits<typename decltype(tris)::value_type::Scalar>::quiet_NaN();
+        return tris;
+    };
+    const TriangleMesh torus = make_torus(48, 24);
+    check_walks_from_a_start(with_a_nan(sliver_soup<float>(test::scaled(2000, 10), 3)), 31);
+    check_walks_from_a_start(with_a_nan(sliver_soup<double>(test::scaled(2000, 10), 4)), 32);
+    check_walks_from_a_start(with_a_nan(moved<float>(torus, 1e6f)), 33);
+    check_walks_from_a_start(with_a_nan(moved<float>(torus, 0, 1e-6f)), 34);
+    check_walks_from_a_start(with_a_nan(moved<double>(torus, 1e9, 1e12)), 35);
+}
+
 TEST(NearestWide, FuzzAgainstBruteForce) {
     for (std::uint64_t seed : {1, 2, 3}) {
         SCOPED_TRACE(::testing::Message() << "seed " << seed);

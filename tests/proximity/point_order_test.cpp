@@ -16,15 +16,14 @@ using namespace bvhkit;
 
 namespace {
 
-// Ten bits an axis of p's cell in `box` (the lowest cell for a flat axis), x highest.
+// Ten bits an axis of p's cell in [lo, hi] (1024 cells an axis, the lowest for a flat axis), x
+// highest.
 std::uint64_t reference_key(const Vec3f& p, const Vec3f& lo, const Vec3f& hi) {
     std::uint64_t cell[3];
     for (int a = 0; a < 3; ++a) {
         const long double extent = static_cast<long double>(hi[a]) - lo[a];
         const long double t = extent > 0 ? (static_cast<long double>(p[a]) - lo[a]) / extent : 0;
-        const long double c = std::floor(t * (1u << 21));  // morton_code's 21 bits
-        cell[a] =
-            std::uint64_t(std::clamp(c, 0.0L, static_cast<long double>((1u << 21) - 1))) >> 11;
+        cell[a] = std::uint64_t(std::clamp(std::floor(t * 1024), 0.0L, 1023.0L));
     }
     std::uint64_t key = 0;
     for (int bit = 9; bit >= 0; --bit)

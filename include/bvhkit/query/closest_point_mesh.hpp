@@ -71,6 +71,79 @@ class ClosestPointMesh {
     MeshPoint<T> closest_point(const Vec<T, 3>& p, NearestScratch<T>& scratch,
                                T max_distance_squared = std::numeric_limits<T>::infinity(),
                                Stats&& stats = {}) const {
+        return closest_point_from(p, invalid_index, scratch, max_distance_squared, stats);
+    }
+    /// The same answer as closest_point(p, scratch, max_distance_squared), found sooner when
+    /// `near` is the answer for a point close to p (the previous point of a grid, or of a batch
+    /// in spatial_order): the walk starts with the radius to the nearest corner of near's
+    /// triangle instead of none. Any `near` gives the same answer (an invalid one, none; of
+    /// triangles at the same distance the answer is always the one in the lowest leaf slot).
+    MeshPoint<T> closest_point(const Vec<T, 3>& p, const MeshPoint<T>& near,
+                               NearestScratch<T>& scratch,
+                               T max_distance_squared = std::numeric_limits<T>::infinity()) const {
+        const std::uint32_t start = near.triangle < slot_of_triangle_.size()
+                                        ? slot_of_triangle_[near.triangle]
+                                        : invalid_index;
+        NoStats stats;
+        return closest_point_from(p, start, scratch, max_distance_squared, stats);
+    }
+    MeshPoint<T> closest_point(const Vec<T, 3>& p) const {
+        thread_local NearestScratch<T> scratch;
+        return closest_point(p, scratch);
+    }
+
+    /// The k nearest triangles (nearest first), each with its closest point.
+    void k_nearest(const Vec<T, 3>& p, std::size_t k, std::vector<MeshPoint<T>>& out,
+                   NearestScratch<T>& scratch) const {
+        thread_local std::vector<std::pair<T, std::uint32_t>> slots;
+        bvhkit::k_nearest(bvh_, p, k, distance(), scratch, slots);
+        out.clear();
+        for (const auto& [d2, s] : slots) out.push_back(point_of(s, p));
+    }
+
+    /// Every triangle within `radius` of p (inclusive, on the distances as rounded to T), in no
+    /// particular order. A negative or NaN radius finds nothing.
+    void within_radius(const Vec<T, 3>& p, T radius, std::vector<MeshPoint<T>>& out) const {
+        out.clear();
+        bvhkit::within_radius(bvh_, p, radius, distance(), [&](LeafSlot s, T) {
+            out.push_back(point_of(s.value, p));
+            return true;
+        });
+    }
+
+    /// closest_point for every point, on `threads` threads (0 = all; see exec/executor.hpp).
+    void closest_points(std::span<const Vec<T, 3>> points, std::span<MeshPoint<T>> out,
+                        unsigned threads = 0) const {
+        closest_points(points, out, Executor(threads));
+    }
+    /// closest_point for every point, on `exec`.
+    void closest_points(std::span<const Vec<T, 3>> points, std::span<MeshPoint<T>> out,
+                        const Executor& exec) const {
+        if (out.size() < points.size())
+            throw Error("ClosestPointMesh::closest_points: " + std::to_string(points.size()) +
+                        " points but room for " + std::to_string(out.size()));
+        // In spatial order (query/point_order.hpp): neighbours find the same nodes in cache.
+        for_point_chunks(points, exec, 1024, [&](std::span<const std::uint32_t> chunk) {
+            NearestScratch<T> scratch;
+            MeshPoint<T> previous;  // each walk starts from its neighbour's answer
+            for (const std::uint32_t i : chunk)
+                previous = out[i] = closest_point(points[i], previous, scratch);
+        });
+    }
+
+    const AabbBvh<T, 3>& bvh() const { return bvh_; }
+    /// The triangle in leaf slot `slot` (slots are the order of bvh().primitive_indices).
+    const Triangle<T>& triangle_in_slot(std::uint32_t slot) const { return tris_[slot]; }
+    std::size_t triangle_count() const { return triangle_count_; }
+
+  private:
+    friend struct serial_detail::ClosestPointMeshAccess;
+
+    // closest_point, its walk started from the triangle in leaf slot `start` when that is one.
+    template <class Stats>
+    MeshPoint<T> closest_point_from(const Vec<T, 3>& p, std::uint32_t start,
+                                    NearestScratch<T>& scratch, T max_distance_squared,
+                                    Stats&& stats) const {
         if (!is_finite(p)) return {};
         using W = AccurateScalar<T>;
         NearestSlot<T> best;
@@ -97,8 +170,12 @@ class ClosestPointMesh {
         const T unscale2 = unscale * unscale;
         const auto measure = [&](std::uint32_t s, const Triangle<T>& t) {
             const W d2 = distance_squared_accurate(t, p);
-            // The limit is judged on the distance as returned (rounded to T).
-            if (d2 < best2 && T(d2) <= max_distance_squared) best = {s, T(d2)}, best2 = d2;
+            // The limit is judged on the distance as returned (rounded to T). Of triangles at
+            // the same distance the one in the lowest slot wins, whatever the order they were
+            // measured in: every triangle that ties with the best is measured (its estimate is
+            // within the slack), so the answer does not depend on where the walk started.
+            if ((d2 < best2 || (d2 == best2 && s < best.slot)) && T(d2) <= max_distance_squared)
+                best = {s, T(d2)}, best2 = d2;
         };
         const auto tighten = [&] {
             T bound = std::min(limit2, widened(widened(best_estimate)));
@@ -140,6 +217,16 @@ class ClosestPointMesh {
                 return reinterpret_cast<std::uintptr_t>(packs) + first * sizeof(*packs);
             }
         };
+        if (start < triangle_slots_) {
+            // The nearest corner of the starting triangle bounds the distance from above, for
+            // twenty instructions (measuring the triangle itself bounds it tighter but cost
+            // more than it saved). The bound is widened twice, as a pack's estimate is: its
+            // rounding is a few ulps of the distance, far inside one widening.
+            const Triangle<T>& t = tris_[start];
+            const T corner2 = std::min(
+                {length_squared(p - t.p0), length_squared(p - t.p1), length_squared(p - t.p2)});
+            search2 = std::min(search2, widened(widened(corner2)));
+        }
         nearest_wide(wide_, p, scratch, search2, OpenLeaf{open_leaf, packs_.data()}, stats);
         // Nearest estimate first; stop at the first whose estimate rounding cannot bring below
         // the best measured so far.
@@ -151,55 +238,6 @@ class ClosestPointMesh {
         }
         return best ? point_of(best.slot, p) : MeshPoint<T>{};
     }
-    MeshPoint<T> closest_point(const Vec<T, 3>& p) const {
-        thread_local NearestScratch<T> scratch;
-        return closest_point(p, scratch);
-    }
-
-    /// The k nearest triangles (nearest first), each with its closest point.
-    void k_nearest(const Vec<T, 3>& p, std::size_t k, std::vector<MeshPoint<T>>& out,
-                   NearestScratch<T>& scratch) const {
-        thread_local std::vector<std::pair<T, std::uint32_t>> slots;
-        bvhkit::k_nearest(bvh_, p, k, distance(), scratch, slots);
-        out.clear();
-        for (const auto& [d2, s] : slots) out.push_back(point_of(s, p));
-    }
-
-    /// Every triangle within `radius` of p (inclusive, on the distances as rounded to T), in no
-    /// particular order. A negative or NaN radius finds nothing.
-    void within_radius(const Vec<T, 3>& p, T radius, std::vector<MeshPoint<T>>& out) const {
-        out.clear();
-        bvhkit::within_radius(bvh_, p, radius, distance(), [&](LeafSlot s, T) {
-            out.push_back(point_of(s.value, p));
-            return true;
-        });
-    }
-
-    /// closest_point for every point, on `threads` threads (0 = all; see exec/executor.hpp).
-    void closest_points(std::span<const Vec<T, 3>> points, std::span<MeshPoint<T>> out,
-                        unsigned threads = 0) const {
-        closest_points(points, out, Executor(threads));
-    }
-    /// closest_point for every point, on `exec`.
-    void closest_points(std::span<const Vec<T, 3>> points, std::span<MeshPoint<T>> out,
-                        const Executor& exec) const {
-        if (out.size() < points.size())
-            throw Error("ClosestPointMesh::closest_points: " + std::to_string(points.size()) +
-                        " points but room for " + std::to_string(out.size()));
-        // In spatial order (query/point_order.hpp): neighbours find the same nodes in cache.
-        for_point_chunks(points, exec, 1024, [&](std::span<const std::uint32_t> chunk) {
-            NearestScratch<T> scratch;
-            for (const std::uint32_t i : chunk) out[i] = closest_point(points[i], scratch);
-        });
-    }
-
-    const AabbBvh<T, 3>& bvh() const { return bvh_; }
-    /// The triangle in leaf slot `slot` (slots are the order of bvh().primitive_indices).
-    const Triangle<T>& triangle_in_slot(std::uint32_t slot) const { return tris_[slot]; }
-    std::size_t triangle_count() const { return triangle_count_; }
-
-  private:
-    friend struct serial_detail::ClosestPointMeshAccess;
 
     void build(const std::vector<Triangle<T>>& tris, const BuildOptions& options) {
         std::vector<Aabb<T, 3>> boxes(tris.size());
@@ -233,6 +271,12 @@ class ClosestPointMesh {
     // The wide tree and the packs, from bvh_ and tris_ alone (a loaded file rebuilds them so).
     void derive_walk_data() {
         wide_ = collapse_to_wide(bvh_);
+        // Where each triangle sits, for a walk that starts from a given triangle.
+        triangle_slots_ = std::uint32_t(bvh_.primitive_indices.size());
+        slot_of_triangle_.assign(triangle_count_, invalid_index);
+        for (std::uint32_t s = 0; s < triangle_slots_; ++s)
+            if (bvh_.primitive_indices[s] < triangle_count_)
+                slot_of_triangle_[bvh_.primitive_indices[s]] = s;
         // The packs hold the triangles scaled by a power of two (exact, barring denormals) that
         // brings the largest coordinate to [1, 2) (for all but meshes within a few binades of
         // T's range): the pack formula's products of four lengths then neither overflow nor
@@ -334,6 +378,8 @@ class ClosestPointMesh {
     T longest_edge_ = 0;                   // the mesh's longest edge (finite triangles)
     T pack_scale_ = 1;                     // packs_ hold the triangles times this (a power of 2)
     bool packs_unscale_exactly_ = true;    // and dividing by it gives tris_ back, bit for bit
+    std::vector<std::uint32_t> slot_of_triangle_;  // mesh triangle -> leaf slot (or invalid)
+    std::uint32_t triangle_slots_ = 0;             // bvh_.primitive_indices.size()
     std::size_t triangle_count_ = 0;
 };
 

@@ -15,7 +15,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "bvhkit/build/morton.hpp"
+#include "bvhkit/build/morton.hpp"  // morton_spread3
 #include "bvhkit/error.hpp"
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/hit.hpp"  // invalid_index
@@ -33,14 +33,27 @@ std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const E
     Aabb<typename V::Scalar, 3> bounds;
     for (std::size_t i = 0; i < n; ++i)
         if (const V p = point(i); is_finite(p)) bounds.grow(p);
-    // Item: key in the high half, index in the low half. morton_code gives 21 bits an axis;
-    // its top ten of each make a 30-bit key, and a non-finite point the key 2^30.
+    // Item: key in the high half, index in the low half. The key interleaves ten bits an axis
+    // of the point's cell in the box, 1024 cells an axis (x highest); a non-finite point's key
+    // is 2^30. A flat axis has one cell.
+    double scale[3];
+    for (int a = 0; a < 3; ++a) {
+        const double extent = double(bounds.max[a]) - double(bounds.min[a]);
+        scale[a] = extent > 0 ? 1024.0 / extent : 0.0;
+    }
     std::vector<std::uint64_t> items(n), spare(n);
     exec.parallel_for(n, 4096, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
             const V p = point(i);
-            const std::uint64_t key =
-                is_finite(p) ? morton_code(p, bounds) >> 33 : std::uint64_t(1) << 30;
+            std::uint64_t key = std::uint64_t(1) << 30;
+            if (is_finite(p)) {
+                key = 0;
+                for (int a = 0; a < 3; ++a) {
+                    const double x = (double(p[a]) - double(bounds.min[a])) * scale[a];
+                    const std::uint64_t cell = x < 1023.0 ? std::uint64_t(x > 0 ? x : 0) : 1023;
+                    key |= morton_spread3(cell) << (2 - a);
+                }
+            }
             items[i] = key << 32 | i;
         }
     });

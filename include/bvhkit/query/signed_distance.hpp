@@ -115,8 +115,14 @@ class SignedDistanceMesh {
     /// Signed distance: negative inside. The sign is decided by the pseudonormal at the closest
     /// point (see above).
     SignedDistance<T> signed_distance(const Vec<T, 3>& p, NearestScratch<T>& scratch) const {
+        return signed_distance(p, MeshPoint<T>{}, scratch);
+    }
+    /// The same answer, found sooner when `near` is the closest point of a point close to p
+    /// (see ClosestPointMesh::closest_point).
+    SignedDistance<T> signed_distance(const Vec<T, 3>& p, const MeshPoint<T>& near,
+                                      NearestScratch<T>& scratch) const {
         SignedDistance<T> r;
-        r.closest = closest_.closest_point(p, scratch);
+        r.closest = closest_.closest_point(p, near, scratch);
         if (!r.closest) return {std::numeric_limits<T>::infinity(), r.closest};
         const T d = std::sqrt(r.closest.distance_squared);
         r.distance = dot(p - r.closest.point, pseudonormal(r.closest)) < T(0) ? -d : d;
@@ -143,7 +149,11 @@ class SignedDistanceMesh {
                         " points but room for " + std::to_string(out.size()));
         for_point_chunks(points, exec, 1024, [&](std::span<const std::uint32_t> chunk) {
             NearestScratch<T> scratch;
-            for (const std::uint32_t i : chunk) out[i] = signed_distance(points[i], scratch);
+            MeshPoint<T> previous;  // each walk starts from its neighbour's closest point
+            for (const std::uint32_t i : chunk) {
+                out[i] = signed_distance(points[i], previous, scratch);
+                previous = out[i].closest;
+            }
         });
     }
 
