@@ -74,6 +74,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>) {
             if (traces_wide() && wide_ray_usable(ray)) {
+                if (!ray_meets_box(ray, bvh_.root().bounds)) return Hit<T>{};
                 TriangleHit<float> h;
                 const TriangleGroup4* group;
                 int lane;

@@ -6,6 +6,7 @@
 // wide layout (TriangleBvh<float>'s default).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstring>
 
 #include "bvhkit/io/read_mesh.hpp"
@@ -175,6 +176,83 @@ TEST(WideRays, RefitKeepsTheWideLayoutInStep) {
     flat.refit(mesh);
     const auto tris = placed(mesh, 1, 0);
     expect_same(wide, flat, tris, rays_for(tris, test::scaled(5000), 5));
+}
+
+// ray_meets_box (the closest-hit early out on the tree's bounds) decides as the scalar slab test
+// of the binary walk (RaySlabData::clip, the same rounding model written independently), on rays
+// that touch the box exactly: aimed at its corners, edges and faces, grazing a face with a zero
+// direction component of either sign, from inside and outside, with flat boxes and far offsets;
+// and a mesh whose triangles lie on its own bounds is hit from outside at every corner and edge.
+TEST(WideRays, BoxEarlyOutDecidesAsTheSlabTest) {
+    test::Random rng(23);
+    std::size_t hits = 0, misses = 0;
+    for (std::size_t i = 0; i < test::scaled(200000, 10); ++i) {
+        const double offset = i % 3 == 0 ? 1e5 : 0.0;
+        Vec3f lo, hi;
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = float(offset + rng.uniform(-1, 1));
+            hi[a] =
+                i % 7 == std::size_t(a) ? lo[a] : float(double(lo[a]) + rng.uniform(0, 2));  // flat
+        }
+        const Aabb3f box(lo, hi);
+        Vec3f target, origin;
+        for (int a = 0; a < 3; ++a) {
+            const std::uint32_t pick = rng.below(3);  // a corner, edge or face coordinate
+            target[a] = pick == 0 ? lo[a] : pick == 1 ? hi[a] : float(rng.uniform(lo[a], hi[a]));
+            origin[a] = float(offset + rng.uniform(-4, 4));
+        }
+        Ray3f ray;
+        ray.origin = origin;
+        ray.direction = target - origin;
+        if (i % 5 == 1) {  // grazing: parallel to a face, in its plane
+            const int a = int(i % 3);
+            ray.origin[a] = rng.below(2) ? lo[a] : hi[a];
+            ray.direction[a] = rng.below(2) ? 0.0f : -0.0f;
+        }
+        if (i % 9 == 4) ray.tmax = float(rng.uniform(0, 1.5));
+        if (i % 11 == 6) ray.tmin = float(rng.uniform(0, 1));
+        if (!wide_ray_usable(ray)) continue;
+        float t0 = ray.tmin, t1 = ray.tmax;
+        const bool want = RaySlabData<float, 3>(ray).clip(box, t0, t1);
+        ASSERT_EQ(ray_meets_box(ray, box), want) << i;
+        (want ? hits : misses)++;
+    }
+    EXPECT_GT(hits, test::scaled(200000, 10) / 10);
+    EXPECT_GT(misses, test::scaled(200000, 10) / 20);
+
+    // A cube's triangles lie on its bounds: every ray from outside aimed at a corner or at an
+    // edge's midpoint, along the axes and diagonally, hits as the binary walk says.
+    TriangleMesh cube;
+    for (int v = 0; v < 8; ++v)
+        cube.vertices.push_back({v & 1 ? 1.0f : -1.0f, v & 2 ? 1.0f : -1.0f, v & 4 ? 1.0f : -1.0f});
+    // Two triangles a face; the orientation does not matter to either walk.
+    for (const auto& q : std::vector<std::array<std::uint32_t, 4>>{
+             {0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}}) {
+        cube.triangles.push_back({q[0], q[1], q[2]});
+        cube.triangles.push_back({q[0], q[2], q[3]});
+    }
+    TriangleBvhOptions binary;
+    binary.ray_layout = RayLayout::Binary;
+    const TriangleBvh<float> wide(cube), flat(cube, binary);
+    ASSERT_TRUE(wide.traces_wide());
+    std::size_t tested = 0;
+    for (int x = -1; x <= 1; ++x)
+        for (int y = -1; y <= 1; ++y)
+            for (int z = -1; z <= 1; ++z) {
+                if (x == 0 && y == 0 && z == 0) continue;
+                const Vec3f target{float(x), float(y), float(z)};
+                for (const Vec3f& from : {target * 3.0f, target + Vec3f{3, 0, 0},
+                                          target + Vec3f{0, -3, 0}, target + Vec3f{0, 0, 3}}) {
+                    const Ray3f ray(from, target - from);
+                    const Hit<float> a = wide.closest_hit(ray), b = flat.closest_hit(ray);
+                    ASSERT_EQ(bool(a), bool(b)) << x << y << z;
+                    if (a) {
+                        ASSERT_EQ(a.t, b.t);
+                    }
+                    ++tested;
+                }
+            }
+    EXPECT_EQ(tested, 26u * 4u);
 }
 
 // A NaN or infinite vertex in a triangle of the tree makes refit an Error for every layout, and

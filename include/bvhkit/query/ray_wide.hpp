@@ -467,6 +467,37 @@ bool any_hit_wide(const WideRayBvh<W>& tree, Ray<float, 3> ray, const Watertight
 }
 #endif
 
+#if defined(__SSE2__)
+/// Whether `ray` (one wide_ray_usable accepts) can meet `box` in [tmin, tmax], by the walk's own
+/// slab test and rounding (SlabConstants): a box inside this one gives an interval inside this
+/// one's, so a miss here is a miss of everything in it. A ray that misses a mesh's bounds (most
+/// camera rays around a model) then costs this test and no set-up of the walk: the watertight
+/// ray, the slab constants and the stack took more than half of such a ray's time.
+inline bool ray_meets_box(const Ray<float, 3>& ray, const Aabb<float, 3>& box) {
+    constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
+    const float inf = std::numeric_limits<float>::infinity();
+    // The fourth lane goes from 0 along 1 through [-inf, inf]: it restricts nothing.
+    const __m128 o = _mm_setr_ps(ray.origin[0], ray.origin[1], ray.origin[2], 0.0f);
+    const __m128 d = _mm_setr_ps(ray.direction[0], ray.direction[1], ray.direction[2], 1.0f);
+    const __m128 lo = _mm_setr_ps(box.min[0], box.min[1], box.min[2], -inf);
+    const __m128 hi = _mm_setr_ps(box.max[0], box.max[1], box.max[2], inf);
+    const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), d);
+    // -0 counts as negative, as in SlabConstants: the near plane is then the box's max.
+    const __m128 negative = _mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(d), 31));
+    const __m128 near = _mm_or_ps(_mm_and_ps(negative, hi), _mm_andnot_ps(negative, lo));
+    const __m128 far = _mm_or_ps(_mm_and_ps(negative, lo), _mm_andnot_ps(negative, hi));
+    // As in the walk, maxps/minps keep their second operand when the first is NaN (0 * inf).
+    __m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, o), inv), _mm_set1_ps(ray.tmin));
+    __m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, o), _mm_mul_ps(inv, _mm_set1_ps(s))),
+                           _mm_set1_ps(ray.tmax));
+    t0 = _mm_max_ps(t0, _mm_shuffle_ps(t0, t0, _MM_SHUFFLE(1, 0, 3, 2)));
+    t0 = _mm_max_ps(t0, _mm_shuffle_ps(t0, t0, _MM_SHUFFLE(2, 3, 0, 1)));
+    t1 = _mm_min_ps(t1, _mm_shuffle_ps(t1, t1, _MM_SHUFFLE(1, 0, 3, 2)));
+    t1 = _mm_min_ps(t1, _mm_shuffle_ps(t1, t1, _MM_SHUFFLE(2, 3, 0, 1)));
+    return _mm_comile_ss(t0, t1);
+}
+#endif
+
 /// Whether the wide walk serves `ray`: traceable, and no direction component subnormal (whose
 /// reciprocal the slab test would ignore, letting the ray into empty lanes).
 inline bool wide_ray_usable(const Ray<float, 3>& ray) {
