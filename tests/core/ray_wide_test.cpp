@@ -178,6 +178,43 @@ TEST(WideRays, RefitKeepsTheWideLayoutInStep) {
     expect_same(wide, flat, tris, rays_for(tris, test::scaled(5000), 5));
 }
 
+// wide_ray_usable against its definition, written here per component: origin and direction
+// finite, tmin <= tmax, some direction component non-zero, none subnormal; over every mix of the
+// special values.
+TEST(WideRays, UsableRaysAreTheDefinitionsOnes) {
+    const float inf = std::numeric_limits<float>::infinity();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float least = std::numeric_limits<float>::min();
+    const std::vector<float> values{0.0f,   -0.0f,   1.0f,  -2.5f, least, -least,
+                                    1e-40f, -1e-45f, 3e38f, -inf,  inf,   nan};
+    const auto reference = [](const Ray3f& r) {
+        bool finite = r.tmin <= r.tmax, moves = false, subnormal = false;
+        for (int a = 0; a < 3; ++a) {
+            finite = finite && std::isfinite(r.origin[a]) && std::isfinite(r.direction[a]);
+            moves = moves || r.direction[a] != 0.0f;
+            subnormal = subnormal || std::fpclassify(r.direction[a]) == FP_SUBNORMAL;
+        }
+        return finite && moves && !subnormal;
+    };
+    std::size_t usable = 0, tested = 0;
+    for (const float a : values)
+        for (const float b : values)
+            for (const float c : values)
+                for (int k = 0; k < 4; ++k) {
+                    Ray3f r;
+                    r.direction = {a, b, c};
+                    r.origin = {1.0f, -2.0f, 3.0f};
+                    if (k == 1) r.origin = {c, 0.5f, a};  // the special values in the origin
+                    if (k == 2) r.tmin = 2.0f, r.tmax = 1.0f;
+                    if (k == 3) r.tmin = nan;
+                    ASSERT_EQ(wide_ray_usable(r), reference(r))
+                        << a << " " << b << " " << c << " " << k;
+                    usable += reference(r);
+                    ++tested;
+                }
+    EXPECT_GT(usable, tested / 20);
+}
+
 // ray_meets_box (the closest-hit early out on the tree's bounds) decides as the scalar slab test
 // of the binary walk (RaySlabData::clip, the same rounding model written independently), on rays
 // that touch the box exactly: aimed at its corners, edges and faces, grazing a face with a zero

@@ -501,10 +501,28 @@ inline bool ray_meets_box(const Ray<float, 3>& ray, const Aabb<float, 3>& box) {
 /// Whether the wide walk serves `ray`: traceable, and no direction component subnormal (whose
 /// reciprocal the slab test would ignore, letting the ray into empty lanes).
 inline bool wide_ray_usable(const Ray<float, 3>& ray) {
+#if defined(__SSE2__)
+    // The same tests on all components at once (a fifth of a camera ray's instructions when
+    // written per component): |x| < inf is false for NaN and inf; a direction component is
+    // 0 or at least the least normal float; at least one is not 0.
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    const __m128 o =
+        _mm_andnot_ps(sign, _mm_setr_ps(ray.origin[0], ray.origin[1], ray.origin[2], 0));
+    const __m128 d =
+        _mm_andnot_ps(sign, _mm_setr_ps(ray.direction[0], ray.direction[1], ray.direction[2], 0));
+    const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    const __m128 zero = _mm_setzero_ps();
+    const int finite = _mm_movemask_ps(_mm_and_ps(_mm_cmplt_ps(o, inf), _mm_cmplt_ps(d, inf)));
+    const int normal = _mm_movemask_ps(_mm_or_ps(
+        _mm_cmpeq_ps(d, zero), _mm_cmpge_ps(d, _mm_set1_ps(std::numeric_limits<float>::min()))));
+    const int moves = _mm_movemask_ps(_mm_cmpgt_ps(d, zero));
+    return (finite & normal) == 15 && moves != 0 && ray.tmin <= ray.tmax;
+#else
     if (!is_traceable(ray)) return false;
     for (int a = 0; a < 3; ++a)
         if (std::fpclassify(ray.direction[a]) == FP_SUBNORMAL) return false;
     return true;
+#endif
 }
 
 }  // namespace bvhkit
