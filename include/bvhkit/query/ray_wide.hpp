@@ -322,9 +322,8 @@ template <class OnLeaf, class Stats>
 
 /// The walk of `tree` for `ray`.
 template <int W, class OnLeaf, class Stats>
-void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, OnLeaf&& on_leaf,
-                       Stats& stats) {
-    const SlabConstants k(ray);
+void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, const SlabConstants& k,
+                       OnLeaf&& on_leaf, Stats& stats) {
     WideStack<W> stack;
     if constexpr (W == 4) {
         walk4(tree, ray, k, stack, on_leaf, stats);
@@ -442,27 +441,33 @@ struct AnyLeaves {
 /// misses); hit_group is null on a miss. The ray must be one wide_ray_usable accepts, and an
 /// eight-wide tree needs cpu_has_avx2().
 template <int W, class Stats = NoStats>
-bool closest_hit_wide(const WideRayBvh<W>& tree, Ray<float, 3> ray,
+bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
                       const WatertightRay<float>& prep, TriangleHit<float>& best,
                       const TriangleGroup4*& hit_group, int& hit_lane, Stats&& stats = {}) {
+    // The slab constants from the caller's ray, before the copy the walk narrows: read from the
+    // copy, its direction straddled the two stores that wrote it (a store-forwarding stall).
+    const detail::SlabConstants k(ray_in);
+    Ray<float, 3> ray = ray_in;
     hit_group = nullptr;
     hit_lane = 0;
     const WatertightRay4 r4(prep);
     detail::ClosestLeaves<std::remove_reference_t<Stats>> leaves{
         tree.groups.data(), r4, ray, best, hit_group, hit_lane, stats};
-    detail::traverse_wide_ray(tree, ray, leaves, stats);
+    detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return hit_group != nullptr;
 }
 
 /// Any hit through a wide tree (same conditions as closest_hit_wide).
 template <int W, class Stats = NoStats>
-bool any_hit_wide(const WideRayBvh<W>& tree, Ray<float, 3> ray, const WatertightRay<float>& prep,
-                  Stats&& stats = {}) {
+bool any_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
+                  const WatertightRay<float>& prep, Stats&& stats = {}) {
+    const detail::SlabConstants k(ray_in);
+    Ray<float, 3> ray = ray_in;
     const WatertightRay4 r4(prep);
     bool found = false;
     detail::AnyLeaves<std::remove_reference_t<Stats>> leaves{tree.groups.data(), r4, ray, found,
                                                              stats};
-    detail::traverse_wide_ray(tree, ray, leaves, stats);
+    detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return found;
 }
 #endif
