@@ -36,7 +36,15 @@ namespace bvhkit {
 template <class T, std::size_t N, class OnLeaf, class Stats = NoStats>
 void traverse_ray(BvhView<Aabb<T, N>> bvh, Ray<T, N>& ray, OnLeaf&& on_leaf, Stats&& stats = {}) {
     if (bvh.empty() || !is_traceable(ray)) return;
-    const RaySlabData<T, N> slab(ray);
+    traverse_ray(bvh, ray, RaySlabData<T, N>(ray), on_leaf, stats);
+}
+/// The same with the slab data made by the caller, from a ray not yet traceable-checked by this
+/// call: closest_hit and the others make it from their caller's ray before copying that ray for
+/// the walk to narrow (read from the fresh copy, the direction straddled the two stores that
+/// wrote it: a store-forwarding stall on every ray).
+template <class T, std::size_t N, class OnLeaf, class Stats>
+void traverse_ray(BvhView<Aabb<T, N>> bvh, Ray<T, N>& ray, const RaySlabData<T, N>& slab,
+                  OnLeaf&& on_leaf, Stats&& stats) {
     struct Entry {
         std::uint32_t node;
         T t_entry;
@@ -110,7 +118,11 @@ Hit<T, N> make_hit(const Test& test, std::uint32_t slot, std::uint32_t primitive
 }  // namespace detail
 
 template <class T, std::size_t N, class Test, class Stats = NoStats>
-Hit<T, N> closest_hit(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, Stats&& stats = {}) {
+Hit<T, N> closest_hit(BvhView<Aabb<T, N>> bvh, const Ray<T, N>& ray_in, Test&& test,
+                      Stats&& stats = {}) {
+    if (bvh.empty() || !is_traceable(ray_in)) return Hit<T, N>{};
+    const RaySlabData<T, N> slab(ray_in);
+    Ray<T, N> ray = ray_in;
     // The test's output is a local of the leaf loop, which the compiler keeps in registers; the
     // best hit is copied out only on a hit (3.5% on R1 against one record shared by reference).
     struct Best {
@@ -118,7 +130,7 @@ Hit<T, N> closest_hit(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, Stats
         std::uint32_t slot = invalid_index;
     } best;
     traverse_ray(
-        bvh, ray,
+        bvh, ray, slab,
         [&](const auto& leaf) {
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
@@ -138,10 +150,13 @@ Hit<T, N> closest_hit(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, Stats
 
 /// Any hit (occlusion): true as soon as some primitive is hit within [tmin, tmax].
 template <class T, std::size_t N, class Test, class Stats = NoStats>
-bool any_hit(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, Stats&& stats = {}) {
+bool any_hit(BvhView<Aabb<T, N>> bvh, const Ray<T, N>& ray_in, Test&& test, Stats&& stats = {}) {
+    if (bvh.empty() || !is_traceable(ray_in)) return false;
+    const RaySlabData<T, N> slab(ray_in);
+    Ray<T, N> ray = ray_in;
     bool found = false;
     traverse_ray(
-        bvh, ray,
+        bvh, ray, slab,
         [&](const auto& leaf) {
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
@@ -157,11 +172,14 @@ bool any_hit(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, Stats&& stats 
 /// All hits within [tmin, tmax], in no particular order: on_hit(const Hit<T, N>&) returns true to
 /// go on, false to stop.
 template <class T, std::size_t N, class Test, class OnHit, class Stats = NoStats>
-void all_hits(BvhView<Aabb<T, N>> bvh, Ray<T, N> ray, Test&& test, OnHit&& on_hit,
+void all_hits(BvhView<Aabb<T, N>> bvh, const Ray<T, N>& ray_in, Test&& test, OnHit&& on_hit,
               Stats&& stats = {}) {
+    if (bvh.empty() || !is_traceable(ray_in)) return;
+    const RaySlabData<T, N> slab(ray_in);
+    Ray<T, N> ray = ray_in;
     TriangleHit<T> h;
     traverse_ray(
-        bvh, ray,
+        bvh, ray, slab,
         [&](const auto& leaf) {
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
