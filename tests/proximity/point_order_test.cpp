@@ -31,31 +31,40 @@ std::uint64_t reference_key(const Vec3f& p, const Vec3f& lo, const Vec3f& hi) {
     return key;
 }
 
-void expect_order(const std::vector<Vec3f>& points, unsigned threads) {
+// Each run of `run` points (the last may be shorter) is a permutation of its own indices, its
+// finite points in the order of their key over the run's box, then its non-finite ones.
+void expect_order(const std::vector<Vec3f>& points, unsigned threads,
+                  std::size_t run = spatial_order_run) {
     const std::vector<std::uint32_t> order =
-        spatial_order(std::span<const Vec3f>(points), Executor(threads));
+        spatial_order(std::span<const Vec3f>(points), Executor(threads), run);
     ASSERT_EQ(order.size(), points.size());
-    std::vector<char> seen(points.size(), 0);
-    for (std::uint32_t i : order) {
-        ASSERT_LT(i, points.size());
-        ASSERT_FALSE(seen[i]) << "index " << i << " twice";
-        seen[i] = 1;
-    }
-    Vec3f lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
-    for (const Vec3f& p : points)
-        if (is_finite(p)) lo = min(lo, p), hi = max(hi, p);
-    bool finite_part = true;
-    for (std::size_t k = 0; k < order.size(); ++k) {
-        const Vec3f& p = points[order[k]];
-        if (!is_finite(p)) {
-            finite_part = false;
-            continue;
+    for (std::size_t first = 0; first < points.size(); first += run) {
+        const std::size_t end = std::min(points.size(), first + run);
+        std::vector<char> seen(points.size(), 0);
+        for (std::size_t k = first; k < end; ++k) {
+            const std::uint32_t i = order[k];
+            ASSERT_GE(i, first);
+            ASSERT_LT(i, end);
+            ASSERT_FALSE(seen[i]) << "index " << i << " twice";
+            seen[i] = 1;
         }
-        ASSERT_TRUE(finite_part) << "a finite point after a non-finite one, at " << k;
-        if (k == 0 || !is_finite(points[order[k - 1]])) continue;
-        const std::uint64_t a = reference_key(points[order[k - 1]], lo, hi);
-        const std::uint64_t b = reference_key(p, lo, hi);
-        ASSERT_TRUE(a < b || (a == b && order[k - 1] < order[k])) << "at " << k;
+        Vec3f lo(std::numeric_limits<float>::infinity());
+        Vec3f hi(-std::numeric_limits<float>::infinity());
+        for (std::size_t i = first; i < end; ++i)
+            if (is_finite(points[i])) lo = min(lo, points[i]), hi = max(hi, points[i]);
+        bool finite_part = true;
+        for (std::size_t k = first; k < end; ++k) {
+            const Vec3f& p = points[order[k]];
+            if (!is_finite(p)) {
+                finite_part = false;
+                continue;
+            }
+            ASSERT_TRUE(finite_part) << "a finite point after a non-finite one, at " << k;
+            if (k == first || !is_finite(points[order[k - 1]])) continue;
+            const std::uint64_t a = reference_key(points[order[k - 1]], lo, hi);
+            const std::uint64_t b = reference_key(p, lo, hi);
+            ASSERT_TRUE(a < b || (a == b && order[k - 1] < order[k])) << "at " << k;
+        }
     }
 }
 
@@ -82,6 +91,9 @@ TEST(SpatialOrder, IsTheMortonOrderOfTheBatch) {
         set->push_back({0, inf, 0});
         set->push_back({0, 0, -inf});
         for (unsigned threads : {1u, 0u}) expect_order(*set, threads);
+        // Runs shorter than the batch, as a batch past spatial_order_run points is sorted.
+        expect_order(*set, 0, 1000);
+        expect_order(*set, 1, 7);
     }
     expect_order({}, 1);
     expect_order({{nan, nan, nan}}, 1);
