@@ -38,10 +38,10 @@ void traverse_ray(BvhView<Aabb<T, N>> bvh, Ray<T, N>& ray, OnLeaf&& on_leaf, Sta
     if (bvh.empty() || !is_traceable(ray)) return;
     traverse_ray(bvh, ray, RaySlabData<T, N>(ray), on_leaf, stats);
 }
-/// The same with the slab data made by the caller, from a ray not yet traceable-checked by this
-/// call: closest_hit and the others make it from their caller's ray before copying that ray for
-/// the walk to narrow (read from the fresh copy, the direction straddled the two stores that
-/// wrote it: a store-forwarding stall on every ray).
+/// The same with the slab data made by the caller from `ray`, for a tree that is not empty and a
+/// traceable ray (the caller checks both). closest_hit and the others make it from their caller's
+/// ray before copying that ray for the walk to narrow: read from the fresh copy, the direction
+/// straddled the two stores that wrote it, a store-forwarding stall on every ray.
 template <class T, std::size_t N, class OnLeaf, class Stats>
 void traverse_ray(BvhView<Aabb<T, N>> bvh, Ray<T, N>& ray, const RaySlabData<T, N>& slab,
                   OnLeaf&& on_leaf, Stats&& stats) {
