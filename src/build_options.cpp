@@ -96,6 +96,8 @@ void validate_options(const BuildOptions& o) {
         bad_option("costs.traversal", u(o.costs.traversal), "finite and >= 0");
     if (!std::isfinite(o.costs.intersection) || !(o.costs.intersection > 0))
         bad_option("costs.intersection", u(o.costs.intersection), "finite and > 0");
+    if (o.costs.leaf_block > 64)
+        bad_option("costs.leaf_block", u(o.costs.leaf_block), "0..64 (0: the tree's choice)");
     if (o.ploc_radius < 1 || o.ploc_radius > max_ploc_radius)
         bad_option("ploc_radius", u(o.ploc_radius), ("1.." + u(max_ploc_radius)).c_str());
 }

@@ -72,6 +72,9 @@ TEST_P(SharedMeshes, EveryBuilderValidatesAndMatchesBruteForceInDouble) {
 }
 INSTANTIATE_TEST_SUITE_P(Meshes, SharedMeshes, ::testing::ValuesIn(kMeshes), test::MeshFileName{});
 
+// The full sweep considers every split binning does, so at each node its greedy choice is no worse;
+// over the whole tree that is no theorem (teapot, leaves in blocks of four: 19.04 against 19.01),
+// hence the half per cent.
 TEST(SharedMeshesQuality, SweepSahCostIsNoWorseThanBinnedOnEveryMesh) {
     for (const char* name : kMeshes) {
         const auto path = test::shared_mesh(name);
@@ -79,10 +82,15 @@ TEST(SharedMeshesQuality, SweepSahCostIsNoWorseThanBinnedOnEveryMesh) {
         const TriangleMesh mesh = read_mesh(path);
         BuildOptions sweep;
         sweep.builder = Builder::SweepSah;
-        const double binned_cost = statistics(TriangleBvh<float>(mesh).bvh()).sah_cost;
-        const double sweep_cost = statistics(TriangleBvh<float>(mesh, sweep).bvh()).sah_cost;
+        // Both built with the leaf blocks of the wide layout (when this CPU runs it) and costed
+        // with them.
+        const TriangleBvh<float> binned_tree(mesh), sweep_tree(mesh, sweep);
+        SahCosts costs;
+        costs.leaf_block = binned_tree.ray_width() > 2 ? 4 : 1;
+        const double binned_cost = statistics(binned_tree.bvh(), costs).sah_cost;
+        const double sweep_cost = statistics(sweep_tree.bvh(), costs).sah_cost;
         std::printf("%-20s SAH cost: binned %.3f, sweep %.3f\n", name, binned_cost, sweep_cost);
-        EXPECT_LE(sweep_cost, binned_cost) << name;
+        EXPECT_LE(sweep_cost, binned_cost * 1.005) << name;
     }
 }
 

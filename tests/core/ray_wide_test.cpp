@@ -79,6 +79,7 @@ void expect_same(const TriangleBvh<float>& wide, const TriangleBvh<float>& binar
     for (std::size_t r = 0; r < rays.size(); ++r) {
         const Hit<float> a = wide.closest_hit(rays[r]), b = binary.closest_hit(rays[r]);
         ASSERT_EQ(bool(a), bool(b)) << "ray " << r;
+        hits += bool(a);
         if (a.primitive != b.primitive) {
             ++ties;
             ASSERT_TRUE(same_bits(a.t, b.t)) << "ray " << r << ": t " << a.t << " vs " << b.t;
@@ -91,7 +92,6 @@ void expect_same(const TriangleBvh<float>& wide, const TriangleBvh<float>& binar
             << "ray " << r << ": t " << a.t << " vs " << b.t;
         ASSERT_EQ(a.normal, b.normal) << "ray " << r;
         ASSERT_EQ(wide.any_hit(rays[r]), binary.any_hit(rays[r])) << "ray " << r;
-        hits += bool(a);
     }
     // Enough hits and misses for the comparison to mean something.
     EXPECT_GT(hits, rays.size() / 20);

@@ -56,7 +56,7 @@ TEST(MappedTriangleBvh, ResidentMemoryDoesNotGrowByTheTreesSize) {
         save(tree, file.path);
     }
     const std::size_t size = std::filesystem::file_size(file.path);
-    ASSERT_GT(size, std::size_t(20) << 20);
+    ASSERT_GT(size, std::size_t(12) << 20);  // large against the noise of the process's own memory
     const auto rays = random_rays<float>(2000, Aabb3f({-2, -2, -2}, {2, 2, 2}), 5);
 
     const std::size_t before = *status_bytes("RssAnon");

@@ -3,20 +3,21 @@
 // the centroids are dropped into equal bins along each axis, and the SAH is evaluated only at the
 // bin boundaries, with one sweep from each side. Linear in the node's size per axis. As in Embree,
 // smaller nodes get fewer bins (4 + n / 20, up to bin_count): the sweep over bins is a per-node
-// cost that would otherwise dominate the many small nodes. A node no larger than 8 primitives goes
-// to the full sweep instead, which is exact and, that small, cheaper.
+// cost that would otherwise dominate the many small nodes. (Nodes of up to 8 primitives once went
+// to the exact full sweep instead: on bunny and igea the SAH cost came out within 0.01% of four
+// bins', and the build took 15-20% longer.)
 //
 // A large node (parallel_binning_from primitives) bins in chunks on several threads when the
 // driver's executor allows, each chunk into its own bins, merged afterwards; box unions and
 // counts are exact in any order, so the split is the same as binned serially.
-#include "bvhkit/build/sweep_sah.hpp"
+#include "bvhkit/build/sah.hpp"
+#include "bvhkit/build/top_down_core.hpp"
 
 namespace bvhkit {
 
 template <class T, std::size_t N>
 class BinnedSahRule {
   public:
-    static constexpr std::uint32_t sweep_below = 8;
     static constexpr std::size_t parallel_binning_from = 1u << 15;
     static constexpr std::size_t binning_chunk = 8192;
 
@@ -24,13 +25,12 @@ class BinnedSahRule {
         : in_(in),
           costs_(options.costs),
           max_bins_(std::clamp<std::uint32_t>(options.bin_count, 2, 256)),
-          bins_(N * max_bins_),
-          right_area_(max_bins_),
-          small_nodes_(in, options) {}
+          bins_(2 * N * max_bins_),
+          right_area_(max_bins_) {}
 
     Split<T> operator()(const SplitTask<T, N>& task, const Executor& exec) {
         const auto count = static_cast<std::uint32_t>(task.indices.size());
-        if (count <= sweep_below) return small_nodes_(task, exec);
+        if (sah_leaf_certain(costs_, count)) return Split<T>::leaf();
         const std::uint32_t bin_count = std::min(max_bins_, 4 + count / 20);
         const Aabb<T, N>& cb = task.centroid_bounds;
         T scale[N];
@@ -45,16 +45,16 @@ class BinnedSahRule {
         const std::size_t row = N * bin_count;
         if (exec.is_parallel() && count >= parallel_binning_from) {
             const std::size_t chunks = (count + binning_chunk - 1) / binning_chunk;
-            if (chunk_bins_.size() < chunks * row) chunk_bins_.resize(chunks * row);
+            if (chunk_bins_.size() < chunks * 2 * row) chunk_bins_.resize(chunks * 2 * row);
             exec.parallel_for(count, binning_chunk, [&](std::size_t b, std::size_t e) {
                 bin_range(task.indices.subspan(b, e - b), mapping,
-                          &chunk_bins_[b / binning_chunk * row]);
+                          &chunk_bins_[b / binning_chunk * 2 * row]);
             });
             std::fill_n(bins_.begin(), row, Bin{});
             for (std::size_t c = 0; c < chunks; ++c)
                 for (std::size_t k = 0; k < row; ++k) {
-                    bins_[k].bounds.grow(chunk_bins_[c * row + k].bounds);
-                    bins_[k].count += chunk_bins_[c * row + k].count;
+                    bins_[k].bounds.grow(chunk_bins_[c * 2 * row + k].bounds);
+                    bins_[k].count += chunk_bins_[c * 2 * row + k].count;
                 }
         } else {
             bin_range(task.indices, mapping, bins_.data());
@@ -76,7 +76,7 @@ class BinnedSahRule {
                 acc.grow(bins[b].bounds);
                 left_count += bins[b].count;
                 if (left_count == 0 || left_count == count) continue;
-                const T cost = sah_partial_cost(acc.area(), left_count, right_area_[b + 1],
+                const T cost = sah_partial_cost(costs_, acc.area(), left_count, right_area_[b + 1],
                                                 count - left_count);
                 if (cost < best_cost) {
                     best_cost = cost;
@@ -136,29 +136,46 @@ class BinnedSahRule {
         std::uint32_t count = 0;
     };
 
-    /// Resets the N rows of `mapping.count` bins at `out` and bins the primitives of `indices`.
+    /// Bins the primitives of `indices` into the N rows of `mapping.count` bins at `out`, using
+    /// as many more after them as scratch. Every other primitive goes to the scratch rows, merged
+    /// at the end: one set alone makes a chain of loads and stores through the same bin whenever
+    /// neighbouring primitives share one, as they mostly do (the build measured 3-5% faster).
     void bin_range(std::span<const std::uint32_t> indices, const BinMapping& mapping,
                    Bin* out) const {
-        const std::uint32_t bin_count = mapping.count;
-        std::fill_n(out, N * bin_count, Bin{});
-        for (std::uint32_t i : indices) {
+        const std::size_t row = N * mapping.count;
+        Bin* const odd = out + row;
+        std::fill_n(out, 2 * row, Bin{});
+        // Local copies: through `this` they would be reloaded after every count written.
+        const Aabb<T, N>* const boxes = in_.boxes.data();
+        const Vec<T, N>* const centroids = in_.centroids.data();
+        const BinMapping m = mapping;
+        const auto add = [&](std::uint32_t i, Bin* rows) {
             std::uint32_t bin[N];
-            mapping.bins(in_.centroids[i], bin);
+            m.bins(centroids[i], bin);
             for (std::size_t a = 0; a < N; ++a) {
-                Bin& b = out[a * bin_count + bin[a]];
-                b.bounds.grow(in_.boxes[i]);
+                Bin& b = rows[a * m.count + bin[a]];
+                b.bounds.grow(boxes[i]);
                 ++b.count;
             }
+        };
+        std::size_t k = 0;
+        for (; k + 1 < indices.size(); k += 2) {
+            add(indices[k], out);
+            add(indices[k + 1], odd);
+        }
+        if (k < indices.size()) add(indices[k], out);
+        for (std::size_t b = 0; b < row; ++b) {
+            out[b].bounds.grow(odd[b].bounds);
+            out[b].count += odd[b].count;
         }
     }
 
     BuildInput<T, N> in_;
     SahCosts costs_;
     std::uint32_t max_bins_;
-    std::vector<Bin> bins_;        // N rows of bins, reused for every node
-    std::vector<Bin> chunk_bins_;  // N rows per chunk of a node binned in parallel
+    std::vector<Bin> bins_;        // 2N rows of bins (bin_range's), reused for every node
+    std::vector<Bin> chunk_bins_;  // 2N rows per chunk of a node binned in parallel
     std::vector<T> right_area_;
-    SweepSahRule<T, N> small_nodes_;
 };
 
 }  // namespace bvhkit

@@ -47,6 +47,18 @@ class BoxAccumulator<float, 3> {
         lo_ = _mm_min_ps(lo_, v);
         hi_ = _mm_max_ps(hi_, _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 1, 0, 0)));
     }
+    /// Branch-free choice of accumulator: `skip` is 0 in every lane to grow, +inf to leave the
+    /// box as it is (a finite coordinate plus inf is inf, which min ignores; minus inf, max).
+    void grow(const Aabb3f& b, __m128 skip) {
+        const float* p = &b.min[0];
+        lo_ = _mm_min_ps(lo_, _mm_add_ps(_mm_loadu_ps(p), skip));
+        hi_ = _mm_max_ps(hi_, _mm_sub_ps(_mm_loadu_ps(p + 2), skip));
+    }
+    void grow_point(const Vec3f& p, __m128 skip) {
+        const __m128 v = load(p);
+        lo_ = _mm_min_ps(lo_, _mm_add_ps(v, skip));
+        hi_ = _mm_max_ps(hi_, _mm_sub_ps(_mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 1, 0, 0)), skip));
+    }
     /// (x, y, z, 0) without reading past the 12 bytes of the vector.
     static __m128 load(const Vec3f& p) {
         // 8 bytes for x, y (__m64 may alias anything) and 4 for z; no store-forwarding stall.

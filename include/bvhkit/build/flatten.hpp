@@ -99,7 +99,8 @@ SubtreeMeasures<T, N> measure_subtrees(const BinaryTree& tree, std::span<const A
                 b.grow(boxes[tree.order[s]]);
             m.box[v] = b;
             m.prims[v] = tree.count[v];
-            cost[v] = options.costs.intersection * m.prims[v] * double(b.area());
+            cost[v] = options.costs.intersection * options.costs.leaf_tests(m.prims[v]) *
+                      double(b.area());
             m.collapse[v] = 1;
             continue;
         }
@@ -109,7 +110,8 @@ SubtreeMeasures<T, N> measure_subtrees(const BinaryTree& tree, std::span<const A
         m.prims[v] = m.prims[l] + m.prims[r];
         const double area = double(m.box[v].area());
         const double split = options.costs.traversal * area + cost[l] + cost[r];
-        const double leaf = options.costs.intersection * m.prims[v] * area;
+        const double leaf =
+            options.costs.intersection * options.costs.leaf_tests(m.prims[v]) * area;
         if (m.prims[v] <= options.max_leaf_size && leaf <= split) {
             m.collapse[v] = 1;
             cost[v] = leaf;

@@ -22,6 +22,7 @@ class SweepSahRule {
 
     Split<T> operator()(const SplitTask<T, N>& task, const Executor& exec) {
         const auto count = static_cast<std::uint32_t>(task.indices.size());
+        if (sah_leaf_certain(costs_, count)) return Split<T>::leaf();
         AxisBest best[N];
         if (exec.is_parallel() && count >= parallel_axes_from) {
             if (order_.size() < N * count) {
@@ -80,7 +81,7 @@ class SweepSahRule {
         acc = BoxAccumulator<T, N>();
         for (std::uint32_t k = 1; k < count; ++k) {  // left = [0, k)
             acc.grow(in_.boxes[order[k - 1].second]);
-            const T cost = sah_partial_cost(acc.area(), k, right_area[k], count - k);
+            const T cost = sah_partial_cost(costs_, acc.area(), k, right_area[k], count - k);
             if (cost < best.cost) best = {cost, k};
         }
         return best;
