@@ -71,7 +71,7 @@ template <int W, class TriangleAtSlot, class IndexAtSlot>
 WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&& triangle_at_slot,
                                 IndexAtSlot&& index_at_slot) {
     WideRayBvh<W> out;
-    // Every node's lanes filled (collapse_to_wide's fill_lanes), and a lane of up to 24
+    // Every node's lanes filled (collapse_to_wide's fill_lanes), and a lane of up to leaf_limit
     // triangles not opened further is a leaf child. Against leaf limit 8 without filling (3.7
     // lanes an eight-wide node on igea, 16k nodes, 4.2 MB), 1M random rays, closest hit, against
     // Embree 3 in the same run: eight wide, igea 0.72-0.81x -> 0.88-0.97x, bunny 0.69x ->
@@ -79,7 +79,14 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
     // (occlusion 0.74-0.78x -> 0.91-1.04x), bunny, spot and dragon within noise. Leaf limits 16-32
     // measured within noise of 24. (Four wide without filling, leaf limit 2 / 4 / 8 / 16, ms: igea
     // 861 / 736 / 637 / 583, spot 296 (4) / 268 (8) / 273 (16); the binary walk 853 and 380.)
-    const WideBvh<float, W> wide = collapse_to_wide<float, W>(bvh, 24, true);
+    // Eight wide, leaves in blocks of four (2026-11-26, 1M random rays, one thread): leaf limit
+    // 24 / 48 / 64, closest hit, ms: the 1.3M-triangle displaced sphere 586 / 456-489 / 458,
+    // bunny 141-143 / 141-143 / 144-146, igea 246 / 241-247 / 244-250; R1 and occlusion within
+    // noise on bunny and igea, the sphere's occlusion 517 / 384-407. Once the tree outgrows the
+    // caches, a node costs more than the groups of a larger leaf, which lie side by side. Four
+    // wide, 48 was mixed (bunny 5% faster, the sphere 6% slower): it keeps 24.
+    constexpr std::uint32_t leaf_limit = W == 8 ? 48 : 24;
+    const WideBvh<float, W> wide = collapse_to_wide<float, W>(bvh, leaf_limit, true);
     out.nodes.resize(wide.nodes.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
     for (std::size_t i = 0; i < wide.nodes.size(); ++i) {
