@@ -82,12 +82,44 @@ TEST(SahBlocks, NodesOfOneBlockAreLeavesAndLargerOnesStillSplit) {
         EXPECT_LE(s.leaf_size_histogram.size(), 9u);  // max_leaf_size 8
         // Leaves of two blocks exist: the SAH keeps some five to eight whole.
         EXPECT_GT(leaves_past_block, 0u);
-        // The same input with cheaper traversal may split one block again: the shortcut is off.
+        // The same input with cheaper traversal splits nodes of one block again where the SAH
+        // says so: the shortcut is off.
         o.costs.traversal = 0.25;
         const auto cheap = build_bvh<float, 3>(in.boxes, in.centroids, o);
         validate(cheap, in.boxes);
-        EXPECT_GT(cheap.nodes.size(), bvh.nodes.size());
+        const auto under_cheap = [&](auto&& self, std::uint32_t i) -> std::uint32_t {
+            const auto& n = cheap.nodes[i];
+            return n.is_leaf() ? n.count : self(self, n.left()) + self(self, n.right());
+        };
+        std::size_t cheap_small_inner = 0;
+        for (std::uint32_t i = 0; i < cheap.nodes.size(); ++i)
+            cheap_small_inner += !cheap.nodes[i].is_leaf() && under_cheap(under_cheap, i) <= 4;
+        EXPECT_GT(cheap_small_inner, 0u);
     }
+}
+
+// A flat node (zero area) keeps the SAH's rule for flat nodes: it splits, blocks or not.
+TEST(SahBlocks, FlatNodesOfOneBlockStillSplit) {
+    Input in;
+    for (int k = 0; k < 4; ++k) {  // four collinear segments along x
+        const float x = float(2 * k);
+        in.boxes.push_back(Aabb3f({x, 0, 0}, {x + 1, 0, 0}));
+        in.centroids.push_back({x + 0.5f, 0, 0});
+    }
+    for (auto builder : {Builder::BinnedSah, Builder::SweepSah}) {
+        SCOPED_TRACE(to_string(builder));
+        BuildOptions o;
+        o.builder = builder;
+        o.costs.leaf_block = 4;
+        const auto bvh = build_bvh<float, 3>(in.boxes, in.centroids, o);
+        validate(bvh, in.boxes);
+        EXPECT_GT(bvh.nodes.size(), 1u);
+    }
+    SahCosts huge;
+    huge.leaf_block = 64;
+    EXPECT_EQ(huge.leaf_tests(0xFFFFFFFEu), 0x4000000u);  // no overflow near 2^32
+    EXPECT_EQ(huge.leaf_tests(0xFFFFFFFFu), 0x4000000u);
+    EXPECT_EQ(huge.leaf_tests(65), 2u);
 }
 
 TEST(SahBlocks, TriangleBvhPricesLeavesByItsLayout) {

@@ -30,7 +30,7 @@ class BinnedSahRule {
 
     Split<T> operator()(const SplitTask<T, N>& task, const Executor& exec) {
         const auto count = static_cast<std::uint32_t>(task.indices.size());
-        if (sah_leaf_certain(costs_, count)) return Split<T>::leaf();
+        if (sah_leaf_certain(costs_, count, task.bounds.area())) return Split<T>::leaf();
         const std::uint32_t bin_count = std::min(max_bins_, 4 + count / 20);
         const Aabb<T, N>& cb = task.centroid_bounds;
         T scale[N];

@@ -5,7 +5,8 @@
 // The builders that make such trees (bottom_up, lbvh, insertion, reinsertion) give one primitive
 // (or one run of primitives) per leaf and no depth limit. Flattening does the two things they
 // share:
-//   - collapse: a subtree becomes one leaf when that is cheaper by the SAH (leaf cost C_isect * n
+//   - collapse: a subtree becomes one leaf when that is cheaper by the SAH (leaf cost C_isect * n,
+//     n counted in blocks of SahCosts::leaf_block,
 //     against C_trav + the children's best costs, all weighted by area) and it holds no more than
 //     max_leaf_size primitives; the usual post-pass of bottom-up builders (Karras 2012, Meister and
 //     Bittner 2018);

@@ -17,10 +17,12 @@ inline T sah_partial_cost(const SahCosts& costs, T left_area, std::uint32_t left
            right_area * T(costs.leaf_tests(right_count));
 }
 
-/// True when a node of `count` primitives is a leaf whatever its split: it fits one leaf test, and
-/// a split costs C_trav plus at least one test on a child, more than the one test of the leaf.
-inline bool sah_leaf_certain(const SahCosts& costs, std::uint32_t count) {
-    return count <= costs.block() && costs.traversal >= costs.intersection;
+/// True when a node of `count` primitives and area `node_area` is a leaf whatever its split: it
+/// fits one leaf test, and a split costs C_trav plus at least one test on a child, no less than
+/// the one test of the leaf. A flat node is left to sah_split_beats_leaf, which splits it.
+template <class T>
+inline bool sah_leaf_certain(const SahCosts& costs, std::uint32_t count, T node_area) {
+    return count <= costs.block() && costs.traversal >= costs.intersection && node_area > T(0);
 }
 
 /// True when splitting (with the best partial cost found) is cheaper than a leaf of `count`.

@@ -22,7 +22,7 @@ class SweepSahRule {
 
     Split<T> operator()(const SplitTask<T, N>& task, const Executor& exec) {
         const auto count = static_cast<std::uint32_t>(task.indices.size());
-        if (sah_leaf_certain(costs_, count)) return Split<T>::leaf();
+        if (sah_leaf_certain(costs_, count, task.bounds.area())) return Split<T>::leaf();
         AxisBest best[N];
         if (exec.is_parallel() && count >= parallel_axes_from) {
             if (order_.size() < N * count) {

@@ -16,6 +16,7 @@
 // where the serial driver puts them. Every decision depends on a node's primitives and size only,
 // never on the thread count, so the tree is the same bit for bit.
 #include <algorithm>
+#include <cassert>
 #include <memory>
 #include <numeric>
 #include <span>
@@ -52,7 +53,8 @@ struct Split {
     enum class Kind {
         Leaf,  // ...nowhere: make a leaf (overridden when the node is larger than max_leaf_size)
         AtPosition,  // ...below `position`
-        AtBin,       // ...in a bin <= `bin`, bins being floor((c - bin_origin) * bin_scale) clamped
+        AtBin,       // ...in a bin <= `bin` (< bin_count - 1), bins being floor((c - bin_origin) *
+                     // bin_scale) clamped
         AtCount,     // ...among the `left_count` smallest (ties broken by primitive index)
     };
     Kind kind = Kind::Leaf;
@@ -172,6 +174,7 @@ struct RangeBounds {
 /// Adds primitive i to `left` when `goes_left`, else to `right`: without a branch for 3D float
 /// boxes on x86, where which side a primitive goes is a coin toss the branch predictor loses
 /// about half the time.
+/// Finite boxes and centroids only (see partition_primitives).
 template <class T, std::size_t N>
 [[gnu::always_inline]] inline void add_to_side(const BuildInput<T, N>& in, std::uint32_t i,
                                                bool goes_left, RangeBounds<T, N>& left,
@@ -327,7 +330,10 @@ std::uint32_t partition_by(const BuildInput<T, N>& in, std::span<std::uint32_t> 
 /// Reorders `range` so the primitives going left come first, gathering both sides' bounds on the
 /// way (each primitive is classified and grown exactly once); returns how many go left. A range of
 /// at least stable_partition_from primitives is partitioned stably through `scratch` (as long as
-/// the range; the drivers always pass it), on `exec`; a shorter one in place.
+/// the range; the drivers always pass it), on `exec`; a shorter one in place. The boxes and
+/// centroids must be finite, as usable_primitives leaves them (the in-place pass grows the other
+/// side's bounds by coordinate + inf, which an infinite coordinate would turn to NaN), and an AtBin
+/// split's bin below bin_count - 1, as BinnedSahRule makes it.
 template <class T, std::size_t N>
 std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::uint32_t> range,
                                    const Split<T>& s, RangeBounds<T, N>& left,
@@ -365,6 +371,7 @@ std::uint32_t partition_primitives(const BuildInput<T, N>& in, std::span<std::ui
                 },
                 left, right);
         case Kind::AtBin:
+            assert(s.bin + 1 < s.bin_count && s.bin_count <= (1u << 24));
             return top_down_detail::partition_by(
                 in, range, scratch, exec,
                 // bin_of(x) <= bin exactly when !((x - origin) * scale >= bin + 1): bin + 1 is

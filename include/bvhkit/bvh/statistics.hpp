@@ -24,7 +24,9 @@ struct SahCosts {
 
     std::uint32_t block() const { return leaf_block ? leaf_block : 1; }
     /// ceil(count / block()): the tests a leaf of `count` primitives takes.
-    std::uint32_t leaf_tests(std::uint32_t count) const { return (count + block() - 1) / block(); }
+    std::uint32_t leaf_tests(std::uint32_t count) const {
+        return count / block() + (count % block() != 0);  // no overflow near 2^32
+    }
 };
 
 struct BvhStatistics {
