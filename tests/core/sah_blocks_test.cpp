@@ -31,6 +31,18 @@ Input input_of(const std::vector<Trianglef>& tris) {
     return in;
 }
 
+/// Inner nodes holding at most `limit` primitives below them.
+std::size_t inner_nodes_of_at_most(const AabbBvh<float, 3>& bvh, std::uint32_t limit) {
+    std::vector<std::uint32_t> under(bvh.nodes.size());
+    std::size_t small = 0;
+    for (std::size_t i = bvh.nodes.size(); i-- > 0;) {  // children come after their parents
+        const auto& n = bvh.nodes[i];
+        under[i] = n.is_leaf() ? n.count : under[n.left()] + under[n.right()];
+        small += !n.is_leaf() && under[i] <= limit;
+    }
+    return small;
+}
+
 }  // namespace
 
 TEST(SahBlocks, StatisticsCountLeafTestsInBlocks) {
@@ -66,18 +78,9 @@ TEST(SahBlocks, NodesOfOneBlockAreLeavesAndLargerOnesStillSplit) {
         o.costs.leaf_block = 4;
         const auto bvh = build_bvh<float, 3>(in.boxes, in.centroids, o);
         validate(bvh, in.boxes);
-        const auto under = [&](auto&& self, std::uint32_t i) -> std::uint32_t {
-            const auto& n = bvh.nodes[i];
-            return n.is_leaf() ? n.count : self(self, n.left()) + self(self, n.right());
-        };
-        std::size_t small_inner = 0, leaves_past_block = 0;
-        for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
-            if (!bvh.nodes[i].is_leaf())
-                small_inner += under(under, i) <= 4;
-            else
-                leaves_past_block += bvh.nodes[i].count > 4;
-        }
-        EXPECT_EQ(small_inner, 0u);
+        EXPECT_EQ(inner_nodes_of_at_most(bvh, 4), 0u);
+        std::size_t leaves_past_block = 0;
+        for (const auto& n : bvh.nodes) leaves_past_block += n.is_leaf() && n.count > 4;
         const auto s = statistics(bvh);
         EXPECT_LE(s.leaf_size_histogram.size(), 9u);  // max_leaf_size 8
         // Leaves of two blocks exist: the SAH keeps some five to eight whole.
@@ -87,14 +90,7 @@ TEST(SahBlocks, NodesOfOneBlockAreLeavesAndLargerOnesStillSplit) {
         o.costs.traversal = 0.25;
         const auto cheap = build_bvh<float, 3>(in.boxes, in.centroids, o);
         validate(cheap, in.boxes);
-        const auto under_cheap = [&](auto&& self, std::uint32_t i) -> std::uint32_t {
-            const auto& n = cheap.nodes[i];
-            return n.is_leaf() ? n.count : self(self, n.left()) + self(self, n.right());
-        };
-        std::size_t cheap_small_inner = 0;
-        for (std::uint32_t i = 0; i < cheap.nodes.size(); ++i)
-            cheap_small_inner += !cheap.nodes[i].is_leaf() && under_cheap(under_cheap, i) <= 4;
-        EXPECT_GT(cheap_small_inner, 0u);
+        EXPECT_GT(inner_nodes_of_at_most(cheap, 4), 0u);
     }
 }
 
