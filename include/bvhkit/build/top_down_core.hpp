@@ -53,8 +53,8 @@ struct Split {
     enum class Kind {
         Leaf,  // ...nowhere: make a leaf (overridden when the node is larger than max_leaf_size)
         AtPosition,  // ...below `position`
-        AtBin,       // ...in a bin <= `bin` (< bin_count - 1), bins being floor((c - bin_origin) *
-                     // bin_scale) clamped
+        AtBin,       // ...in a bin <= `bin`, bins being floor((c - bin_origin) * bin_scale) clamped
+                     // to [0, bin_count - 1]; bin < bin_count - 1
         AtCount,     // ...among the `left_count` smallest (ties broken by primitive index)
     };
     Kind kind = Kind::Leaf;
@@ -173,8 +173,7 @@ struct RangeBounds {
 
 /// Adds primitive i to `left` when `goes_left`, else to `right`: without a branch for 3D float
 /// boxes on x86, where which side a primitive goes is a coin toss the branch predictor loses
-/// about half the time.
-/// Finite boxes and centroids only (see partition_primitives).
+/// about half the time. Finite boxes and centroids only (see partition_primitives).
 template <class T, std::size_t N>
 [[gnu::always_inline]] inline void add_to_side(const BuildInput<T, N>& in, std::uint32_t i,
                                                bool goes_left, RangeBounds<T, N>& left,
