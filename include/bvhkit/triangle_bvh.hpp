@@ -74,14 +74,16 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>) {
             if (traces_wide() && wide_ray_usable(ray)) {
-                if (!ray_meets_box(ray, bvh_.root().bounds)) return Hit<T>{};
+                // The slab constants serve the bounds test and then the walk.
+                const detail::SlabConstants k(ray);
+                if (!k.meets(bvh_.root().bounds, ray.tmin, ray.tmax)) return Hit<T>{};
                 TriangleHit<float> h;
                 const TriangleGroup4* group;
                 int lane;
-                const WatertightRay<float> prep(ray);
-                const bool hit = wide8_.empty()
-                                     ? closest_hit_wide(wide4_, ray, prep, h, group, lane, stats)
-                                     : closest_hit_wide(wide8_, ray, prep, h, group, lane, stats);
+                const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
+                const bool hit =
+                    wide8_.empty() ? closest_hit_wide(wide4_, ray, k, prep, h, group, lane, stats)
+                                   : closest_hit_wide(wide8_, ray, k, prep, h, group, lane, stats);
                 if (!hit) return Hit<T>{};
                 // The groups hold the primitive index and a copy of the corners: the same normal
                 // as exact_'s, from the line just tested.
@@ -99,9 +101,11 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     bool any_hit(const Ray<T, 3>& ray, Stats&& stats) const {
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>)
-            if (traces_wide() && wide_ray_usable(ray))
-                return wide8_.empty() ? any_hit_wide(wide4_, ray, WatertightRay<float>(ray), stats)
-                                      : any_hit_wide(wide8_, ray, WatertightRay<float>(ray), stats);
+            if (traces_wide() && wide_ray_usable(ray)) {
+                const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
+                return wide8_.empty() ? any_hit_wide(wide4_, ray, prep, stats)
+                                      : any_hit_wide(wide8_, ray, prep, stats);
+            }
 #endif
         return binary_rays().any_hit(ray, stats);
     }

@@ -215,6 +215,49 @@ TEST(WideRays, UsableRaysAreTheDefinitionsOnes) {
     EXPECT_GT(usable, tested / 20);
 }
 
+// The per-ray constants the wide walks make once, against their definitions: the slab constants
+// (made four lanes at once) per component, and the watertight constants of a ray known usable
+// (made without the checks) equal to the checked constructor's, bit for bit, over every mix of
+// the special direction values a usable ray can have.
+TEST(WideRays, PerRayConstantsAreTheDefinitionsOnes) {
+    const float least = std::numeric_limits<float>::min();
+    const std::vector<float> values{0.0f, -0.0f, 1.0f, -2.5f, least, -least, 3e38f, -7e-30f};
+    const auto same = [](auto a, auto b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+    constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
+    std::size_t tested = 0;
+    for (const float a : values)
+        for (const float b : values)
+            for (const float c : values) {
+                Ray3f r;
+                r.direction = {a, b, c};
+                r.origin = {1e5f, -2.0f, 3e-3f};
+                if (!wide_ray_usable(r)) continue;
+                const detail::SlabConstants k(r);
+                for (std::uint32_t axis = 0; axis < 3; ++axis) {
+                    const float inv = 1.0f / r.direction[axis];
+                    ASSERT_TRUE(same(k.inv[axis], inv)) << a << " " << b << " " << c;
+                    ASSERT_TRUE(same(k.inv_far[axis], inv * s));
+                    ASSERT_EQ(k.origin[axis], r.origin[axis]);
+                    const bool negative = std::signbit(r.direction[axis]);
+                    ASSERT_EQ(k.near[axis], negative ? axis + 3 : axis);
+                    ASSERT_EQ(k.far[axis], negative ? axis : axis + 3);
+                }
+                const WatertightRay<float> checked(r);
+                const WatertightRay<float> known(r, WatertightRay<float>::KnownValid{});
+                ASSERT_TRUE(checked.valid);
+                EXPECT_EQ(known.kx, checked.kx);
+                EXPECT_EQ(known.ky, checked.ky);
+                EXPECT_EQ(known.kz, checked.kz);
+                EXPECT_TRUE(same(known.sx, checked.sx) && same(known.sy, checked.sy));
+                EXPECT_TRUE(same(known.dz, checked.dz));
+                EXPECT_TRUE(same(known.ox, checked.ox) && same(known.oy, checked.oy) &&
+                            same(known.oz, checked.oz));
+                EXPECT_TRUE(known.valid);
+                ++tested;
+            }
+    EXPECT_GT(tested, 200u);
+}
+
 // ray_meets_box (the closest-hit early out on the tree's bounds) decides as the scalar slab test
 // of the binary walk (RaySlabData::clip, the same rounding model written independently), on rays
 // that touch the box exactly: aimed at its corners, edges and faces, grazing a face with a zero

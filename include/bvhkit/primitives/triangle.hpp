@@ -44,6 +44,30 @@ struct WatertightRay {
     WatertightRay() = default;
     explicit WatertightRay(const Ray<T, 3>& ray) {
         const Vec<T, 3>& d = ray.direction;
+        choose_axes(ray);
+        valid = d[kz] != T(0) && std::isfinite(d[0]) && std::isfinite(d[1]) && std::isfinite(d[2]);
+        // |sx|, |sy| <= 1 by the choice of kz, also for subnormal components; d[kz] itself is
+        // used only as a divisor of t (1 / d[kz] overflows for a subnormal d[kz]).
+        sx = valid ? d[kx] / d[kz] : T(0);
+        sy = valid ? d[ky] / d[kz] : T(0);
+        // An invalid ray gets NaN, so that every t it produces fails the range test.
+        dz = valid ? Wide(d[kz]) : std::numeric_limits<Wide>::quiet_NaN();
+    }
+    /// The same constants for a ray already known to have a finite direction with a component
+    /// other than zero (the wide walks' wide_ray_usable): then d[kz] != 0 and the ray is valid.
+    struct KnownValid {};
+    [[gnu::always_inline]] WatertightRay(const Ray<T, 3>& ray, KnownValid) {
+        const Vec<T, 3>& d = ray.direction;
+        choose_axes(ray);
+        valid = true;
+        sx = d[kx] / d[kz];
+        sy = d[ky] / d[kz];
+        dz = Wide(d[kz]);
+    }
+
+  private:
+    [[gnu::always_inline]] void choose_axes(const Ray<T, 3>& ray) {
+        const Vec<T, 3>& d = ray.direction;
         // kz = d0 >= d1 ? (d0 >= d2 ? 0 : 2) : (d1 >= d2 ? 1 : 2) in magnitudes, and the swap,
         // without branches: for incoherent rays each would be a coin toss for the predictor.
         const T a0 = std::fabs(d[0]), a1 = std::fabs(d[1]), a2 = std::fabs(d[2]);
@@ -55,13 +79,6 @@ struct WatertightRay {
         const std::uint32_t swap = (x0 ^ y0) & (0u - std::uint32_t(d[kz] < T(0)));
         kx = x0 ^ swap;
         ky = y0 ^ swap;
-        valid = d[kz] != T(0) && std::isfinite(d[0]) && std::isfinite(d[1]) && std::isfinite(d[2]);
-        // |sx|, |sy| <= 1 by the choice of kz, also for subnormal components; d[kz] itself is
-        // used only as a divisor of t (1 / d[kz] overflows for a subnormal d[kz]).
-        sx = valid ? d[kx] / d[kz] : T(0);
-        sy = valid ? d[ky] / d[kz] : T(0);
-        // An invalid ray gets NaN, so that every t it produces fails the range test.
-        dz = valid ? Wide(d[kz]) : std::numeric_limits<Wide>::quiet_NaN();
         ox = ray.origin[kx];
         oy = ray.origin[ky];
         oz = ray.origin[kz];

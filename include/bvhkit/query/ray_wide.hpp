@@ -197,23 +197,56 @@ template <int W, class Line>
 // each axis's near and far planes. The rows are chosen per ray at run time rather than by one
 // compiled walk per octant: incoherent rays then share one copy of the walk, and pay neither the
 // dispatch's mispredicted indirect jump nor the branches that computed the octant.
-struct SlabConstants {
-    float origin[3], inv[3], inv_far[3];
-    std::uint32_t near[3], far[3];
+struct alignas(16) SlabConstants {
+    // Lane 3 of each row is a fourth axis that restricts nothing (origin 0, direction 1), so that
+    // meets() can clip four lanes at once; the walks read lanes 0-2.
+    float origin[4], inv[4], inv_far[4];
+    std::uint32_t near[4], far[4];
     /// For a ray wide_ray_usable accepts: no subnormal direction component, so 1 / d is what
     /// RaySlabData holds (an infinity for a zero of either sign, finite otherwise).
     explicit SlabConstants(const Ray<float, 3>& ray) {
         constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
-        for (std::uint32_t a = 0; a < 3; ++a) {
-            origin[a] = ray.origin[a];
-            inv[a] = 1.0f / ray.direction[a];
-            inv_far[a] = inv[a] * s;
-            // -0 counts as negative, as in RaySlabData: its -inf reciprocal meets the planes in
-            // the right order.
-            const std::uint32_t negative = std::signbit(ray.direction[a]) ? 3u : 0u;
-            near[a] = a + negative;
-            far[a] = a + 3u - negative;
-        }
+        // All axes at once: the same IEEE quotients and products as one axis at a time.
+        const __m128 d = _mm_setr_ps(ray.direction[0], ray.direction[1], ray.direction[2], 1.0f);
+        const __m128 r = _mm_div_ps(_mm_set1_ps(1.0f), d);
+        _mm_store_ps(origin, _mm_setr_ps(ray.origin[0], ray.origin[1], ray.origin[2], 0.0f));
+        _mm_store_ps(inv, r);
+        _mm_store_ps(inv_far, _mm_mul_ps(r, _mm_set1_ps(s)));
+        // -0 counts as negative, as in RaySlabData: its -inf reciprocal meets the planes in the
+        // right order. A negative axis reads its near plane from the max row (a + 3).
+        const __m128i negative =
+            _mm_and_si128(_mm_srai_epi32(_mm_castps_si128(d), 31), _mm_set1_epi32(3));
+        _mm_store_si128(reinterpret_cast<__m128i*>(near),
+                        _mm_add_epi32(_mm_setr_epi32(0, 1, 2, 3), negative));
+        _mm_store_si128(reinterpret_cast<__m128i*>(far),
+                        _mm_sub_epi32(_mm_setr_epi32(3, 4, 5, 6), negative));
+    }
+
+    /// Whether the ray can meet `box` in [tmin, tmax], by the walks' own slab test and rounding:
+    /// a box inside this one gives an interval inside this one's, so a miss here is a miss of
+    /// everything in it.
+    bool meets(const Aabb<float, 3>& box, float tmin, float tmax) const {
+        const float inf = std::numeric_limits<float>::infinity();
+        // Lane 3 goes from 0 along 1 through [-inf, inf]: it restricts nothing.
+        const __m128 lo = _mm_setr_ps(box.min[0], box.min[1], box.min[2], -inf);
+        const __m128 hi = _mm_setr_ps(box.max[0], box.max[1], box.max[2], inf);
+        const __m128 negative = _mm_castsi128_ps(
+            _mm_xor_si128(_mm_cmpeq_epi32(_mm_load_si128(reinterpret_cast<const __m128i*>(near)),
+                                          _mm_setr_epi32(0, 1, 2, 3)),
+                          _mm_set1_epi32(-1)));
+        const __m128 near_plane = _mm_or_ps(_mm_and_ps(negative, hi), _mm_andnot_ps(negative, lo));
+        const __m128 far_plane = _mm_or_ps(_mm_and_ps(negative, lo), _mm_andnot_ps(negative, hi));
+        const __m128 o = _mm_load_ps(origin);
+        // As in the walks, maxps/minps keep their second operand when the first is NaN (0 * inf).
+        __m128 t0 =
+            _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near_plane, o), _mm_load_ps(inv)), _mm_set1_ps(tmin));
+        __m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far_plane, o), _mm_load_ps(inv_far)),
+                               _mm_set1_ps(tmax));
+        t0 = _mm_max_ps(t0, _mm_shuffle_ps(t0, t0, _MM_SHUFFLE(1, 0, 3, 2)));
+        t0 = _mm_max_ps(t0, _mm_shuffle_ps(t0, t0, _MM_SHUFFLE(2, 3, 0, 1)));
+        t1 = _mm_min_ps(t1, _mm_shuffle_ps(t1, t1, _MM_SHUFFLE(1, 0, 3, 2)));
+        t1 = _mm_min_ps(t1, _mm_shuffle_ps(t1, t1, _MM_SHUFFLE(2, 3, 0, 1)));
+        return _mm_comile_ss(t0, t1);
     }
 };
 
@@ -353,7 +386,7 @@ template <class Stats>
 struct ClosestLeaves {
     static constexpr bool any_hit = false;  // the walk visits hit children nearest first
     const TriangleGroup4* groups;
-    const WatertightRay4& r4;
+    const WatertightRay<float>& prep;
     Ray<float, 3>& ray;
     TriangleHit<float>& best;
     const TriangleGroup4*& hit_group;
@@ -361,6 +394,7 @@ struct ClosestLeaves {
     Stats& stats;
 
     bool operator()(std::uint32_t first, std::uint32_t count) {
+        const WatertightRay4 r4(prep);  // made per leaf: the eight-wide walk does not need it
         for (std::uint32_t g = first; g < first + count; ++g) {
             count_lanes(groups[g], stats);
             intersect_watertight4(r4, groups[g], ray.tmin, ray.tmax,
@@ -383,7 +417,7 @@ struct ClosestLeaves {
             count_lanes(groups[g], stats);
             if (pair) count_lanes(groups[g + 1], stats);
             intersect_watertight4x2(
-                r4.ray, groups[g], groups[pair ? g + 1 : g], ray.tmin, ray.tmax,
+                prep, groups[g], groups[pair ? g + 1 : g], ray.tmin, ray.tmax,
                 [&](int lane, const TriangleHit<float>& h) {
                     best = h;
                     hit_group = groups + g + std::uint32_t(lane >> 2);
@@ -401,12 +435,13 @@ template <class Stats>
 struct AnyLeaves {
     static constexpr bool any_hit = true;  // the walk visits hit children in any order
     const TriangleGroup4* groups;
-    const WatertightRay4& r4;
+    const WatertightRay<float>& prep;
     const Ray<float, 3>& ray;
     bool& found;
     Stats& stats;
 
     bool operator()(std::uint32_t first, std::uint32_t count) {
+        const WatertightRay4 r4(prep);
         for (std::uint32_t g = first; g < first + count && !found; ++g) {
             count_lanes(groups[g], stats);
             float tmax = ray.tmax;
@@ -428,7 +463,7 @@ struct AnyLeaves {
             if (pair) count_lanes(groups[g + 1], stats);
             float tmax = ray.tmax;
             intersect_watertight4x2(
-                r4.ray, groups[g], groups[pair ? g + 1 : g], ray.tmin, tmax,
+                prep, groups[g], groups[pair ? g + 1 : g], ray.tmin, tmax,
                 [&](int, const TriangleHit<float>& h) {
                     found = true;
                     return h.t;
@@ -449,30 +484,36 @@ struct AnyLeaves {
 /// eight-wide tree needs cpu_has_avx2().
 template <int W, class Stats = NoStats>
 bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
-                      const WatertightRay<float>& prep, TriangleHit<float>& best,
-                      const TriangleGroup4*& hit_group, int& hit_lane, Stats&& stats = {}) {
-    // The slab constants from the caller's ray, before the copy the walk narrows: read from the
-    // copy, its direction straddled the two stores that wrote it (a store-forwarding stall).
-    const detail::SlabConstants k(ray_in);
+                      const detail::SlabConstants& k, const WatertightRay<float>& prep,
+                      TriangleHit<float>& best, const TriangleGroup4*& hit_group, int& hit_lane,
+                      Stats&& stats = {}) {
     Ray<float, 3> ray = ray_in;
     hit_group = nullptr;
     hit_lane = 0;
-    const WatertightRay4 r4(prep);
     detail::ClosestLeaves<std::remove_reference_t<Stats>> leaves{
-        tree.groups.data(), r4, ray, best, hit_group, hit_lane, stats};
+        tree.groups.data(), prep, ray, best, hit_group, hit_lane, stats};
     detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return hit_group != nullptr;
+}
+/// The same, with the slab constants made here.
+template <int W, class Stats = NoStats>
+bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray,
+                      const WatertightRay<float>& prep, TriangleHit<float>& best,
+                      const TriangleGroup4*& hit_group, int& hit_lane, Stats&& stats = {}) {
+    return closest_hit_wide(tree, ray, detail::SlabConstants(ray), prep, best, hit_group, hit_lane,
+                            stats);
 }
 
 /// Any hit through a wide tree (same conditions as closest_hit_wide).
 template <int W, class Stats = NoStats>
 bool any_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
                   const WatertightRay<float>& prep, Stats&& stats = {}) {
+    // The slab constants from the caller's ray, before the copy the walk reads: read from the
+    // copy, its direction straddled the two stores that wrote it (a store-forwarding stall).
     const detail::SlabConstants k(ray_in);
     Ray<float, 3> ray = ray_in;
-    const WatertightRay4 r4(prep);
     bool found = false;
-    detail::AnyLeaves<std::remove_reference_t<Stats>> leaves{tree.groups.data(), r4, ray, found,
+    detail::AnyLeaves<std::remove_reference_t<Stats>> leaves{tree.groups.data(), prep, ray, found,
                                                              stats};
     detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return found;
@@ -486,27 +527,7 @@ bool any_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
 /// camera rays around a model) then costs this test and no set-up of the walk: the watertight
 /// ray, the slab constants and the stack took more than half of such a ray's time.
 inline bool ray_meets_box(const Ray<float, 3>& ray, const Aabb<float, 3>& box) {
-    constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
-    const float inf = std::numeric_limits<float>::infinity();
-    // The fourth lane goes from 0 along 1 through [-inf, inf]: it restricts nothing.
-    const __m128 o = _mm_setr_ps(ray.origin[0], ray.origin[1], ray.origin[2], 0.0f);
-    const __m128 d = _mm_setr_ps(ray.direction[0], ray.direction[1], ray.direction[2], 1.0f);
-    const __m128 lo = _mm_setr_ps(box.min[0], box.min[1], box.min[2], -inf);
-    const __m128 hi = _mm_setr_ps(box.max[0], box.max[1], box.max[2], inf);
-    const __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), d);
-    // -0 counts as negative, as in SlabConstants: the near plane is then the box's max.
-    const __m128 negative = _mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(d), 31));
-    const __m128 near = _mm_or_ps(_mm_and_ps(negative, hi), _mm_andnot_ps(negative, lo));
-    const __m128 far = _mm_or_ps(_mm_and_ps(negative, lo), _mm_andnot_ps(negative, hi));
-    // As in the walk, maxps/minps keep their second operand when the first is NaN (0 * inf).
-    __m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, o), inv), _mm_set1_ps(ray.tmin));
-    __m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, o), _mm_mul_ps(inv, _mm_set1_ps(s))),
-                           _mm_set1_ps(ray.tmax));
-    t0 = _mm_max_ps(t0, _mm_shuffle_ps(t0, t0, _MM_SHUFFLE(1, 0, 3, 2)));
-    t0 = _mm_max_ps(t0, _mm_shuffle_ps(t0, t0, _MM_SHUFFLE(2, 3, 0, 1)));
-    t1 = _mm_min_ps(t1, _mm_shuffle_ps(t1, t1, _MM_SHUFFLE(1, 0, 3, 2)));
-    t1 = _mm_min_ps(t1, _mm_shuffle_ps(t1, t1, _MM_SHUFFLE(2, 3, 0, 1)));
-    return _mm_comile_ss(t0, t1);
+    return detail::SlabConstants(ray).meets(box, ray.tmin, ray.tmax);
 }
 #endif
 
