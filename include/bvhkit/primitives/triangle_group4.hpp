@@ -79,7 +79,8 @@ template <class OnHit>
                                                          const TriangleGroup4& g, float tmin,
                                                          float& tmax, OnHit&& on_hit) {
     const WatertightRay<float>& s = r.ray;
-    const auto corner = [&](int k, std::uint32_t axis) {
+    // Indices in size_t: 3 k + axis cannot wrap, so the compiler folds 3 k into the address.
+    const auto corner = [&](std::size_t k, std::size_t axis) {
         return _mm_load_ps(g.corner[3 * k + axis]);
     };
     __m128 x[3], y[3], z[3];
@@ -127,17 +128,20 @@ template <class OnHit>
     const __m256 ox = _mm256_set1_ps(s.ox), oy = _mm256_set1_ps(s.oy), oz = _mm256_set1_ps(s.oz);
     const __m256 sx = _mm256_set1_ps(s.sx), sy = _mm256_set1_ps(s.sy);
     __m256 x[3], y[3], z[3];
-    for (std::uint32_t k = 0; k < 3; ++k) {
-        const std::uint32_t row = 3 * k;
+    // Indices in size_t: row + axis cannot wrap, so the compiler folds the row into the address
+    // (with uint32_t it computed and shifted each of the nine indices on every pass).
+    const std::size_t kx = s.kx, ky = s.ky, kz = s.kz;
+    for (std::size_t k = 0; k < 3; ++k) {
+        const std::size_t row = 3 * k;
         const __m256 cz =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + s.kz])),
-                                 _mm_load_ps(b.corner[row + s.kz]), 1);
+            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + kz])),
+                                 _mm_load_ps(b.corner[row + kz]), 1);
         const __m256 cx =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + s.kx])),
-                                 _mm_load_ps(b.corner[row + s.kx]), 1);
+            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + kx])),
+                                 _mm_load_ps(b.corner[row + kx]), 1);
         const __m256 cy =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + s.ky])),
-                                 _mm_load_ps(b.corner[row + s.ky]), 1);
+            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + ky])),
+                                 _mm_load_ps(b.corner[row + ky]), 1);
         z[k] = _mm256_sub_ps(cz, oz);
         x[k] = _mm256_sub_ps(_mm256_sub_ps(cx, ox), _mm256_mul_ps(sx, z[k]));
         y[k] = _mm256_sub_ps(_mm256_sub_ps(cy, oy), _mm256_mul_ps(sy, z[k]));
