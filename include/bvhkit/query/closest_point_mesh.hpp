@@ -168,14 +168,18 @@ class ClosestPointMesh {
             max_component(abs(ps)) < std::ldexp(T(1), std::numeric_limits<T>::max_exponent / 4);
         const T unscale = T(1) / pack_scale_;  // exact: a power of two
         const T unscale2 = unscale * unscale;
+        // The best triangle's answer is kept, not measured again at the end: the triangle
+        // measured is tris_[s] bit for bit (a pack's copy only when it unscales exactly).
+        AccurateClosestPoint<T> best_point;
         const auto measure = [&](std::uint32_t s, const Triangle<T>& t) {
-            const W d2 = distance_squared_accurate(t, p);
+            const AccurateClosestPoint<T> c = closest_point_accurate(t, p);
+            const W d2 = c.distance_squared;
             // The limit is judged on the distance as returned (rounded to T). Of triangles at
             // the same distance the one in the lowest slot wins, whatever the order they were
             // measured in: every triangle that ties with the best is measured (its estimate is
             // within the slack), so the answer does not depend on where the walk started.
             if ((d2 < best2 || (d2 == best2 && s < best.slot)) && T(d2) <= max_distance_squared)
-                best = {s, T(d2)}, best2 = d2;
+                best = {s, T(d2)}, best2 = d2, best_point = c;
         };
         const auto tighten = [&] {
             T bound = std::min(limit2, widened(widened(best_estimate)));
@@ -236,7 +240,7 @@ class ClosestPointMesh {
             if (estimate > search2) break;
             measure(s, tris_[s]);
         }
-        return best ? point_of(best.slot, p) : MeshPoint<T>{};
+        return best ? point_of(best.slot, best_point) : MeshPoint<T>{};
     }
 
     void build(const std::vector<Triangle<T>>& tris, const BuildOptions& options) {
@@ -366,7 +370,9 @@ class ClosestPointMesh {
         return d2;
     }
     MeshPoint<T> point_of(std::uint32_t slot, const Vec<T, 3>& p) const {
-        const AccurateClosestPoint<T> c = closest_point_accurate(tris_[slot], p);
+        return point_of(slot, closest_point_accurate(tris_[slot], p));
+    }
+    MeshPoint<T> point_of(std::uint32_t slot, const AccurateClosestPoint<T>& c) const {
         return {Vec<T, 3>(c.point), T(c.distance_squared), bvh_.primitive_indices[slot], T(c.u),
                 T(c.v)};
     }
