@@ -221,7 +221,9 @@ TEST(WideRays, UsableRaysAreTheDefinitionsOnes) {
 // the special direction values a usable ray can have.
 TEST(WideRays, PerRayConstantsAreTheDefinitionsOnes) {
     const float least = std::numeric_limits<float>::min();
-    const std::vector<float> values{0.0f, -0.0f, 1.0f, -2.5f, least, -least, 3e38f, -7e-30f};
+    const float largest = std::numeric_limits<float>::max();  // its reciprocal is subnormal
+    const std::vector<float> values{0.0f,   -0.0f, 1.0f,    -2.5f,   least,
+                                    -least, 3e38f, -7e-30f, largest, -largest};
     const auto same = [](auto a, auto b) { return std::memcmp(&a, &b, sizeof a) == 0; };
     constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
     std::size_t tested = 0;
