@@ -206,7 +206,7 @@ def _check_distances(d, reference) -> str:
     """The largest difference to bvhkit's distances as a share of the largest distance, and the
     largest relative difference among points farther than 1e-4 of it: the relative difference of
     a point within float32 rounding of the surface says nothing (a peer that returns float32
-    closest points differs there by 8% at 1e-8 from the surface)."""
+    closest points differs there by 8% at 1e-7 of the mesh's size from the surface)."""
     d_ref = reference[0][: len(d)].astype(np.float64)
     d = np.asarray(d, dtype=np.float64)
     scale = np.abs(d_ref).max()
