@@ -8,7 +8,8 @@
 namespace bvhkit::bench {
 
 EmbreeScene::EmbreeScene(const TriangleMesh& mesh, int threads) {
-    const std::string config = "threads=" + std::to_string(threads);
+    // threads=0 leaves Embree's default, every core, and no process-wide limit on oneTBB.
+    const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
     device_ = rtcNewDevice(config.c_str());
     if (!device_) throw Error("Embree: rtcNewDevice failed");
     build(mesh);

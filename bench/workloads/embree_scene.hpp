@@ -12,7 +12,9 @@ namespace bvhkit::bench {
 
 class EmbreeScene {
   public:
-    /// Builds with RTC_BUILD_QUALITY_MEDIUM on a device limited to `threads` threads.
+    /// Builds with RTC_BUILD_QUALITY_MEDIUM on a device limited to `threads` threads (0: every
+    /// core). A limited device limits every oneTBB call of the process while it lives (Embree 3
+    /// sets a global_control), bvhkit's included.
     explicit EmbreeScene(const TriangleMesh& mesh, int threads = 1);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;

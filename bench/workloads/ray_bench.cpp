@@ -1,6 +1,7 @@
 #include "ray_bench.hpp"
 
 #include <functional>
+#include <memory>
 
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
@@ -120,8 +121,11 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
                 trees[i] = TriangleBvh<float>(mesh, o);
             });
 #if BVHKIT_HAVE_EMBREE
-        EmbreeScene embree(mesh, 1);
-        builds.push_back([&] { embree.build(mesh); });
+        // On one thread. Embree 3 limits a device's threads with a process-wide oneTBB
+        // global_control, which holds bvhkit's batch calls to one thread too while the device
+        // lives: this one is released before the batch rows, which make their own.
+        auto embree = std::make_unique<EmbreeScene>(mesh, 1);
+        builds.push_back([&] { embree->build(mesh); });
 #endif
         const std::vector<double> build_ms = median_ms_interleaved(options.repetitions, builds);
         const bool peer = build_ms.size() > layouts.size();
@@ -146,7 +150,7 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
                 std::size_t& n = hits.back();
                 n = 0;
                 for (const auto& r : *w.rays)
-                    n += w.occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
+                    n += w.occlusion ? embree->any_hit(r) : bool(embree->closest_hit(r));
             });
 #endif
             const std::vector<double> ms = median_ms_interleaved(options.repetitions, runs);
@@ -177,8 +181,10 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
         }
         PeerRay peer_ray;
 #if BVHKIT_HAVE_EMBREE
-        peer_ray = [&embree](const Ray3f& r, bool occlusion) {
-            return occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
+        embree.reset();
+        const EmbreeScene embree_all(mesh, 0);
+        peer_ray = [&embree_all](const Ray3f& r, bool occlusion) {
+            return occlusion ? embree_all.any_hit(r) : bool(embree_all.closest_hit(r));
         };
 #endif
         add_batch_rows(rows, trees[0], r2, row_for, options.repetitions, peer_ray);
