@@ -119,6 +119,16 @@ void run_batch(std::size_t count, std::size_t grain, unsigned threads, Body&& bo
     if (error) std::rethrow_exception(error);
 }
 
+/// run_batch in the shape of an Executor's parallel_for, for the library's own parallel steps
+/// (spatial_order); `threads` as run_batch's.
+struct BatchExecutor {
+    unsigned threads;
+    template <class Body>
+    void parallel_for(std::size_t count, std::size_t grain, Body&& body) const {
+        run_batch(count, grain, threads, body);
+    }
+};
+
 /// A (rows, cols) numpy array that owns `values` (rows * cols of them).
 template <class X>
 nb::ndarray<nb::numpy, X> owned_array(std::vector<X>&& values, std::size_t rows, std::size_t cols) {

@@ -157,7 +157,7 @@ class Scene {
         // A large batch is answered in spatial order (bvhkit/query/point_order.hpp): neighbours
         // find the tree's nodes in cache. Each point's answer is its own, whatever the order.
         const std::vector<std::uint32_t> order = batch_order(
-            k, [&](std::size_t i) { return row(p, i); }, Executor(1));
+            k, [&](std::size_t i) { return row(p, i); }, BatchExecutor{threads});
         run_batch(k, 256, threads, [&](std::size_t b, std::size_t e) {
             PointScratch scratch;
             for (std::size_t j = b; j < e; ++j) per_point(order[j], row(p, order[j]), scratch);

@@ -31,12 +31,25 @@ std::uint64_t reference_key(const Vec3f& p, const Vec3f& lo, const Vec3f& hi) {
     return key;
 }
 
+// An executor whose parallel_for calls the chunks last first: the order must not depend on the
+// order in which the chunks run.
+struct LastChunkFirst {
+    template <class Body>
+    void parallel_for(std::size_t count, std::size_t grain, Body&& body) const {
+        for (std::size_t c = (count + grain - 1) / grain; c-- > 0;)
+            body(c * grain, std::min(count, (c + 1) * grain));
+    }
+};
+
 // Each run of `run` points (the last may be shorter) is a permutation of its own indices, its
 // finite points in the order of their key over the run's box, then its non-finite ones.
+template <class Exec = Executor>
 void expect_order(const std::vector<Vec3f>& points, unsigned threads,
-                  std::size_t run = spatial_order_run) {
+                  std::size_t run = spatial_order_run, const Exec& exec = Exec()) {
     const std::vector<std::uint32_t> order =
-        spatial_order(std::span<const Vec3f>(points), Executor(threads), run);
+        std::is_same_v<Exec, Executor>
+            ? spatial_order(std::span<const Vec3f>(points), Executor(threads), run)
+            : spatial_order(std::span<const Vec3f>(points), exec, run);
     ASSERT_EQ(order.size(), points.size());
     for (std::size_t first = 0; first < points.size(); first += run) {
         const std::size_t end = std::min(points.size(), first + run);
@@ -91,6 +104,7 @@ TEST(SpatialOrder, IsTheMortonOrderOfTheBatch) {
         set->push_back({0, inf, 0});
         set->push_back({0, 0, -inf});
         for (unsigned threads : {1u, 0u}) expect_order(*set, threads);
+        expect_order(*set, 0, spatial_order_run, LastChunkFirst{});
         // Runs shorter than the batch, as a batch past spatial_order_run points is sorted.
         expect_order(*set, 0, 1000);
         expect_order(*set, 1, 7);

@@ -29,23 +29,55 @@ namespace bvhkit {
 /// whatever the batch; 4M points to a run are dense enough that neighbours still share the tree.
 inline constexpr std::size_t spatial_order_run = std::size_t(1) << 22;
 
+namespace point_order_detail {
+
+/// Sorts items[0, count) by their bits [shift, end), stably, eight bits a pass from the least
+/// significant, using spare[0, count); the result ends in items.
+inline void radix_sort(std::uint64_t* items, std::uint64_t* spare, std::size_t count, int shift,
+                       int end) {
+    std::uint64_t *from = items, *to = spare;
+    for (; shift < end; shift += 8) {
+        std::array<std::size_t, 257> start{};
+        for (std::size_t k = 0; k < count; ++k) ++start[(from[k] >> shift & 255) + 1];
+        if (start[(from[0] >> shift & 255) + 1] == count) continue;  // one digit: no pass
+        for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
+        for (std::size_t k = 0; k < count; ++k) to[start[from[k] >> shift & 255]++] = from[k];
+        std::swap(from, to);
+    }
+    if (from != items) std::copy(from, from + count, items);
+}
+
+}  // namespace point_order_detail
+
 /// The order in which to answer n points, point(i) giving point i (a Vec<T, 3>): a permutation
-/// of 0 .. n - 1; see above. `run`: the points sorted together (spatial_order_run).
-template <class PointAt>
-std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const Executor& exec,
+/// of 0 .. n - 1; see above. `run`: the points sorted together (spatial_order_run). `exec`: an
+/// Executor, or anything with its parallel_for(count, grain, body); the order is the same for
+/// every thread count.
+template <class PointAt, class Exec>
+std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const Exec& exec,
                                          std::size_t run = spatial_order_run) {
     using V = std::remove_cvref_t<decltype(point(std::size_t(0)))>;
+    using Box = Aabb<typename V::Scalar, 3>;
     if (n >= std::size_t(invalid_index))
         throw Error("spatial_order: " + std::to_string(n) +
                     " points, more than 32-bit indices hold");
     run = std::max<std::size_t>(run, 1);
+    constexpr std::size_t grain = 16384;
     std::vector<std::uint32_t> order(n);
     std::vector<std::uint64_t> items, spare;
+    std::vector<Box> chunk_bounds;
     for (std::size_t first = 0; first < n; first += run) {
         const std::size_t count = std::min(run, n - first);
-        Aabb<typename V::Scalar, 3> bounds;
-        for (std::size_t i = first; i < first + count; ++i)
-            if (const V p = point(i); is_finite(p)) bounds.grow(p);
+        // The box of the finite points, a box per chunk then their union: the same box in any
+        // order.
+        chunk_bounds.assign((count + grain - 1) / grain, Box{});
+        exec.parallel_for(count, grain, [&](std::size_t b, std::size_t e) {
+            Box& box = chunk_bounds[b / grain];
+            for (std::size_t k = b; k < e; ++k)
+                if (const V p = point(first + k); is_finite(p)) box.grow(p);
+        });
+        Box bounds;
+        for (const Box& box : chunk_bounds) bounds.grow(box);
         // Item: key in the high half, index in the low half. The key interleaves ten bits an
         // axis of the point's cell in the box, 1024 cells an axis (x highest); a non-finite
         // point's key is 2^30. A flat axis has one cell.
@@ -56,7 +88,7 @@ std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const E
         }
         items.resize(count);
         spare.resize(count);
-        exec.parallel_for(count, 4096, [&](std::size_t b, std::size_t e) {
+        exec.parallel_for(count, grain, [&](std::size_t b, std::size_t e) {
             for (std::size_t k = b; k < e; ++k) {
                 const std::size_t i = first + k;
                 const V p = point(i);
@@ -72,21 +104,33 @@ std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const E
                 items[k] = key << 32 | i;
             }
         });
-        // Least significant digit first, eight bits a pass, over the key's 31 bits.
-        for (int shift = 32; shift < 64; shift += 8) {
-            std::array<std::size_t, 257> start{};
-            for (const std::uint64_t item : items) ++start[(item >> shift & 255) + 1];
-            if (start[(items[0] >> shift & 255) + 1] == count) continue;  // one digit: no pass
-            for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
-            for (const std::uint64_t item : items) spare[start[item >> shift & 255]++] = item;
-            items.swap(spare);
+        // A stable sort by the key: one pass on its top eight bits into buckets, then each bucket
+        // sorted on the bits below, least significant first. The same order as one sort from the
+        // least significant digit, but the buckets are sorted in parallel, each small enough to
+        // stay in cache (2M grid points: 100 ms on one thread before, 60-70 ms now).
+        constexpr int top = 56;
+        std::array<std::size_t, 257> start{};
+        for (const std::uint64_t item : items) ++start[(item >> top) + 1];
+        for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
+        {
+            std::array<std::size_t, 257> next = start;
+            for (const std::uint64_t item : items) spare[next[item >> top]++] = item;
         }
-        for (std::size_t k = 0; k < count; ++k) order[first + k] = std::uint32_t(items[k]);
+        items.swap(spare);
+        exec.parallel_for(256, 1, [&](std::size_t b, std::size_t e) {
+            for (std::size_t d = b; d < e; ++d)
+                if (start[d + 1] - start[d] > 1)
+                    point_order_detail::radix_sort(items.data() + start[d], spare.data() + start[d],
+                                                   start[d + 1] - start[d], 32, top);
+        });
+        exec.parallel_for(count, grain, [&](std::size_t b, std::size_t e) {
+            for (std::size_t k = b; k < e; ++k) order[first + k] = std::uint32_t(items[k]);
+        });
     }
     return order;
 }
-template <class T>
-std::vector<std::uint32_t> spatial_order(std::span<const Vec<T, 3>> points, const Executor& exec,
+template <class T, class Exec>
+std::vector<std::uint32_t> spatial_order(std::span<const Vec<T, 3>> points, const Exec& exec,
                                          std::size_t run = spatial_order_run) {
     return spatial_order(
         points.size(), [&](std::size_t i) { return points[i]; }, exec, run);
@@ -98,8 +142,8 @@ inline constexpr std::size_t spatial_order_from = 4096;
 
 /// The order to answer a batch of n points in: spatial_order from spatial_order_from points on,
 /// else 0 .. n - 1.
-template <class PointAt>
-std::vector<std::uint32_t> batch_order(std::size_t n, PointAt&& point, const Executor& exec) {
+template <class PointAt, class Exec>
+std::vector<std::uint32_t> batch_order(std::size_t n, PointAt&& point, const Exec& exec) {
     if (n >= spatial_order_from) return spatial_order(n, point, exec);
     std::vector<std::uint32_t> order(n);
     for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
