@@ -107,7 +107,7 @@ std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const E
         // A stable sort by the key: one pass on its top eight bits into buckets, then each bucket
         // sorted on the bits below, least significant first. The same order as one sort from the
         // least significant digit, but the buckets are sorted in parallel, each small enough to
-        // stay in cache (2M grid points: 100 ms on one thread before, 60-70 ms now).
+        // stay in cache. A 128^3 grid, one / two threads: 102 / 90 ms before, 85 / 50 ms now.
         constexpr int top = 56;
         std::array<std::size_t, 257> start{};
         for (const std::uint64_t item : items) ++start[(item >> top) + 1];
