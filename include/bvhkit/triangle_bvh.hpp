@@ -77,17 +77,18 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
                 // The slab constants serve the bounds test and then the walk.
                 const detail::SlabConstants k(ray);
                 if (!k.meets(bvh_.root().bounds, ray.tmin, ray.tmax)) return Hit<T>{};
-                TriangleHit<float> h;
-                const TriangleGroup4* group;
-                int lane;
                 const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
-                const bool hit =
-                    wide8_.empty() ? closest_hit_wide(wide4_, ray, k, prep, h, group, lane, stats)
-                                   : closest_hit_wide(wide8_, ray, k, prep, h, group, lane, stats);
-                if (!hit) return Hit<T>{};
                 // The groups hold the primitive index and a copy of the corners: the same normal
                 // as exact_'s, from the line just tested.
-                return Hit<T>{h.t, group->slot[lane], h.u, h.v, group->triangle(lane).normal()};
+                const auto trace = [&](const auto& wide) {
+                    TriangleHit<float> h;
+                    const typename std::remove_cvref_t<decltype(wide)>::Group* group;
+                    int lane;
+                    if (!closest_hit_wide(wide, ray, k, prep, h, group, lane, stats))
+                        return Hit<T>{};
+                    return Hit<T>{h.t, group->slot[lane], h.u, h.v, group->triangle(lane).normal()};
+                };
+                return wide8_.empty() ? trace(wide4_) : trace(wide8_);
             }
         }
 #endif

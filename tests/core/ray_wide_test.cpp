@@ -119,6 +119,77 @@ TEST(WideRays, LayoutChosenAsDocumented) {
     EXPECT_FALSE(TriangleBvh<float>(TriangleMesh{}).closest_hit(Ray3f({0, 0, 0}, {1, 0, 0})));
 }
 
+// The ray layout of each width, read against the binary tree it came from: every leaf lane's
+// groups in range and owned by that lane alone, every group owned; within a leaf, the groups
+// full but the last, whose padding comes after its triangles; each triangle in exactly one lane,
+// with its corners bit for bit and its own index; and a leaf's triangles those of the binary
+// subtree under its box (each inside the lane's box).
+Triangle<float> corners(const TriangleMesh& mesh, std::uint32_t t) {
+    const auto& v = mesh.triangles[t];
+    return {mesh.vertices[v[0]], mesh.vertices[v[1]], mesh.vertices[v[2]]};
+}
+
+template <int W>
+void expect_layout_holds_every_triangle_once(const TriangleMesh& mesh) {
+    const TriangleBvh<float> tree(mesh);
+    const Bvh<Aabb3f>& bvh = tree.bvh();
+    const auto& index = bvh.primitive_indices;
+    const WideRayBvh<W> wide = make_wide_ray_bvh<W>(
+        bvh, [&](std::uint32_t s) { return corners(mesh, index[s]); },
+        [&](std::uint32_t s) { return index[s]; });
+    constexpr int lanes = WideRayBvh<W>::Group::lanes;
+    static_assert(lanes == (W == 8 ? 8 : 4));
+    std::vector<int> owner_count(wide.groups.size(), 0), seen(mesh.triangle_count(), 0);
+    for (const RayNode<W>& node : wide.nodes)
+        for (int c = 0; c < W; ++c) {
+            if (node.groups[c] == 0) continue;
+            ASSERT_NE(node.child[c], invalid_index);
+            ASSERT_LE(std::size_t(node.child[c]) + node.groups[c], wide.groups.size());
+            const Aabb3f box({node.lo[0][c], node.lo[1][c], node.lo[2][c]},
+                             {node.lo[3][c], node.lo[4][c], node.lo[5][c]});
+            for (std::uint32_t g = node.child[c]; g < node.child[c] + node.groups[c]; ++g) {
+                ++owner_count[g];
+                const bool last = g + 1 == node.child[c] + node.groups[c];
+                bool padded = false;
+                for (int lane = 0; lane < lanes; ++lane) {
+                    const std::uint32_t t = wide.groups[g].slot[lane];
+                    if (t == invalid_index) {
+                        ASSERT_TRUE(last) << "padding inside a leaf's run, group " << g;
+                        padded = true;
+                        continue;
+                    }
+                    ASSERT_FALSE(padded) << "a triangle after padding, group " << g;
+                    ASSERT_LT(t, mesh.triangle_count());
+                    ++seen[t];
+                    const Triangle<float> want = corners(mesh, t);
+                    const Triangle<float> got = wide.groups[g].triangle(lane);
+                    ASSERT_EQ(std::memcmp(&got, &want, sizeof got), 0) << "triangle " << t;
+                    ASSERT_TRUE(box.contains(want.bounds())) << "triangle " << t;
+                }
+            }
+        }
+    for (std::size_t g = 0; g < owner_count.size(); ++g)
+        ASSERT_EQ(owner_count[g], 1) << "group " << g;
+    for (std::size_t t = 0; t < seen.size(); ++t) ASSERT_EQ(seen[t], 1) << "triangle " << t;
+}
+
+TEST(WideRays, LayoutHoldsEveryTriangleOnce) {
+    test::Random rng(3);
+    TriangleMesh soup;  // leaves of every size, duplicates and zero-area triangles among them
+    for (std::uint32_t i = 0; i < 3000; ++i) {
+        const Vec3f c = rng.point_in(Aabb3f({0, 0, 0}, {10, 10, 10}));
+        for (int k = 0; k < 3; ++k)
+            soup.vertices.push_back(c + rng.point_in(Aabb3f({0, 0, 0}, {1, 1, 1})) *
+                                            (i % 17 == 0 ? 0.0f : 1.0f));
+        soup.triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
+        if (i % 29 == 0) soup.triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
+    }
+    for (const TriangleMesh& mesh : {make_sphere(4), soup, make_sphere(0)}) {
+        expect_layout_holds_every_triangle_once<4>(mesh);
+        expect_layout_holds_every_triangle_once<8>(mesh);
+    }
+}
+
 TEST(WideRays, SameAnswersAsTheBinaryWalkOnHardGeometry) {
     struct Case {
         std::string name;
@@ -365,13 +436,12 @@ TEST(WideRays, RefitWithANonFiniteVertexIsAnError) {
 }
 
 #if BVHKIT_RAY_AVX2
-// The two-group AVX test (the eight-wide walk's), in a function that carries its target.
-[[gnu::target("avx2")]] void test_two_groups(const WatertightRay<float>& prep,
-                                             const TriangleGroup4& a, const TriangleGroup4& b,
-                                             float tmin, float tmax, bool (&got)[8],
-                                             TriangleHit<float> (&hit)[8]) {
+// The eight-abreast AVX test (the eight-wide walk's), in a function that carries its target.
+[[gnu::target("avx2")]] void test_eight(const WatertightRay<float>& prep, const TriangleGroup8& g,
+                                        float tmin, float tmax, bool (&got)[8],
+                                        TriangleHit<float> (&hit)[8]) {
     const float open = tmax;
-    intersect_watertight4x2(prep, a, b, tmin, tmax, [&](int lane, const TriangleHit<float>& h) {
+    intersect_watertight8(prep, g, tmin, tmax, [&](int lane, const TriangleHit<float>& h) {
         got[lane] = true;
         hit[lane] = h;
         return open;  // keep the whole range open
@@ -439,12 +509,19 @@ TEST(WideRays, FourAbreastTestEqualsTheScalarTest) {
                 ASSERT_FALSE(got[lane]) << "a padding lane hit";
             }
 #if BVHKIT_RAY_AVX2
-        // Two groups abreast in AVX (here the same group twice): each half answers as the
-        // four-abreast test.
+        // Eight abreast in AVX (here the group's four triangles twice): each half answers as
+        // the four-abreast test.
         if (cpu_has_avx2()) {
+            TriangleGroup8 eight;
+            for (int lane = 0; lane < 8; ++lane) {
+                if (group.slot[lane & 3] == invalid_index)
+                    eight.clear(lane);
+                else
+                    eight.set(lane, group.triangle(lane & 3), group.slot[lane & 3]);
+            }
             bool got8[8] = {};
             TriangleHit<float> hit8[8];
-            test_two_groups(prep, group, group, ray.tmin, ray.tmax, got8, hit8);
+            test_eight(prep, eight, ray.tmin, ray.tmax, got8, hit8);
             for (int lane = 0; lane < 8; ++lane) {
                 ASSERT_EQ(got8[lane], got[lane & 3]) << "case " << i << " lane " << lane;
                 if (got8[lane]) {

@@ -1,9 +1,10 @@
 #pragma once
-// TriangleGroup4: four float triangles side by side (each corner coordinate an array of four), and
-// the watertight ray test of Woop, Benthin and Wald 2013 run on all four at once.
+// TriangleGroup4 and TriangleGroup8: four or eight float triangles side by side (each corner
+// coordinate an array of four or eight), and the watertight ray test of Woop, Benthin and Wald
+// 2013 run on all of them at once, in SSE or AVX registers.
 //
 // The test keeps the scalar test's answers (primitives/triangle.hpp). The corners are moved to the
-// ray's origin and sheared in SSE with the same float operations as the scalar code. The edge
+// ray's origin and sheared with the same float operations as the scalar code. The edge
 // functions are then formed in float, as a filter: rounding is monotonic, so fl(a b) - fl(c d) is
 // never of the opposite sign to a b - c d (at worst it is zero; overflow to inf keeps the order
 // too), and a lane whose float edge functions have strictly mixed signs has mixed exact signs,
@@ -20,9 +21,12 @@
 
 namespace bvhkit {
 
-struct alignas(16) TriangleGroup4 {
-    float corner[9][4];  // corner[3 * k + axis][lane]: corner k (p0, p1, p2) of the lane's triangle
-    std::uint32_t slot[4];  // the lane's triangle (the caller's index); invalid_index pads
+/// L triangles side by side: L = 4 for the SSE test, 8 for the AVX test.
+template <int L>
+struct alignas(4 * L) TriangleGroup {
+    static constexpr int lanes = L;
+    float corner[9][L];  // corner[3 * k + axis][lane]: corner k (p0, p1, p2) of the lane's triangle
+    std::uint32_t slot[L];  // the lane's triangle (the caller's index); invalid_index pads
 
     /// Puts `tri` in `lane` as triangle `index`.
     void set(int lane, const Triangle<float>& tri, std::uint32_t index) {
@@ -45,6 +49,8 @@ struct alignas(16) TriangleGroup4 {
         slot[lane] = invalid_index;
     }
 };
+using TriangleGroup4 = TriangleGroup<4>;
+using TriangleGroup8 = TriangleGroup<8>;
 
 #if defined(__SSE2__)
 /// The ray's constants of the watertight test, as SSE registers.
@@ -114,17 +120,15 @@ template <class OnHit>
 }
 
 #if defined(__x86_64__) && defined(__GNUC__)
-/// intersect_watertight4 on two groups at once in AVX registers (lanes 0-3 from `a`, 4-7 from
-/// `b`), for the eight-wide walk, which carries the same target: one pass and one branch for up
-/// to eight triangles of a leaf. Lane by lane the same float operations as the four-abreast test
-/// (no FMA: the target does not enable it, so nothing is contracted), and the surviving lanes are
-/// finished by watertight_finish in the order a0..a3, b0..b3, with tmax shrinking as they hit:
-/// the same calls, with the same answers, as testing `a` and then `b`. on_hit(lane, hit) gets
-/// lanes 0-7. Only the lanes set in `lanes` are tested (0x0F: `a` alone, with b = a).
+/// intersect_watertight4 on eight triangles in AVX registers, for the eight-wide walk, which
+/// carries the same target. Lane by lane the same float operations as the four-abreast test (no
+/// FMA: the target does not enable it, so nothing is contracted), and the surviving lanes are
+/// finished by watertight_finish in lane order with tmax shrinking as they hit: the same answers
+/// as testing lanes 0-3 and then 4-7 four abreast.
 template <class OnHit>
-[[gnu::target("avx2"), gnu::always_inline]] inline void intersect_watertight4x2(
-    const WatertightRay<float>& s, const TriangleGroup4& a, const TriangleGroup4& b, float tmin,
-    float& tmax, OnHit&& on_hit, unsigned lanes = 0xFFu) {
+[[gnu::target("avx2"), gnu::always_inline]] inline void intersect_watertight8(
+    const WatertightRay<float>& s, const TriangleGroup8& g, float tmin, float& tmax,
+    OnHit&& on_hit) {
     const __m256 ox = _mm256_set1_ps(s.ox), oy = _mm256_set1_ps(s.oy), oz = _mm256_set1_ps(s.oz);
     const __m256 sx = _mm256_set1_ps(s.sx), sy = _mm256_set1_ps(s.sy);
     __m256 x[3], y[3], z[3];
@@ -133,18 +137,11 @@ template <class OnHit>
     const std::size_t kx = s.kx, ky = s.ky, kz = s.kz;
     for (std::size_t k = 0; k < 3; ++k) {
         const std::size_t row = 3 * k;
-        const __m256 cz =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + kz])),
-                                 _mm_load_ps(b.corner[row + kz]), 1);
-        const __m256 cx =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + kx])),
-                                 _mm_load_ps(b.corner[row + kx]), 1);
-        const __m256 cy =
-            _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(a.corner[row + ky])),
-                                 _mm_load_ps(b.corner[row + ky]), 1);
-        z[k] = _mm256_sub_ps(cz, oz);
-        x[k] = _mm256_sub_ps(_mm256_sub_ps(cx, ox), _mm256_mul_ps(sx, z[k]));
-        y[k] = _mm256_sub_ps(_mm256_sub_ps(cy, oy), _mm256_mul_ps(sy, z[k]));
+        z[k] = _mm256_sub_ps(_mm256_load_ps(g.corner[row + kz]), oz);
+        x[k] = _mm256_sub_ps(_mm256_sub_ps(_mm256_load_ps(g.corner[row + kx]), ox),
+                             _mm256_mul_ps(sx, z[k]));
+        y[k] = _mm256_sub_ps(_mm256_sub_ps(_mm256_load_ps(g.corner[row + ky]), oy),
+                             _mm256_mul_ps(sy, z[k]));
     }
     const __m256 zero = _mm256_setzero_ps();
     __m256 negative = zero, positive = zero;
@@ -156,13 +153,11 @@ template <class OnHit>
         negative = _mm256_or_ps(negative, _mm256_cmp_ps(f, zero, _CMP_LT_OQ));
         positive = _mm256_or_ps(positive, _mm256_cmp_ps(f, zero, _CMP_GT_OQ));
     }
-    const __m256i slots = _mm256_insertf128_si256(
-        _mm256_castsi128_si256(_mm_load_si128(reinterpret_cast<const __m128i*>(a.slot))),
-        _mm_load_si128(reinterpret_cast<const __m128i*>(b.slot)), 1);
-    const __m256i pad = _mm256_cmpeq_epi32(slots, _mm256_set1_epi32(-1));
+    const __m256i pad = _mm256_cmpeq_epi32(
+        _mm256_load_si256(reinterpret_cast<const __m256i*>(g.slot)), _mm256_set1_epi32(-1));
     unsigned live = ~unsigned(_mm256_movemask_ps(_mm256_or_ps(_mm256_and_ps(negative, positive),
                                                               _mm256_castsi256_ps(pad)))) &
-                    lanes;
+                    0xFFu;
     if (live == 0) return;
     alignas(32) float v[9][8];
     for (int k = 0; k < 3; ++k) {

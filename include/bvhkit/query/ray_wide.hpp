@@ -9,9 +9,9 @@
 // planes are chosen once per ray (SlabConstants). For a closest hit the hit children are visited
 // nearest first: the others go on a stack with their entry distances, and an entry farther than
 // the closest hit so far is dropped when popped, without reading its node (an any-hit query
-// pushes them unordered). A leaf child is a run of TriangleGroup4s, four triangles tested at once
-// (primitives/triangle_group4.hpp; two groups at once in the eight-wide walk) with the answers of
-// the scalar watertight test.
+// pushes them unordered). A leaf child is a run of triangle groups as wide as the walk: four
+// triangles tested at once in the four-wide walk, eight in the eight-wide one
+// (primitives/triangle_group4.hpp), with the answers of the scalar watertight test.
 //
 // An empty lane has the inverted box (+inf, -inf), which every ray misses; rays with a subnormal
 // direction component (a NaN reciprocal, which the slab test ignores) take the binary tree instead,
@@ -46,8 +46,9 @@ struct alignas(64) RayNode {
 
 template <int W>
 struct WideRayBvh {
-    std::vector<RayNode<W>> nodes;  // nodes[0] is the root; empty for an empty tree
-    std::vector<TriangleGroup4> groups;
+    using Group = TriangleGroup<W == 8 ? 8 : 4>;  // as wide as the walk's registers
+    std::vector<RayNode<W>> nodes;                // nodes[0] is the root; empty for an empty tree
+    std::vector<Group> groups;
 
     bool empty() const { return nodes.empty(); }
 };
@@ -66,7 +67,7 @@ inline bool cpu_has_avx2() {
 }
 
 /// The ray layout of width W of a binary tree whose leaf slot s holds triangle_at_slot(s); its
-/// groups name that triangle index_at_slot(s) (TriangleGroup4::slot), which a hit reports.
+/// groups name that triangle index_at_slot(s) (TriangleGroup::slot), which a hit reports.
 template <int W, class TriangleAtSlot, class IndexAtSlot>
 WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&& triangle_at_slot,
                                 IndexAtSlot&& index_at_slot) {
@@ -101,23 +102,49 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
             n.groups[c] = w.has(c) ? w.groups[c] : 0;
         }
     }
-    out.groups.resize(wide.group_count());
-    for (std::size_t g = 0; g < out.groups.size(); ++g)
-        for (int lane = 0; lane < 4; ++lane) {
-            const std::uint32_t s = wide.group_slots[4 * g + std::size_t(lane)];
+    // collapse_to_wide's groups are of four slots, a leaf child's slots in a run of them padded
+    // at its end only; here each run is cut again into groups of the layout's width, kept in the
+    // runs' order. A group of eight holds the slots of two consecutive groups of four.
+    constexpr std::size_t lanes = WideRayBvh<W>::Group::lanes;
+    std::vector<std::uint32_t> run_of(wide.group_count(), 0), first_of(wide.group_count(), 0);
+    for (const WideNode<float, W>& w : wide.nodes)
+        for (int c = 0; c < W; ++c)
+            if (w.has(c) && w.groups[c] > 0) run_of[w.child[c]] = w.groups[c];
+    std::size_t group_count = 0;
+    for (std::size_t g = 0; g < run_of.size(); g += run_of[g]) {
+        if (run_of[g] == 0) throw Error("make_wide_ray_bvh: a group outside every leaf");
+        first_of[g] = std::uint32_t(group_count);
+        group_count += (4 * std::size_t(run_of[g]) + lanes - 1) / lanes;
+    }
+    out.groups.resize(group_count);
+    for (std::size_t g = 0; g < run_of.size(); g += run_of[g]) {
+        const std::size_t first = first_of[g];
+        const std::size_t slots = 4 * std::size_t(run_of[g]);
+        for (std::size_t k = 0; k < (slots + lanes - 1) / lanes * lanes; ++k) {
+            const std::uint32_t s = k < slots ? wide.group_slots[4 * g + k] : invalid_index;
+            auto& group = out.groups[first + k / lanes];
             if (s == invalid_index)
-                out.groups[g].clear(lane);
+                group.clear(int(k % lanes));
             else
-                out.groups[g].set(lane, triangle_at_slot(s), index_at_slot(s));
+                group.set(int(k % lanes), triangle_at_slot(s), index_at_slot(s));
         }
+    }
+    for (std::size_t i = 0; i < wide.nodes.size(); ++i)
+        for (int c = 0; c < W; ++c)
+            if (out.nodes[i].groups[c] > 0) {
+                const std::uint32_t g = out.nodes[i].child[c];
+                out.nodes[i].child[c] = first_of[g];
+                out.nodes[i].groups[c] =
+                    std::uint32_t((4 * std::size_t(run_of[g]) + lanes - 1) / lanes);
+            }
     return out;
 }
 
 #if defined(__SSE2__)
 namespace detail {
 
-template <class Stats>
-void count_lanes(const TriangleGroup4& g, Stats& stats) {
+template <int L, class Stats>
+void count_lanes(const TriangleGroup<L>& g, Stats& stats) {
     for (std::uint32_t s : g.slot)
         if (s != invalid_index) stats.primitive();
 }
@@ -317,7 +344,7 @@ template <class OnLeaf, class Stats>
         inv_far[a] = _mm256_set1_ps(k.inv_far[a]);
     }
     const RayNode<8>* nodes = tree.nodes.data();
-    const TriangleGroup4* groups = tree.groups.data();
+    const TriangleGroup8* groups = tree.groups.data();
     const auto line = [&](const WideEntry& e) {  // both addresses, then a select
         const char* node = reinterpret_cast<const char*>(nodes + e.child);
         const char* group = reinterpret_cast<const char*>(groups + e.child);
@@ -377,17 +404,18 @@ void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, const Slab
 
 namespace detail {
 
-// The leaf tests of the two queries: operator() for walk4, wide8 for walk8, which tests a leaf's
-// groups two at a time in AVX registers (intersect_watertight4x2); named structs rather than
-// lambdas because wide8 must carry the AVX2 target itself to be inlined into walk8.
-template <class Stats>
+// The leaf tests of the two queries, for groups of Group (TriangleGroup4 or TriangleGroup8):
+// operator() for walk4, wide8 for walk8, which tests a leaf's groups of eight in AVX registers
+// (intersect_watertight8); named structs rather than lambdas because wide8 must carry the AVX2
+// target itself to be inlined into walk8. Each is used only with its width's groups.
+template <class Group, class Stats>
 struct ClosestLeaves {
     static constexpr bool any_hit = false;  // the walk visits hit children nearest first
-    const TriangleGroup4* groups;
+    const Group* groups;
     const WatertightRay<float>& prep;
     Ray<float, 3>& ray;
     TriangleHit<float>& best;
-    const TriangleGroup4*& hit_group;
+    const Group*& hit_group;
     int& hit_lane;
     Stats& stats;
 
@@ -408,31 +436,25 @@ struct ClosestLeaves {
 #if BVHKIT_RAY_AVX2
     [[gnu::target("avx2"), gnu::always_inline]] inline bool wide8(std::uint32_t first,
                                                                   std::uint32_t count) {
-        // Two groups a pass; an odd last one alone, in the lower half.
-        const std::uint32_t end = first + count;
-        for (std::uint32_t g = first; g < end; g += 2) {
-            const bool pair = g + 1 < end;
+        for (std::uint32_t g = first; g < first + count; ++g) {
             count_lanes(groups[g], stats);
-            if (pair) count_lanes(groups[g + 1], stats);
-            intersect_watertight4x2(
-                prep, groups[g], groups[pair ? g + 1 : g], ray.tmin, ray.tmax,
-                [&](int lane, const TriangleHit<float>& h) {
-                    best = h;
-                    hit_group = groups + g + std::uint32_t(lane >> 2);
-                    hit_lane = lane & 3;
-                    return h.t;
-                },
-                pair ? 0xFFu : 0x0Fu);
+            intersect_watertight8(prep, groups[g], ray.tmin, ray.tmax,
+                                  [&](int lane, const TriangleHit<float>& h) {
+                                      best = h;
+                                      hit_group = groups + g;
+                                      hit_lane = lane;
+                                      return h.t;
+                                  });
         }
         return false;
     }
 #endif
 };
 
-template <class Stats>
+template <class Group, class Stats>
 struct AnyLeaves {
     static constexpr bool any_hit = true;  // the walk visits hit children in any order
-    const TriangleGroup4* groups;
+    const Group* groups;
     const WatertightRay<float>& prep;
     const Ray<float, 3>& ray;
     bool& found;
@@ -454,19 +476,14 @@ struct AnyLeaves {
 #if BVHKIT_RAY_AVX2
     [[gnu::target("avx2"), gnu::always_inline]] inline bool wide8(std::uint32_t first,
                                                                   std::uint32_t count) {
-        const std::uint32_t end = first + count;
-        for (std::uint32_t g = first; g < end && !found; g += 2) {
-            const bool pair = g + 1 < end;
+        for (std::uint32_t g = first; g < first + count && !found; ++g) {
             count_lanes(groups[g], stats);
-            if (pair) count_lanes(groups[g + 1], stats);
             float tmax = ray.tmax;
-            intersect_watertight4x2(
-                prep, groups[g], groups[pair ? g + 1 : g], ray.tmin, tmax,
-                [&](int, const TriangleHit<float>& h) {
-                    found = true;
-                    return h.t;
-                },
-                pair ? 0xFFu : 0x0Fu);
+            intersect_watertight8(prep, groups[g], ray.tmin, tmax,
+                                  [&](int, const TriangleHit<float>& h) {
+                                      found = true;
+                                      return h.t;
+                                  });
         }
         return found;
     }
@@ -483,12 +500,12 @@ struct AnyLeaves {
 template <int W, class Stats = NoStats>
 bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
                       const detail::SlabConstants& k, const WatertightRay<float>& prep,
-                      TriangleHit<float>& best, const TriangleGroup4*& hit_group, int& hit_lane,
-                      Stats&& stats = {}) {
+                      TriangleHit<float>& best, const typename WideRayBvh<W>::Group*& hit_group,
+                      int& hit_lane, Stats&& stats = {}) {
     Ray<float, 3> ray = ray_in;
     hit_group = nullptr;
     hit_lane = 0;
-    detail::ClosestLeaves<std::remove_reference_t<Stats>> leaves{
+    detail::ClosestLeaves<typename WideRayBvh<W>::Group, std::remove_reference_t<Stats>> leaves{
         tree.groups.data(), prep, ray, best, hit_group, hit_lane, stats};
     detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return hit_group != nullptr;
@@ -497,7 +514,8 @@ bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
 template <int W, class Stats = NoStats>
 bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray,
                       const WatertightRay<float>& prep, TriangleHit<float>& best,
-                      const TriangleGroup4*& hit_group, int& hit_lane, Stats&& stats = {}) {
+                      const typename WideRayBvh<W>::Group*& hit_group, int& hit_lane,
+                      Stats&& stats = {}) {
     return closest_hit_wide(tree, ray, detail::SlabConstants(ray), prep, best, hit_group, hit_lane,
                             stats);
 }
@@ -511,8 +529,8 @@ bool any_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
     const detail::SlabConstants k(ray_in);
     Ray<float, 3> ray = ray_in;
     bool found = false;
-    detail::AnyLeaves<std::remove_reference_t<Stats>> leaves{tree.groups.data(), prep, ray, found,
-                                                             stats};
+    detail::AnyLeaves<typename WideRayBvh<W>::Group, std::remove_reference_t<Stats>> leaves{
+        tree.groups.data(), prep, ray, found, stats};
     detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return found;
 }
