@@ -109,6 +109,21 @@ TEST(SpatialOrder, IsTheMortonOrderOfTheBatch) {
         expect_order(*set, 0, 1000);
         expect_order(*set, 1, 7);
     }
+    // Runs past the size from which they are sorted in buckets: random points with non-finite
+    // ones, and points bunched in one coarse cell but for one (nearly all in one bucket).
+    std::vector<Vec3f> big, bunched;
+    for (std::size_t i = 0; i < 70000; ++i) {
+        big.push_back(rng.point_in(Aabb3f({-1, -2, -3}, {3, 2, 1})));
+        bunched.push_back(Vec3f(5.0f) + rng.point_in(Aabb3f({0, 0, 0}, {1e-3f, 1e-3f, 1e-3f})));
+    }
+    big.insert(big.begin() + 5, {nan, 0, 0});
+    big.push_back({0, 0, inf});
+    big.push_back(big[17]);  // a duplicate
+    bunched.push_back({100, 100, 100});
+    for (auto* set : {&big, &bunched}) {
+        for (unsigned threads : {1u, 0u}) expect_order(*set, threads);
+        expect_order(*set, 0, spatial_order_run, LastChunkFirst{});
+    }
     expect_order({}, 1);
     expect_order({{nan, nan, nan}}, 1);
     expect_order({{1, 2, 3}}, 1);

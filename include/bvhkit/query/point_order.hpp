@@ -68,13 +68,14 @@ std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const E
     std::vector<Box> chunk_bounds;
     for (std::size_t first = 0; first < n; first += run) {
         const std::size_t count = std::min(run, n - first);
-        // The box of the finite points, a box per chunk then their union: the same box in any
-        // order.
-        chunk_bounds.assign((count + grain - 1) / grain, Box{});
-        exec.parallel_for(count, grain, [&](std::size_t b, std::size_t e) {
-            Box& box = chunk_bounds[b / grain];
-            for (std::size_t k = b; k < e; ++k)
-                if (const V p = point(first + k); is_finite(p)) box.grow(p);
+        // The box of the finite points, a box per chunk of `grain` points then their union: the
+        // same box in any order. Chunk c writes only box c, however the executor splits.
+        const std::size_t chunks = (count + grain - 1) / grain;
+        chunk_bounds.assign(chunks, Box{});
+        exec.parallel_for(chunks, 1, [&](std::size_t b, std::size_t e) {
+            for (std::size_t c = b; c < e; ++c)
+                for (std::size_t k = c * grain; k < std::min(count, (c + 1) * grain); ++k)
+                    if (const V p = point(first + k); is_finite(p)) chunk_bounds[c].grow(p);
         });
         Box bounds;
         for (const Box& box : chunk_bounds) bounds.grow(box);
@@ -104,25 +105,33 @@ std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const E
                 items[k] = key << 32 | i;
             }
         });
-        // A stable sort by the key: one pass on its top eight bits into buckets, then each bucket
-        // sorted on the bits below, least significant first. The same order as one sort from the
-        // least significant digit, but the buckets are sorted in parallel, each small enough to
-        // stay in cache. A 128^3 grid, one / two threads: 102 / 90 ms before, 85 / 50 ms now.
-        constexpr int top = 56;
-        std::array<std::size_t, 257> start{};
-        for (const std::uint64_t item : items) ++start[(item >> top) + 1];
-        for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
-        {
-            std::array<std::size_t, 257> next = start;
-            for (const std::uint64_t item : items) spare[next[item >> top]++] = item;
+        // A stable sort by the key. A large run: one pass on the key's bits 23-30 (the Morton
+        // code's top seven bits and the non-finite flag) into at most 129 buckets, then each
+        // bucket sorted on the bits below, least significant first: the same order as one sort
+        // from the least significant digit, with the buckets sorted in parallel, most of them
+        // small enough to stay in cache (points bunched in a few coarse cells leave few buckets
+        // to share out). A 128^3 grid, one / two threads: 102 / 90 ms as one sort, 85 / 50 ms
+        // so. A small run is one sort: 129 buckets would cost more than they save.
+        constexpr int top = 55;
+        if (count < (std::size_t(1) << 16)) {
+            point_order_detail::radix_sort(items.data(), spare.data(), count, 32, 64);
+        } else {
+            std::array<std::size_t, 257> start{};
+            for (const std::uint64_t item : items) ++start[(item >> top) + 1];
+            for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
+            {
+                std::array<std::size_t, 257> next = start;
+                for (const std::uint64_t item : items) spare[next[item >> top]++] = item;
+            }
+            items.swap(spare);
+            exec.parallel_for(256, 1, [&](std::size_t b, std::size_t e) {
+                for (std::size_t d = b; d < e; ++d)
+                    if (start[d + 1] - start[d] > 1)
+                        point_order_detail::radix_sort(items.data() + start[d],
+                                                       spare.data() + start[d],
+                                                       start[d + 1] - start[d], 32, top);
+            });
         }
-        items.swap(spare);
-        exec.parallel_for(256, 1, [&](std::size_t b, std::size_t e) {
-            for (std::size_t d = b; d < e; ++d)
-                if (start[d + 1] - start[d] > 1)
-                    point_order_detail::radix_sort(items.data() + start[d], spare.data() + start[d],
-                                                   start[d + 1] - start[d], 32, top);
-        });
         exec.parallel_for(count, grain, [&](std::size_t b, std::size_t e) {
             for (std::size_t k = b; k < e; ++k) order[first + k] = std::uint32_t(items[k]);
         });
