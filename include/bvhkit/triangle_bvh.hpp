@@ -182,10 +182,10 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
             centroids.push_back(boxes.back().centroid());
         }
         BuildOptions tree_options = options;
-        // The wide layouts test a leaf's triangles four abreast (TriangleGroup4): leaves priced
-        // in blocks of four. Against one triangle a test (bunny and igea, one thread): the build
-        // about a quarter faster (nodes of four or fewer are leaves without a search), R1-R3
-        // within noise.
+        // The wide layouts test a leaf's triangles four or eight abreast, in groups cut from runs
+        // of four slots (collapse_to_wide): leaves priced in blocks of four. Against one triangle a
+        // test (bunny and igea, one thread): the build about a quarter faster (nodes of four or
+        // fewer are leaves without a search), R1-R3 within noise.
         if (tree_options.costs.leaf_block == 0 && wide_layout()) tree_options.costs.leaf_block = 4;
         bvh_ = build_bvh<T, 3>(boxes, centroids, tree_options, &report_);
         triangle_count_ = count;

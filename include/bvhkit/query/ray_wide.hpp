@@ -419,17 +419,20 @@ struct ClosestLeaves {
     int& hit_lane;
     Stats& stats;
 
+    /// A hit in group g becomes the closest so far, and the range shrinks to it.
+    auto record(std::uint32_t g) {
+        return [this, g](int lane, const TriangleHit<float>& h) {
+            best = h;
+            hit_group = groups + g;
+            hit_lane = lane;
+            return h.t;
+        };
+    }
     bool operator()(std::uint32_t first, std::uint32_t count) {
         const WatertightRay4 r4(prep);  // made per leaf: the eight-wide walk does not need it
         for (std::uint32_t g = first; g < first + count; ++g) {
             count_lanes(groups[g], stats);
-            intersect_watertight4(r4, groups[g], ray.tmin, ray.tmax,
-                                  [&](int lane, const TriangleHit<float>& h) {
-                                      best = h;
-                                      hit_group = groups + g;
-                                      hit_lane = lane;
-                                      return h.t;
-                                  });
+            intersect_watertight4(r4, groups[g], ray.tmin, ray.tmax, record(g));
         }
         return false;
     }
@@ -438,13 +441,7 @@ struct ClosestLeaves {
                                                                   std::uint32_t count) {
         for (std::uint32_t g = first; g < first + count; ++g) {
             count_lanes(groups[g], stats);
-            intersect_watertight8(prep, groups[g], ray.tmin, ray.tmax,
-                                  [&](int lane, const TriangleHit<float>& h) {
-                                      best = h;
-                                      hit_group = groups + g;
-                                      hit_lane = lane;
-                                      return h.t;
-                                  });
+            intersect_watertight8(prep, groups[g], ray.tmin, ray.tmax, record(g));
         }
         return false;
     }
@@ -460,16 +457,19 @@ struct AnyLeaves {
     bool& found;
     Stats& stats;
 
+    /// Any hit ends the search.
+    auto record() {
+        return [this](int, const TriangleHit<float>& h) {
+            found = true;
+            return h.t;
+        };
+    }
     bool operator()(std::uint32_t first, std::uint32_t count) {
         const WatertightRay4 r4(prep);
         for (std::uint32_t g = first; g < first + count && !found; ++g) {
             count_lanes(groups[g], stats);
             float tmax = ray.tmax;
-            intersect_watertight4(r4, groups[g], ray.tmin, tmax,
-                                  [&](int, const TriangleHit<float>& h) {
-                                      found = true;
-                                      return h.t;
-                                  });
+            intersect_watertight4(r4, groups[g], ray.tmin, tmax, record());
         }
         return found;
     }
@@ -479,11 +479,7 @@ struct AnyLeaves {
         for (std::uint32_t g = first; g < first + count && !found; ++g) {
             count_lanes(groups[g], stats);
             float tmax = ray.tmax;
-            intersect_watertight8(prep, groups[g], ray.tmin, tmax,
-                                  [&](int, const TriangleHit<float>& h) {
-                                      found = true;
-                                      return h.t;
-                                  });
+            intersect_watertight8(prep, groups[g], ray.tmin, tmax, record());
         }
         return found;
     }
