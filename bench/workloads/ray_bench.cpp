@@ -35,6 +35,18 @@ struct Workload {
 /// A peer's answer for one ray (hit or occluded); empty without a peer.
 using PeerRay = std::function<bool(const Ray3f&, bool occlusion)>;
 
+/// The time of the row made before for `workload` on the mesh and library of `like`; 0 if none.
+double earlier_ms(const std::vector<Row>& rows, const Row& like, const std::string& workload) {
+    for (auto r = rows.rbegin(); r != rows.rend(); ++r) {
+        const Value* w = r->get("workload");
+        const Value* ms = r->get("ms");
+        if (w && ms && *w == Value(workload) && *r->get("mesh") == *like.get("mesh") &&
+            *r->get("library") == *like.get("library"))
+            return std::get<double>(*ms);
+    }
+    return 0;
+}
+
 /// R2-mt and R3-mt: the batch API (trace, occluded) on every core against the peer's one-ray calls
 /// (Embree's rtcIntersect1 and rtcOccluded1) made from the same chunks on every core.
 template <class RowFor>
@@ -67,15 +79,21 @@ void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
         }
         const double n = double(rays.size());
         const long long threads = have_parallel() ? (long long)hardware_threads() : 1;
+        // scaling: the library's one-thread time for the same rays (row R2 or R3) over this one.
+        const std::string one_thread = std::string(w.name).substr(0, 2);
         Row row = row_for(w.name, "bvhkit");
         row.set("rays", (long long)rays.size()).set("hits", found).set("threads", threads);
         row.set("ms", ms[0]).set("mrays_per_s", n / ms[0] / 1e3);
         if (peer) row.set("speedup", ms[1] / ms[0]);
+        if (const double t = earlier_ms(rows, row, one_thread); t > 0)
+            row.set("scaling", t / ms[0]);
         rows.push_back(row);
         if (peer) {
             Row p = row_for(w.name, "embree3");
             p.set("rays", (long long)rays.size()).set("hits", peer_found).set("threads", threads);
             p.set("ms", ms[1]).set("mrays_per_s", n / ms[1] / 1e3);
+            if (const double t = earlier_ms(rows, p, one_thread); t > 0)
+                p.set("scaling", t / ms[1]);
             rows.push_back(p);
         }
     }
