@@ -1,5 +1,5 @@
 // The four-wide ray layout (query/ray_wide.hpp) against the binary walk, and the four-abreast
-// watertight test (primitives/triangle_group4.hpp) against the scalar one. Both must give the same
+// watertight test (primitives/triangle_group.hpp) against the scalar one. Both must give the same
 // answers to the bit: the wide walk only changes the order in which boxes are opened, and the
 // four-abreast test must reject a lane only when the scalar test would. Whether those answers are
 // right is judged against a long-double reference in ray_exactness_test.cpp, which runs on the
@@ -11,7 +11,7 @@
 
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/mesh/procedural.hpp"
-#include "bvhkit/primitives/triangle_group4.hpp"
+#include "bvhkit/primitives/triangle_group.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "random_geometry.hpp"
 #include "test_support.hpp"

@@ -103,7 +103,7 @@ template <class T>
 /// The watertight test's second half, for the triangle's corners already moved to the ray's origin
 /// and sheared (a*, b*, c*: corners p0, p1, p2; x, y sheared, z along the ray): the edge functions
 /// and t in `Wide`. Shared by the scalar test below and the four-abreast one
-/// (primitives/triangle_group4.hpp), which shears in SIMD and finishes here.
+/// (primitives/triangle_group.hpp), which shears in SIMD and finishes here.
 template <class T>
 inline bool watertight_finish(const WatertightRay<T>& r, T ax_, T ay_, T az, T bx_, T by_, T bz,
                               T cx_, T cy_, T cz, T tmin, T tmax, TriangleHit<T>& hit) {

@@ -11,7 +11,7 @@
 // the closest hit so far is dropped when popped, without reading its node (an any-hit query
 // pushes them unordered). A leaf child is a run of triangle groups as wide as the walk: four
 // triangles tested at once in the four-wide walk, eight in the eight-wide one
-// (primitives/triangle_group4.hpp), with the answers of the scalar watertight test.
+// (primitives/triangle_group.hpp), with the answers of the scalar watertight test.
 //
 // An empty lane has the inverted box (+inf, -inf), which every ray misses; rays with a subnormal
 // direction component (a NaN reciprocal, which the slab test ignores) take the binary tree instead,
@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "bvhkit/bvh/wide_bvh.hpp"
-#include "bvhkit/primitives/triangle_group4.hpp"
+#include "bvhkit/primitives/triangle_group.hpp"
 #include "bvhkit/query/stats.hpp"
 
 #if defined(__SSE2__)
@@ -106,6 +106,10 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
     // at its end only; here each run is cut again into groups of the layout's width, kept in the
     // runs' order. A group of eight holds the slots of two consecutive groups of four.
     constexpr std::size_t lanes = WideRayBvh<W>::Group::lanes;
+    // The groups of the layout's width that a run of `run` groups of four fills.
+    const auto cut = [&](std::uint32_t run) {
+        return std::uint32_t((4 * std::size_t(run) + lanes - 1) / lanes);
+    };
     std::vector<std::uint32_t> run_of(wide.group_count(), 0), first_of(wide.group_count(), 0);
     for (const WideNode<float, W>& w : wide.nodes)
         for (int c = 0; c < W; ++c)
@@ -114,13 +118,13 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
     for (std::size_t g = 0; g < run_of.size(); g += run_of[g]) {
         if (run_of[g] == 0) throw Error("make_wide_ray_bvh: a group outside every leaf");
         first_of[g] = std::uint32_t(group_count);
-        group_count += (4 * std::size_t(run_of[g]) + lanes - 1) / lanes;
+        group_count += cut(run_of[g]);
     }
     out.groups.resize(group_count);
     for (std::size_t g = 0; g < run_of.size(); g += run_of[g]) {
         const std::size_t first = first_of[g];
-        const std::size_t slots = 4 * std::size_t(run_of[g]);
-        for (std::size_t k = 0; k < (slots + lanes - 1) / lanes * lanes; ++k) {
+        const std::size_t slots = 4 * std::size_t(run_of[g]), padded = cut(run_of[g]) * lanes;
+        for (std::size_t k = 0; k < padded; ++k) {
             const std::uint32_t s = k < slots ? wide.group_slots[4 * g + k] : invalid_index;
             auto& group = out.groups[first + k / lanes];
             if (s == invalid_index)
@@ -134,8 +138,7 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
             if (out.nodes[i].groups[c] > 0) {
                 const std::uint32_t g = out.nodes[i].child[c];
                 out.nodes[i].child[c] = first_of[g];
-                out.nodes[i].groups[c] =
-                    std::uint32_t((4 * std::size_t(run_of[g]) + lanes - 1) / lanes);
+                out.nodes[i].groups[c] = cut(run_of[g]);
             }
     return out;
 }
