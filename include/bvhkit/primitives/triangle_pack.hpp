@@ -86,17 +86,44 @@ inline F4 ratio01(F4 n, F4 d) {
 }
 #endif
 
-/// Squared distance from p to the triangle (a, b, c), each lane its own triangle.
+/// What the distance below needs of a triangle alone, apart from its corners a and b: edges,
+/// their products and the normal. The pack keeps them, so that a query computes only what
+/// depends on the point (a third of the work it did from the corners alone).
 template <class L>
-inline L triangle_distance_squared(const L a[3], const L b[3], const L c[3], const L p[3]) {
-    const auto dot = [](const L* x, const L* y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
-    L ab[3], ac[3], bc[3], ap[3], bp[3];
+struct TriangleTerms {
+    L ab[3], ac[3], bc[3], n[3];
+    L aa, cc, ac_ab, bc_bc, det, nn;
+};
+
+template <class L>
+inline L dot3(const L* x, const L* y) {
+    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+}
+
+/// The terms of the triangle (a, b, c), each lane its own triangle.
+template <class L>
+inline TriangleTerms<L> triangle_terms(const L a[3], const L b[3], const L c[3]) {
+    TriangleTerms<L> k;
+    for (int i = 0; i < 3; ++i) k.ab[i] = b[i] - a[i], k.ac[i] = c[i] - a[i], k.bc[i] = c[i] - b[i];
+    k.aa = dot3(k.ab, k.ab), k.cc = dot3(k.ac, k.ac), k.ac_ab = dot3(k.ab, k.ac);
+    k.bc_bc = dot3(k.bc, k.bc);
+    k.det = k.aa * k.cc - k.ac_ab * k.ac_ab;
     for (int i = 0; i < 3; ++i) {
-        ab[i] = b[i] - a[i], ac[i] = c[i] - a[i], bc[i] = c[i] - b[i];
-        ap[i] = p[i] - a[i], bp[i] = p[i] - b[i];
+        const int j = (i + 1) % 3, m = (i + 2) % 3;
+        k.n[i] = k.ab[j] * k.ac[m] - k.ab[m] * k.ac[j];
     }
-    const L d1 = dot(ab, ap), d2 = dot(ac, ap);
-    const L aa = dot(ab, ab), cc = dot(ac, ac), ac_ab = dot(ab, ac);
+    k.nn = dot3(k.n, k.n);
+    return k;
+}
+
+/// Squared distance from p to the triangle with corners a, b and terms k, each lane its own
+/// triangle.
+template <class L>
+inline L triangle_distance_squared(const L a[3], const L b[3], const TriangleTerms<L>& k,
+                                   const L p[3]) {
+    L ap[3], bp[3];
+    for (int i = 0; i < 3; ++i) ap[i] = p[i] - a[i], bp[i] = p[i] - b[i];
+    const L d1 = dot3(k.ab, ap), d2 = dot3(k.ac, ap);
     // The closest point of the segment from `from` along `edge`, at (p - from) = `rel`.
     const auto segment = [&](const L* rel, const L* edge, L along, L length2) {
         const L t = ratio01(along, length2);
@@ -107,27 +134,31 @@ inline L triangle_distance_squared(const L a[3], const L b[3], const L c[3], con
         }
         return s;
     };
-    const L edges = min_of(min_of(segment(ap, ab, d1, aa), segment(ap, ac, d2, cc)),
-                           segment(bp, bc, dot(bc, bp), dot(bc, bc)));
+    const L edges = min_of(min_of(segment(ap, k.ab, d1, k.aa), segment(ap, k.ac, d2, k.cc)),
+                           segment(bp, k.bc, dot3(k.bc, bp), k.bc_bc));
     // The projection's barycentrics, times det (Cramer's rule on the 2x2 normal equations).
-    const L det = aa * cc - ac_ab * ac_ab;
-    const L u = cc * d1 - ac_ab * d2, v = aa * d2 - ac_ab * d1;
-    const auto inside = (det > L(0)) & (u >= L(0)) & (v >= L(0)) & (u + v <= det);
-    L n[3];
-    for (int i = 0; i < 3; ++i) {
-        const int j = (i + 1) % 3, k = (i + 2) % 3;
-        n[i] = ab[j] * ac[k] - ab[k] * ac[j];
-    }
-    const L h = dot(n, ap);
-    const L plane = h * (h / dot(n, n));  // h * h could overflow where the quotient does not
+    const L u = k.cc * d1 - k.ac_ab * d2, v = k.aa * d2 - k.ac_ab * d1;
+    const auto inside = (k.det > L(0)) & (u >= L(0)) & (v >= L(0)) & (u + v <= k.det);
+    const L h = dot3(k.n, ap);
+    const L plane = h * (h / k.nn);  // h * h could overflow where the quotient does not
     return select(inside, min_of(edges, plane), edges);
+}
+
+/// Squared distance from p to the triangle (a, b, c), each lane its own triangle.
+template <class L>
+inline L triangle_distance_squared(const L a[3], const L b[3], const L c[3], const L p[3]) {
+    return triangle_distance_squared(a, b, triangle_terms(a, b, c), p);
 }
 
 }  // namespace pack_detail
 
 template <class T>
 struct alignas(16) TrianglePack4 {
-    T corner[3][3][4];      // corner[vertex][axis][lane]
+    T corner[3][3][4];  // corner[vertex][axis][lane]
+    // pack_detail::TriangleTerms of each lane, made by set(): the edges ab, ac, bc and the normal
+    // n (vector[0..11][lane]: ab x, y, z, ac, bc, n), then aa, cc, ac_ab, bc_bc, det, nn.
+    T vector[12][4];
+    T scalar[6][4];
     std::uint32_t slot[4];  // the caller's index of each lane's triangle; invalid_index: empty
     std::uint32_t exact_lanes = 0;  // bit per lane: to be measured exactly by the caller (set())
 
@@ -135,6 +166,10 @@ struct alignas(16) TrianglePack4 {
         for (auto& v : corner)
             for (auto& a : v)
                 for (T& x : a) x = T(0);
+        for (auto& v : vector)
+            for (T& x : v) x = T(0);
+        for (auto& v : scalar)
+            for (T& x : v) x = T(0);
         for (auto& s : slot) s = invalid_index;
     }
 
@@ -143,6 +178,15 @@ struct alignas(16) TrianglePack4 {
         for (int k = 0; k < 3; ++k)
             for (int a = 0; a < 3; ++a) corner[k][a][lane] = (*v[k])[a];
         slot[lane] = s;
+        const T c0[3] = {t.p0[0], t.p0[1], t.p0[2]}, c1[3] = {t.p1[0], t.p1[1], t.p1[2]},
+                c2[3] = {t.p2[0], t.p2[1], t.p2[2]};
+        const pack_detail::TriangleTerms<T> terms = pack_detail::triangle_terms<T>(c0, c1, c2);
+        for (int a = 0; a < 3; ++a) {
+            vector[a][lane] = terms.ab[a], vector[3 + a][lane] = terms.ac[a];
+            vector[6 + a][lane] = terms.bc[a], vector[9 + a][lane] = terms.n[a];
+        }
+        const T scalars[6] = {terms.aa, terms.cc, terms.ac_ab, terms.bc_bc, terms.det, terms.nn};
+        for (int i = 0; i < 6; ++i) scalar[i][lane] = scalars[i];
         // Measured exactly by the caller: a sliver (sin^2 of its angle at p0 below 1e-2: the
         // inside test's rounding grows as 1/sin^2 near the edge p1-p2, past the caller's slack
         // below 1e-3; 0.02% of igea's triangles, 0.08% of the dragon's are flagged), and a
@@ -173,12 +217,18 @@ struct alignas(16) TrianglePack4 {
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>) {
             using pack_detail::F4;
-            F4 a[3], b[3], c[3], q[3];
+            F4 a[3], b[3], q[3];
+            pack_detail::TriangleTerms<F4> k;
             for (int i = 0; i < 3; ++i) {
                 a[i] = _mm_load_ps(corner[0][i]), b[i] = _mm_load_ps(corner[1][i]);
-                c[i] = _mm_load_ps(corner[2][i]), q[i] = F4(p[i]);
+                q[i] = F4(p[i]);
+                k.ab[i] = _mm_load_ps(vector[i]), k.ac[i] = _mm_load_ps(vector[3 + i]);
+                k.bc[i] = _mm_load_ps(vector[6 + i]), k.n[i] = _mm_load_ps(vector[9 + i]);
             }
-            const F4 dist = pack_detail::triangle_distance_squared(a, b, c, q);
+            k.aa = _mm_load_ps(scalar[0]), k.cc = _mm_load_ps(scalar[1]);
+            k.ac_ab = _mm_load_ps(scalar[2]), k.bc_bc = _mm_load_ps(scalar[3]);
+            k.det = _mm_load_ps(scalar[4]), k.nn = _mm_load_ps(scalar[5]);
+            const F4 dist = pack_detail::triangle_distance_squared(a, b, k, q);
             _mm_storeu_ps(d, dist.v);
             const unsigned near =
                 unsigned(_mm_movemask_ps(_mm_cmple_ps(dist.v, _mm_set1_ps(bound))));
@@ -206,11 +256,16 @@ struct alignas(16) TrianglePack4 {
 
     /// The squared distance of one lane's triangle from p, by the same formula, lane alone.
     T distance_squared(int lane, const Vec<T, 3>& p) const {
-        T a[3], b[3], c[3], q[3];
-        for (int i = 0; i < 3; ++i)
-            a[i] = corner[0][i][lane], b[i] = corner[1][i][lane], c[i] = corner[2][i][lane],
-            q[i] = p[i];
-        return pack_detail::triangle_distance_squared(a, b, c, q);
+        T a[3], b[3], q[3];
+        pack_detail::TriangleTerms<T> k;
+        for (int i = 0; i < 3; ++i) {
+            a[i] = corner[0][i][lane], b[i] = corner[1][i][lane], q[i] = p[i];
+            k.ab[i] = vector[i][lane], k.ac[i] = vector[3 + i][lane];
+            k.bc[i] = vector[6 + i][lane], k.n[i] = vector[9 + i][lane];
+        }
+        k.aa = scalar[0][lane], k.cc = scalar[1][lane], k.ac_ab = scalar[2][lane];
+        k.bc_bc = scalar[3][lane], k.det = scalar[4][lane], k.nn = scalar[5][lane];
+        return pack_detail::triangle_distance_squared(a, b, k, q);
     }
 };
 
