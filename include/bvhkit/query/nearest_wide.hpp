@@ -81,20 +81,19 @@ void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>
                 if (node.has(c)) stats.node();
             const unsigned leaves = wide_detail::leaf_children(node) & within;
             // Ask for every child within the radius before opening any: the leaves' triangles
-            // and the inner nodes' lines load together instead of one after another. Without
-            // jumps: a lane out of the radius asks for the node at hand, which is loaded already.
-            // (Addresses are integers here: a lane's index is not always an index into nodes.
-            // Choices by masks, not ?:, which GCC compiled to jumps mispredicted ~45 times a
-            // query.)
-            const auto node_base = reinterpret_cast<std::uintptr_t>(nodes);
-            for (int c = 0; c < 4; ++c) {
-                std::uintptr_t line = node_base + std::uintptr_t(node.child[c]) * sizeof(node);
-                if constexpr (requires { on_leaf.address(0u); }) {
-                    const std::uintptr_t leaf = std::uintptr_t(0) - (leaves >> c & 1u);
-                    line ^= (line ^ on_leaf.address(node.child[c])) & leaf;
-                }
-                const std::uintptr_t out = std::uintptr_t(0) - (~within >> c & 1u);
-                line ^= (line ^ reinterpret_cast<std::uintptr_t>(&node)) & out;
+            // and the inner nodes' lines load together instead of one after another. (The lanes'
+            // addresses chosen without jumps, for all four lanes, cost ~90 instructions a node,
+            // a fifth of a grid query's: 3-5% slower on a grid around spot, the same on random
+            // points around igea and the displaced 1.3M-triangle sphere.)
+            for (unsigned m = within; m; m &= m - 1) {
+                const int c = __builtin_ctz(m);
+                std::uintptr_t line;
+                if (!(leaves >> c & 1u))
+                    line = reinterpret_cast<std::uintptr_t>(nodes + node.child[c]);
+                else if constexpr (requires { on_leaf.address(0u); })
+                    line = on_leaf.address(node.child[c]);
+                else
+                    continue;
                 const char* at = reinterpret_cast<const char*>(line);
                 __builtin_prefetch(at);
                 __builtin_prefetch(at + 64);
