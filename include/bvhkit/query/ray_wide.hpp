@@ -260,12 +260,17 @@ struct alignas(16) SlabConstants {
         // Lane 3 goes from 0 along 1 through [-inf, inf]: it restricts nothing.
         const __m128 lo = _mm_setr_ps(box.min[0], box.min[1], box.min[2], -inf);
         const __m128 hi = _mm_setr_ps(box.max[0], box.max[1], box.max[2], inf);
+        const __m128 o = _mm_load_ps(origin);
+        // A ray that starts in the box at tmin = 0 meets it (the walk's clip keeps such a box:
+        // both plane distances have the right sign whatever their rounding). Rays cast from
+        // inside a model's bounds, the incoherent sets among them, skip the clip below.
+        const int inside = _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(lo, o), _mm_cmple_ps(o, hi)));
+        if (inside == 15 && tmin == 0.0f) return true;
         // 1 / d has d's sign, -0 included (1 / -0 = -inf): negative axes take the max as near.
         const __m128 inverse = _mm_load_ps(inv);
         const __m128 negative = _mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(inverse), 31));
         const __m128 near_plane = _mm_or_ps(_mm_and_ps(negative, hi), _mm_andnot_ps(negative, lo));
         const __m128 far_plane = _mm_or_ps(_mm_and_ps(negative, lo), _mm_andnot_ps(negative, hi));
-        const __m128 o = _mm_load_ps(origin);
         // As in the walks, maxps/minps keep their second operand when the first is NaN (0 * inf).
         __m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near_plane, o), inverse), _mm_set1_ps(tmin));
         __m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far_plane, o), _mm_load_ps(inv_far)),
