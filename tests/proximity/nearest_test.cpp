@@ -648,6 +648,31 @@ TEST(NearestWide, WalksFromAStartingTriangleGiveTheSameAnswers) {
     check_walks_from_a_start(with_a_nan(moved<float>(torus, 1e6f)), 33);
     check_walks_from_a_start(with_a_nan(moved<float>(torus, 0, 1e-6f)), 34);
     check_walks_from_a_start(with_a_nan(moved<double>(torus, 1e9, 1e12)), 35);
+    // Squared distances below T's least normal: the walk's radius is kept in the packs' units.
+    check_walks_from_a_start(with_a_nan(moved<float>(torus, 0, 1e-36f)), 36);
+    check_walks_from_a_start(with_a_nan(moved<double>(torus, 0, 1e-300)), 37);
+}
+
+// A mesh so small that its squared distances underflow T (float 1e-36, double 1e-300): the answer
+// is still the triangle that is nearest by the accurate distance, computed in a wider type.
+template <class T>
+void check_tiny_mesh(T scale, std::uint64_t seed) {
+    const auto tris = moved<T>(make_torus(24, 12), T(0), scale);
+    const ClosestPointMesh<T> mesh(tris);
+    const auto points = query_points(tris, test::scaled(400, 10), seed);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const Vec<T, 3>& p = points[i];
+        AccurateScalar<T> want = std::numeric_limits<AccurateScalar<T>>::infinity();
+        for (const auto& t : tris) want = std::min(want, distance_squared_accurate(t, p));
+        const MeshPoint<T> got = mesh.closest_point(p);
+        ASSERT_TRUE(got) << i;
+        ASSERT_EQ(distance_squared_accurate(tris[got.triangle], p), want) << i;
+    }
+}
+
+TEST(NearestWide, TinyMeshesEqualBruteForce) {
+    check_tiny_mesh<float>(1e-36f, 38);
+    check_tiny_mesh<double>(1e-300, 39);
 }
 
 TEST(NearestWide, FuzzAgainstBruteForce) {

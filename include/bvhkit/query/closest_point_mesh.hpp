@@ -154,20 +154,27 @@ class ClosestPointMesh {
         // the slack of widened() of the true one, so a candidate can still win while its estimate
         // is within twice that slack of the best estimate. Slivers (a pack's exact_lanes) and
         // points too far for the pack's formula are measured at once. The packs hold the mesh
-        // scaled to unit magnitude (see build): p likewise.
-        W best2 = std::numeric_limits<W>::infinity();  // accurate
-        T best_estimate = std::numeric_limits<T>::infinity();
+        // scaled to unit magnitude (see build): p likewise, and the estimates and the search
+        // radius are kept in those units, where the squared distances of a mesh 1e-36 across
+        // (float) do not sink below T's least normal. The node walk gets the radius unscaled.
+        W best2 = std::numeric_limits<W>::infinity();          // accurate, unscaled
+        T best_estimate = std::numeric_limits<T>::infinity();  // scaled
         auto& candidates = scratch.candidates;
         candidates.clear();
-        const T limit2 = widened(max_distance_squared);
-        T search2 = limit2;
+        const T limit2 = widened_scaled(max_distance_squared * pack_scale_ * pack_scale_);
+        T search2 = limit2;  // scaled
         const Vec<T, 3> ps = p * pack_scale_;
         // The pack formula squares lengths twice over: beyond 2^(max_exponent / 4) from the
         // (unit) mesh it would overflow, and every lane is measured.
         const bool scaled_ok =
             max_component(abs(ps)) < std::ldexp(T(1), std::numeric_limits<T>::max_exponent / 4);
-        const T unscale = T(1) / pack_scale_;  // exact: a power of two
-        const T unscale2 = unscale * unscale;
+        const T unscale = T(1) / pack_scale_;  // exact: a power of two (its square may not be)
+        // The radius for the node walk's unscaled boxes: search2 unscaled, exactly, unless that
+        // falls below 4 least normals, where rounding could drop a box within reach.
+        const auto box_radius = [&] {
+            return std::max(search2 * unscale * unscale, T(4) * std::numeric_limits<T>::min());
+        };
+        T box_radius2 = box_radius();
         // The best triangle's answer is kept, not measured again at the end: the triangle
         // measured is tris_[s] bit for bit (a pack's copy only when it unscales exactly).
         AccurateClosestPoint<T> best_point;
@@ -184,9 +191,10 @@ class ClosestPointMesh {
                 best = {s, T(d2)}, best2 = d2, best_point = c;
         };
         const auto tighten = [&] {
-            T bound = std::min(limit2, widened(widened(best_estimate)));
-            if (best) bound = std::min(bound, widened(best.distance_squared));
+            T bound = std::min(limit2, widened_scaled(widened_scaled(best_estimate)));
+            if (best) bound = std::min(bound, widened_scaled(T(best2 * pack_scale_ * pack_scale_)));
             search2 = bound;
+            box_radius2 = box_radius();
         };
         const auto open_leaf = [&](std::uint32_t first, std::uint32_t groups) {
             for (std::uint32_t g = first; g < first + groups; ++g) {
@@ -195,8 +203,7 @@ class ClosestPointMesh {
                     if (pack.slot[l] != invalid_index) stats.primitive();
                 T d[4];
                 const unsigned lanes =
-                    scaled_ok ? pack.lanes_within(ps, search2 * pack_scale_ * pack_scale_, d)
-                              : pack.used_lanes();
+                    scaled_ok ? pack.lanes_within(ps, search2, d) : pack.used_lanes();
                 const unsigned now = scaled_ok ? lanes & pack.exact_lanes : lanes;
                 bool changed = false;
                 for (unsigned m = now; m; m &= m - 1) {
@@ -208,7 +215,7 @@ class ClosestPointMesh {
                 }
                 for (unsigned m = lanes & ~now; m; m &= m - 1) {
                     const int l = __builtin_ctz(m);
-                    const T estimate = d[l] * unscale2;
+                    const T estimate = d[l];
                     candidates.push_back({estimate, pack.slot[l]});
                     if (estimate < best_estimate) best_estimate = estimate, changed = true;
                 }
@@ -229,16 +236,19 @@ class ClosestPointMesh {
             // more than it saved). The bound is widened twice, as a pack's estimate is: its
             // rounding is a few ulps of the distance, far inside one widening.
             const Triangle<T>& t = tris_[start];
-            const T corner2 = std::min(
-                {length_squared(p - t.p0), length_squared(p - t.p1), length_squared(p - t.p2)});
-            search2 = std::min(search2, widened(widened(corner2)));
+            const auto scaled2 = [&](const Vec<T, 3>& corner) {
+                return length_squared((p - corner) * pack_scale_);
+            };
+            const T corner2 = std::min({scaled2(t.p0), scaled2(t.p1), scaled2(t.p2)});
+            search2 = std::min(search2, widened_scaled(widened_scaled(corner2)));
+            box_radius2 = box_radius();
         }
-        nearest_wide(wide_, p, scratch, search2, OpenLeaf{open_leaf, packs_.data()}, stats);
+        nearest_wide(wide_, p, scratch, box_radius2, OpenLeaf{open_leaf, packs_.data()}, stats);
         // Nearest estimate first; stop at the first whose estimate rounding cannot bring below
         // the best measured so far.
         std::sort(candidates.begin(), candidates.end());
         for (const auto& [estimate, s] : candidates) {
-            if (best && estimate > widened(best.distance_squared)) break;
+            if (best && estimate > widened_scaled(T(best2 * pack_scale_ * pack_scale_))) break;
             if (estimate > search2) break;
             measure(s, tris_[s]);
         }
@@ -306,6 +316,7 @@ class ClosestPointMesh {
             magnitude > T(0) && std::isfinite(magnitude)
                 ? std::ldexp(T(1), std::clamp(-std::ilogb(magnitude), -max_shift, max_shift))
                 : T(1);
+        scaled_longest_edge_ = longest_edge_ * pack_scale_;
         // A power of two scales exactly unless a coordinate falls into denormals; then the walk
         // measures from tris_ instead.
         packs_.assign(wide_.group_count(), TrianglePack4<T>{});
@@ -328,10 +339,14 @@ class ClosestPointMesh {
     /// still be within r; tests/proximity/triangle_pack_test.cpp bounds a pack's distance error by
     /// 560 ulps of that length on triangles not flagged as slivers (slivers are always measured).
     /// The slack is 1024 ulps of it.
-    T widened(T radius2) const {
+    T widened(T radius2) const { return widen(radius2, longest_edge_); }
+    /// widened() in the packs' units (the mesh times pack_scale_): the same value times
+    /// pack_scale_^2, bit for bit, where neither under- nor overflows.
+    T widened_scaled(T radius2) const { return widen(radius2, scaled_longest_edge_); }
+    static T widen(T radius2, T longest_edge) {
         if (!(radius2 >= T(0) && radius2 < std::numeric_limits<T>::infinity())) return radius2;
         const T r = std::sqrt(radius2);
-        const T slack = T(1024) * std::numeric_limits<T>::epsilon() * (r + longest_edge_);
+        const T slack = T(1024) * std::numeric_limits<T>::epsilon() * (r + longest_edge);
         return (r + slack) * (r + slack);
     }
     /// The squared distance to the triangle in a leaf slot, for nearest().
@@ -396,6 +411,7 @@ class ClosestPointMesh {
     std::vector<AccurateFrame<T>> frames_;  // leaf-slot order, float meshes only (see above)
     T longest_edge_ = 0;                    // the mesh's longest edge (finite triangles)
     T pack_scale_ = 1;                      // packs_ hold the triangles times this (a power of 2)
+    T scaled_longest_edge_ = 0;             // longest_edge_ * pack_scale_
     bool packs_unscale_exactly_ = true;     // and dividing by it gives tris_ back, bit for bit
     std::vector<std::uint32_t> slot_of_triangle_;  // mesh triangle -> leaf slot (or invalid)
     std::uint32_t triangle_slots_ = 0;             // bvh_.primitive_indices.size()
