@@ -653,13 +653,14 @@ TEST(NearestWide, WalksFromAStartingTriangleGiveTheSameAnswers) {
     check_walks_from_a_start(with_a_nan(moved<double>(torus, 0, 1e-300)), 37);
 }
 
-// A mesh so small that its squared distances underflow T (float 1e-36, double 1e-300): the answer
-// is still the triangle that is nearest by the accurate distance, computed in a wider type.
+// The answer is the triangle nearest by the accurate distance (in a wider type than T), also when
+// the walk starts from the previous point's answer.
 template <class T>
-void check_tiny_mesh(T scale, std::uint64_t seed) {
-    const auto tris = moved<T>(make_torus(24, 12), T(0), scale);
+void check_accurately_nearest(const std::vector<Triangle<T>>& tris,
+                              const std::vector<Vec<T, 3>>& points) {
     const ClosestPointMesh<T> mesh(tris);
-    const auto points = query_points(tris, test::scaled(400, 10), seed);
+    NearestScratch<T> scratch;
+    MeshPoint<T> previous;
     for (std::size_t i = 0; i < points.size(); ++i) {
         const Vec<T, 3>& p = points[i];
         AccurateScalar<T> want = std::numeric_limits<AccurateScalar<T>>::infinity();
@@ -667,12 +668,38 @@ void check_tiny_mesh(T scale, std::uint64_t seed) {
         const MeshPoint<T> got = mesh.closest_point(p);
         ASSERT_TRUE(got) << i;
         ASSERT_EQ(distance_squared_accurate(tris[got.triangle], p), want) << i;
+        const MeshPoint<T> from = mesh.closest_point(p, previous, scratch);
+        ASSERT_EQ(from.triangle, got.triangle) << i;
+        previous = got;
     }
+}
+
+// A mesh so small that its squared distances underflow T (float 1e-36, double 1e-300).
+template <class T>
+void check_tiny_mesh(T scale, std::uint64_t seed) {
+    const auto tris = moved<T>(make_torus(24, 12), T(0), scale);
+    check_accurately_nearest(tris, query_points(tris, test::scaled(400, 10), seed));
 }
 
 TEST(NearestWide, TinyMeshesEqualBruteForce) {
     check_tiny_mesh<float>(1e-36f, 38);
     check_tiny_mesh<double>(1e-300, 39);
+}
+
+// A unit torus and one point triangle 1e25 away (double: 1e160): the packs' scale follows the
+// far corner, and the torus's squared distances in the packs' units sink below T's least normal.
+template <class T>
+void check_far_point_triangle(T far, std::uint64_t seed) {
+    const auto torus = mesh_triangles<T>(make_torus(24, 12));
+    auto tris = torus;
+    const Vec<T, 3> corner(far, T(0), T(0));
+    tris.push_back({corner, corner, corner});
+    check_accurately_nearest(tris, query_points(torus, test::scaled(400, 10), seed));
+}
+
+TEST(NearestWide, MeshFarLargerThanItsNearestTriangles) {
+    check_far_point_triangle<float>(1e25f, 40);
+    check_far_point_triangle<double>(1e160, 41);
 }
 
 TEST(NearestWide, FuzzAgainstBruteForce) {

@@ -144,7 +144,8 @@ class ClosestPointMesh {
     MeshPoint<T> closest_point_from(const Vec<T, 3>& p, std::uint32_t start,
                                     NearestScratch<T>& scratch, T max_distance_squared,
                                     Stats&& stats) const {
-        if (!is_finite(p)) return {};
+        // No distance is within a negative or NaN limit (and the walk would still measure).
+        if (!is_finite(p) || !(max_distance_squared >= T(0))) return {};
         using W = AccurateScalar<T>;
         NearestSlot<T> best;
         // Candidates are measured accurately, in W (closest_point_accurate), and compared there:
@@ -341,8 +342,13 @@ class ClosestPointMesh {
     /// The slack is 1024 ulps of it.
     T widened(T radius2) const { return widen(radius2, longest_edge_); }
     /// widened() in the packs' units (the mesh times pack_scale_): the same value times
-    /// pack_scale_^2, bit for bit, where neither under- nor overflows.
-    T widened_scaled(T radius2) const { return widen(radius2, scaled_longest_edge_); }
+    /// pack_scale_^2, bit for bit, where neither under- nor overflows; and never below 8 least
+    /// normals, where the slack itself would have sunk (a mesh 1e25 across whose nearest
+    /// triangles are 1e-25 of that: its scaled squared distances underflow).
+    T widened_scaled(T radius2) const {
+        const T w = widen(radius2, scaled_longest_edge_);
+        return w >= T(0) ? std::max(w, T(8) * std::numeric_limits<T>::min()) : w;
+    }
     static T widen(T radius2, T longest_edge) {
         if (!(radius2 >= T(0) && radius2 < std::numeric_limits<T>::infinity())) return radius2;
         const T r = std::sqrt(radius2);
