@@ -654,7 +654,10 @@ TEST(NearestWide, WalksFromAStartingTriangleGiveTheSameAnswers) {
 }
 
 // The answer is the triangle nearest by the accurate distance (in a wider type than T), also when
-// the walk starts from the previous point's answer.
+// the walk starts from the previous point's answer. What is judged here is the walk's pruning at
+// extreme scales, so the reference measures every triangle with the same accurate function the
+// mesh uses; that function itself is judged against exact rationals in
+// closest_point_accuracy_test.cpp.
 template <class T>
 void check_accurately_nearest(const std::vector<Triangle<T>>& tris,
                               const std::vector<Vec<T, 3>>& points) {

@@ -89,23 +89,6 @@ inline void segment_2d(W x, W y, W sx, W sy, W ex, W ey, W& t, W& d2) {
 
 }  // namespace closest_detail
 
-/// The closest point of the triangle to p without the cancellation of Ericson's region tests,
-/// whose error grows with the triangle's aspect ratio (0.5% in distance on a 0.1 x 122 float
-/// triangle). In W = AccurateScalar<T>: the longest edge, from its first corner A, gives the unit
-/// x axis; the third corner's offset from A, less its part along x (taken off twice, so that the
-/// axes stay orthogonal however thin the triangle), the unit y axis; their cross product z. In
-/// that frame p and the triangle are 2D plus p's height z; the projection is inside when it is on
-/// the inner side of the three edges, else the nearest of the three edges (clamped segments)
-/// gives the point. Every step rounds in proportion to the lengths it handles, never to a
-/// difference that cancels, so the result is the exact distance to a triangle whose corners moved
-/// by a few ulps (of W) of its size. The bound, with d the returned distance, d_true the exact
-/// one, L the longest edge, eps_T and eps_W the epsilons of T and W:
-///     |d - d_true| <= 2 eps_T d + 96 eps_W (d + L)
-/// (64 of the 96 for the cut between thin triangles and segments; the most measured against
-/// exact rationals is 1.3 for float and 38 for double: docs/accuracy.md). The distance is
-/// returned in W, the point and barycentrics rounded from W. Where long double is double (MSVC,
-/// AArch64 Apple), eps_W for double meshes is double's, and coordinates must stay within 1e150.
-/// Degenerate triangles: a segment (the longest edge holds the third corner) or a point.
 /// Everything closest_point_accurate computes of a triangle before it looks at the point: which
 /// edge is longest, the frame's axes x and y, the longest edge's length l1 and the third corner
 /// at (cx, cy). A caller that measures the same triangles again and again (ClosestPointMesh)
@@ -229,7 +212,24 @@ AccurateClosestPoint<T> closest_point_accurate(const Triangle<T>& tri, const Acc
     return r;
 }
 
-/// The closest point itself (the frame made here).
+/// The closest point of the triangle to p without the cancellation of Ericson's region tests,
+/// whose error grows with the triangle's aspect ratio (0.5% in distance on a 0.1 x 122 float
+/// triangle). In W = AccurateScalar<T>: the longest edge, from its first corner A, gives the unit
+/// x axis; the third corner's offset from A, less its part along x (taken off twice, so that the
+/// axes stay orthogonal however thin the triangle), the unit y axis; their cross product z. In
+/// that frame p and the triangle are 2D plus p's height z; the projection is inside when it is on
+/// the inner side of the three edges, else the nearest of the three edges (clamped segments)
+/// gives the point. Every step rounds in proportion to the lengths it handles, never to a
+/// difference that cancels, so the result is the exact distance to a triangle whose corners moved
+/// by a few ulps (of W) of its size. The bound, with d the returned distance, d_true the exact
+/// one, L the longest edge, eps_T and eps_W the epsilons of T and W:
+///     |d - d_true| <= 2 eps_T d + 96 eps_W (d + L)
+/// (64 of the 96 for the cut between thin triangles and segments; the most measured against
+/// exact rationals is 1.3 for float and 38 for double: docs/accuracy.md). The distance is
+/// returned in W, the point and barycentrics rounded from W. Where long double is double (MSVC,
+/// AArch64 Apple), eps_W for double meshes is double's, and coordinates must stay within 1e150.
+/// Degenerate triangles: a segment (the longest edge holds the third corner) or a point.
+/// (The frame made here: see AccurateFrame above.)
 template <class T>
 AccurateClosestPoint<T> closest_point_accurate(const Triangle<T>& tri, const Vec<T, 3>& p) {
     return closest_point_accurate(tri, accurate_frame(tri), p);

@@ -144,12 +144,6 @@ inline L triangle_distance_squared(const L a[3], const L b[3], const TriangleTer
     return select(inside, min_of(edges, plane), edges);
 }
 
-/// Squared distance from p to the triangle (a, b, c), each lane its own triangle.
-template <class L>
-inline L triangle_distance_squared(const L a[3], const L b[3], const L c[3], const L p[3]) {
-    return triangle_distance_squared(a, b, triangle_terms(a, b, c), p);
-}
-
 }  // namespace pack_detail
 
 template <class T>

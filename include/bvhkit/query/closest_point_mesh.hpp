@@ -295,8 +295,9 @@ class ClosestPointMesh {
             if (bvh_.primitive_indices[s] < triangle_count_)
                 slot_of_triangle_[bvh_.primitive_indices[s]] = s;
         // A float mesh keeps each triangle's accurate frame (80 bytes; a double mesh's, in long
-        // double, would take 144): a query measures ~3 triangles in full, and the frame is two
-        // square roots and six divisions of each. One thread: a 128^3 grid around spot 1615-1640
+        // double, would take 144, so it keeps them only where long double is double): a query
+        // measures ~3 triangles in full, and the frame is two square roots and six divisions of
+        // each. One thread: a 128^3 grid around spot 1615-1640
         // -> 1395-1408 ms, 1M random points around igea 4292-4304 -> 4049 ms.
         frames_.clear();
         if constexpr (sizeof(AccurateScalar<T>) == sizeof(double)) {
@@ -414,7 +415,7 @@ class ClosestPointMesh {
     std::vector<Triangle<T>> tris_;         // leaf-slot order, then one of padding
     WideBvh4<T> wide_;                      // bvh_ collapsed, for closest_point
     std::vector<TrianglePack4<T>> packs_;   // wide_'s leaf groups: triangles four abreast
-    std::vector<AccurateFrame<T>> frames_;  // leaf-slot order, float meshes only (see above)
+    std::vector<AccurateFrame<T>> frames_;  // leaf-slot order, where W is double (see above)
     T longest_edge_ = 0;                    // the mesh's longest edge (finite triangles)
     T pack_scale_ = 1;                      // packs_ hold the triangles times this (a power of 2)
     T scaled_longest_edge_ = 0;             // longest_edge_ * pack_scale_
