@@ -16,7 +16,7 @@ namespace {
 
 constexpr const char* kRaysHelp =
     R"(usage: bvhkit bench rays [MESH ...] [--json] [--reps N] [--rays N]
-                         [--size N] [--builder NAME]
+                         [--size N] [--builder NAME] [--high-quality]
 
 Workload R of docs/workloads.md for bvhkit and Embree 3 (when installed), in this process, one thread
 each: build, R1 (camera rays, SIZE x SIZE), R2 (random rays), R3 (R2 as occlusion queries).
@@ -29,10 +29,13 @@ shared bunny and igea meshes when present, else a procedural sphere.
   --rays N        rays in R2 and R3 (default 1000000)
   --size N        R1 image side (default 1024)
   --builder NAME  bvhkit builder (default binned-sah)
+  --high-quality  also bvhkit with spatial splits (bvhkit-sbvh) against Embree's high-quality
+                  build (embree3-high); bvhkit-sbvh's speedup is over embree3-high
 )";
 
 int bench_rays(int argc, char** argv) {
-    const Args args(argc, argv, {"--reps", "--rays", "--size", "--builder"}, {"--json"});
+    const Args args(argc, argv, {"--reps", "--rays", "--size", "--builder"},
+                    {"--json", "--high-quality"});
     if (args.help()) {
         std::fputs(kRaysHelp, stdout);
         return 0;
@@ -44,6 +47,7 @@ int bench_rays(int argc, char** argv) {
     o.random_rays = std::size_t(args.integer("--rays", 1000000, 1, 100000000));
     o.camera_size = std::uint32_t(args.integer("--size", 1024, 1, 16384));
     o.builder = args.value("--builder", "binned-sah");
+    o.high_quality = args.flag("--high-quality");
     if (!bench::have_embree())
         std::fprintf(stderr,
                      "Embree 3 was not found at build time (apt-get install libembree-dev): "

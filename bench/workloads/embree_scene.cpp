@@ -7,7 +7,7 @@
 
 namespace bvhkit::bench {
 
-EmbreeScene::EmbreeScene(const TriangleMesh& mesh, int threads) {
+EmbreeScene::EmbreeScene(const TriangleMesh& mesh, int threads, bool high) : high_(high) {
     // threads=0 leaves Embree's default, every core, and no process-wide limit on oneTBB.
     const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
     device_ = rtcNewDevice(config.c_str());
@@ -23,7 +23,8 @@ EmbreeScene::~EmbreeScene() {
 void EmbreeScene::build(const TriangleMesh& mesh) {
     if (scene_) rtcReleaseScene(scene_);
     scene_ = rtcNewScene(device_);
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_MEDIUM);
+    const RTCBuildQuality quality = high_ ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
+    rtcSetSceneBuildQuality(scene_, quality);
     RTCGeometry geometry = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vertices = static_cast<float*>(
         rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -33,7 +34,7 @@ void EmbreeScene::build(const TriangleMesh& mesh) {
                                 3 * sizeof(unsigned), mesh.triangles.size()));
     std::memcpy(vertices, mesh.vertices.data(), mesh.vertices.size() * 3 * sizeof(float));
     std::memcpy(indices, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(unsigned));
-    rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_MEDIUM);
+    rtcSetGeometryBuildQuality(geometry, quality);
     rtcCommitGeometry(geometry);
     rtcAttachGeometry(scene_, geometry);
     rtcReleaseGeometry(geometry);

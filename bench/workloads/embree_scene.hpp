@@ -12,10 +12,11 @@ namespace bvhkit::bench {
 
 class EmbreeScene {
   public:
-    /// Builds with RTC_BUILD_QUALITY_MEDIUM on a device limited to `threads` threads (0: every
-    /// core). A limited device limits every oneTBB call of the process while it lives (Embree 3
-    /// sets a global_control), bvhkit's included.
-    explicit EmbreeScene(const TriangleMesh& mesh, int threads = 1);
+    /// Builds with RTC_BUILD_QUALITY_MEDIUM (or, with `high`, RTC_BUILD_QUALITY_HIGH: spatial
+    /// splits) on a device limited to `threads` threads (0: every core). A limited device limits
+    /// every oneTBB call of the process while it lives (Embree 3 sets a global_control), bvhkit's
+    /// included.
+    explicit EmbreeScene(const TriangleMesh& mesh, int threads = 1, bool high = false);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -76,6 +77,7 @@ class EmbreeScene {
   private:
     RTCDevice device_ = nullptr;
     RTCScene scene_ = nullptr;
+    bool high_ = false;
 };
 
 }  // namespace bvhkit::bench

@@ -126,50 +126,70 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
         struct Layout {
             const char* name;
             RayLayout layout;
+            bool spatial_splits = false;
         };
         std::vector<Layout> layouts{{"bvhkit", RayLayout::Auto}};
         if (cpu_has_avx2()) layouts.push_back({"bvhkit-wide4", RayLayout::Wide4});
         layouts.push_back({"bvhkit-binary", RayLayout::Binary});
+        if (options.high_quality) layouts.push_back({"bvhkit-sbvh", RayLayout::Auto, true});
         std::vector<TriangleBvh<float>> trees(layouts.size());
         std::vector<std::function<void()>> builds;
         for (std::size_t i = 0; i < layouts.size(); ++i)
             builds.push_back([&, i] {
                 TriangleBvhOptions o(build_options);
                 o.ray_layout = layouts[i].layout;
+                o.spatial_splits = layouts[i].spatial_splits;
                 trees[i] = TriangleBvh<float>(mesh, o);
             });
+        // The peers: Embree's medium build, and its high-quality build (spatial splits) beside
+        // bvhkit's. A bvhkit row's speedup is over its counterpart: embree3-high for bvhkit-sbvh,
+        // embree3 for the others.
+        std::vector<const char*> peer_names;
 #if BVHKIT_HAVE_EMBREE
         // On one thread. Embree 3 limits a device's threads with a process-wide oneTBB
         // global_control, which holds bvhkit's batch calls to one thread too while the device
-        // lives: this one is released before the batch rows, which make their own.
-        auto embree = std::make_unique<EmbreeScene>(mesh, 1);
-        builds.push_back([&] { embree->build(mesh); });
+        // lives: these are released before the batch rows, which make their own.
+        std::vector<std::unique_ptr<EmbreeScene>> embree;
+        embree.push_back(std::make_unique<EmbreeScene>(mesh, 1));
+        peer_names.push_back("embree3");
+        if (options.high_quality) {
+            embree.push_back(std::make_unique<EmbreeScene>(mesh, 1, true));
+            peer_names.push_back("embree3-high");
+        }
+        for (auto& scene : embree) builds.push_back([&] { scene->build(mesh); });
 #endif
+        // Index in the timings of layout i's peer, if any.
+        const auto peer_of = [&](std::size_t i) {
+            return layouts.size() + (layouts[i].spatial_splits && peer_names.size() > 1 ? 1 : 0);
+        };
+        const bool peer = !peer_names.empty();
         const std::vector<double> build_ms = median_ms_interleaved(options.repetitions, builds);
-        const bool peer = build_ms.size() > layouts.size();
         for (std::size_t i = 0; i < layouts.size(); ++i) {
             Row row = row_for("build", layouts[i].name);
             row.set("ms", build_ms[i]).set("sah_cost", statistics(trees[i].bvh()).sah_cost);
-            if (peer) row.set("speedup", build_ms.back() / build_ms[i]);
+            if (peer) row.set("speedup", build_ms[peer_of(i)] / build_ms[i]);
             rows.push_back(row);
         }
-        if (peer) rows.push_back(row_for("build", "embree3").set("ms", build_ms.back()));
+        for (std::size_t p = 0; p < peer_names.size(); ++p)
+            rows.push_back(row_for("build", peer_names[p]).set("ms", build_ms[layouts.size() + p]));
 
         for (const Workload& w :
              {Workload{"R1", &r1, false}, Workload{"R2", &r2, false}, Workload{"R3", &r2, true}}) {
             if (progress) std::fprintf(progress, "  %s ...\n", w.name);
-            std::vector<std::size_t> hits(layouts.size() + 1, 0);
+            std::vector<std::size_t> hits(layouts.size() + peer_names.size(), 0);
             // In its own file: see ray_timed_calls.cpp.
             std::vector<std::function<void()>> runs;
             for (std::size_t i = 0; i < layouts.size(); ++i)
                 runs.push_back([&, i] { hits[i] = trace_rays(trees[i], *w.rays, w.occlusion); });
 #if BVHKIT_HAVE_EMBREE
-            runs.push_back([&] {
-                std::size_t& n = hits.back();
-                n = 0;
-                for (const auto& r : *w.rays)
-                    n += w.occlusion ? embree->any_hit(r) : bool(embree->closest_hit(r));
-            });
+            for (std::size_t p = 0; p < embree.size(); ++p)
+                runs.push_back([&, p] {
+                    std::size_t& n = hits[layouts.size() + p];
+                    n = 0;
+                    const EmbreeScene& scene = *embree[p];
+                    for (const auto& r : *w.rays)
+                        n += w.occlusion ? scene.any_hit(r) : bool(scene.closest_hit(r));
+                });
 #endif
             const std::vector<double> ms = median_ms_interleaved(options.repetitions, runs);
             const double n = double(w.rays->size());
@@ -187,19 +207,20 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
                 row.set("ms", ms[i]).set("mrays_per_s", n / ms[i] / 1e3);
                 row.set("nodes_per_ray", double(traversal.nodes_visited) / n);
                 row.set("tris_per_ray", double(traversal.primitives_tested) / n);
-                if (peer) row.set("speedup", ms.back() / ms[i]);
+                if (peer) row.set("speedup", ms[peer_of(i)] / ms[i]);
                 rows.push_back(row);
             }
-            if (peer) {
-                Row p = row_for(w.name, "embree3");
-                p.set("rays", (long long)w.rays->size()).set("hits", (long long)hits.back());
-                p.set("ms", ms.back()).set("mrays_per_s", n / ms.back() / 1e3);
-                rows.push_back(p);
+            for (std::size_t p = 0; p < peer_names.size(); ++p) {
+                const std::size_t k = layouts.size() + p;
+                Row row = row_for(w.name, peer_names[p]);
+                row.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[k]);
+                row.set("ms", ms[k]).set("mrays_per_s", n / ms[k] / 1e3);
+                rows.push_back(row);
             }
         }
         PeerRay peer_ray;
 #if BVHKIT_HAVE_EMBREE
-        embree.reset();
+        embree.clear();
         const EmbreeScene embree_all(mesh, 0);
         peer_ray = [&embree_all](const Ray3f& r, bool occlusion) {
             return occlusion ? embree_all.any_hit(r) : bool(embree_all.closest_hit(r));

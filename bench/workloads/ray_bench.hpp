@@ -22,6 +22,9 @@ struct RayBenchOptions {
     std::uint32_t camera_size = 1024;   // R1: camera_size^2 rays
     std::size_t random_rays = 1000000;  // R2, R3
     std::string builder = "binned-sah";
+    /// Also the high-quality builds: bvhkit with spatial splits (rows bvhkit-sbvh) and Embree's
+    /// RTC_BUILD_QUALITY_HIGH (embree3-high).
+    bool high_quality = false;
 };
 
 /// One row per (workload, mesh, library); bvhkit's rows carry `speedup` = Embree ms / bvhkit ms.

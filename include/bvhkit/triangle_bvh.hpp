@@ -13,10 +13,18 @@
 // The triangle test is TriangleBvhOptions::triangle_test: watertight by default (no ray slips
 // through a shared edge or vertex of a closed mesh), or the fast Moller-Trumbore test, which can
 // (see primitives/triangle.hpp).
+//
+// TriangleBvhOptions::spatial_splits builds the high-quality tree (build/spatial_splits.hpp): its
+// leaves may hold parts of one triangle in several places, which queries never show (all_hits
+// reports each triangle once). refit() keeps such a tree correct, with each leaf's box grown to
+// its triangles' whole boxes; a tree with spatial splits cannot be saved
+// (io/triangle_bvh_file.hpp).
 #include <span>
+#include <unordered_set>
 
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/refit.hpp"
+#include "bvhkit/build/spatial_splits.hpp"
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/ray.hpp"
@@ -44,6 +52,11 @@ enum class RayLayout {
 struct TriangleBvhOptions : BuildOptions {
     TriangleTest triangle_test = TriangleTest::Watertight;
     RayLayout ray_layout = RayLayout::Auto;
+    /// The high-quality build: binned SAH with spatial splits (Stich et al. 2009), `spatial` its
+    /// parameters. Serial, several times the default build's time, and up to spatial.budget more
+    /// triangle references; needs Builder::BinnedSah and no optimize (else bvhkit::Error).
+    bool spatial_splits = false;
+    SpatialSplitOptions spatial{};
 
     TriangleBvhOptions() = default;
     TriangleBvhOptions(const BuildOptions& build) : BuildOptions(build) {}  // NOLINT: implicit
@@ -114,7 +127,18 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     /// on_hit(const Hit<T>&) -> bool (true to go on); hits come in no particular order.
     template <class OnHit, class Stats = NoStats>
     void all_hits(const Ray<T, 3>& ray, OnHit&& on_hit, Stats&& stats = {}) const {
-        binary_rays().all_hits(ray, on_hit, stats);
+        if (!split_references_) {
+            binary_rays().all_hits(ray, on_hit, stats);
+            return;
+        }
+        // A triangle split by the build can be met in several leaves: reported the first time.
+        std::unordered_set<std::uint32_t> seen;
+        binary_rays().all_hits(
+            ray,
+            [&](const Hit<T>& h) {
+                return seen.insert(h.primitive).second ? bool(on_hit(h)) : true;
+            },
+            stats);
     }
 
     // Batches: trace() and occluded(), from RayBatches (query/triangle_rays.hpp).
@@ -160,6 +184,10 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     std::size_t triangle_count() const {
         return triangle_count_;
     }
+    /// Whether the build split triangles (spatial splits): then bvh() names some in several leaves.
+    bool has_split_references() const {
+        return split_references_;
+    }
 
   private:
     friend struct serial_detail::TriangleBvhAccess;
@@ -172,22 +200,31 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
 
     template <class TriangleAt>
-    void build(TriangleAt&& triangle, std::size_t count, const BuildOptions& options) {
-        std::vector<Aabb<T, 3>> boxes;
-        std::vector<Vec<T, 3>> centroids;
-        boxes.reserve(count);
-        centroids.reserve(count);
-        for (std::size_t i = 0; i < count; ++i) {
-            boxes.push_back(triangle(i).bounds());
-            centroids.push_back(boxes.back().centroid());
-        }
+    void build(TriangleAt&& triangle, std::size_t count, const TriangleBvhOptions& options) {
         BuildOptions tree_options = options;
         // The wide layouts test a leaf's triangles four or eight abreast, in groups cut from runs
         // of four slots (collapse_to_wide): leaves priced in blocks of four. Against one triangle a
         // test (bunny and igea, one thread): the build about a quarter faster (nodes of four or
         // fewer are leaves without a search), R1-R3 within noise.
         if (tree_options.costs.leaf_block == 0 && wide_layout()) tree_options.costs.leaf_block = 4;
-        bvh_ = build_bvh<T, 3>(boxes, centroids, tree_options, &report_);
+        if (options.spatial_splits) {
+            if (options.builder != Builder::BinnedSah || options.optimize)
+                throw Error(
+                    "TriangleBvh: spatial_splits needs Builder::BinnedSah and optimize = false");
+            bvh_ = build_spatial_split_bvh<T>(triangle, count, tree_options, options.spatial,
+                                              &report_);
+        } else {
+            std::vector<Aabb<T, 3>> boxes;
+            std::vector<Vec<T, 3>> centroids;
+            boxes.reserve(count);
+            centroids.reserve(count);
+            for (std::size_t i = 0; i < count; ++i) {
+                boxes.push_back(triangle(i).bounds());
+                centroids.push_back(boxes.back().centroid());
+            }
+            bvh_ = build_bvh<T, 3>(boxes, centroids, tree_options, &report_);
+        }
+        split_references_ = bvh_.primitive_indices.size() + report_.skipped.size() != count;
         triangle_count_ = count;
         lay_out(triangle);
     }
@@ -241,6 +278,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     std::vector<Triangle<T>> exact_;            // leaf-slot order, only for the watertight test
     BuildReport report_;
     std::size_t triangle_count_ = 0;
+    bool split_references_ = false;  // some triangle is in more than one leaf
     TriangleTest triangle_test_ = TriangleTest::Watertight;
     RayLayout ray_layout_ = RayLayout::Auto;
     WideRayBvh<4> wide4_;  // at most one of the two is filled (float, watertight, x86 only)

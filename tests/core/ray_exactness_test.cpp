@@ -153,17 +153,25 @@ TYPED_TEST(RayExactness, HardGeometryAgreesWithTheLongDoubleReference) {
     for (const Case& c : cases) {
         SCOPED_TRACE(std::string(c.name) + " radius " + std::to_string(c.radius) + " center " +
                      std::to_string(c.center[0]));
-        const TriangleBvh<T> bvh(c.tris);
+        // The default tree, and the one with spatial splits (clipped leaf boxes).
+        TriangleBvhOptions spatial;
+        spatial.spatial_splits = true;
+        spatial.spatial.alpha = 0;
+        const TriangleBvh<T> trees[] = {TriangleBvh<T>(c.tris), TriangleBvh<T>(c.tris, spatial)};
+        EXPECT_TRUE(trees[1].has_split_references() || c.name == std::string("sphere"));
         Tally tally;
         const auto rays = aimed_rays<T>(c.tris, c.center, c.radius, per_case, 11);
-        for (std::size_t r = 0; r < rays.size(); ++r) {
-            SCOPED_TRACE("ray " + std::to_string(r));
-            check_ray(bvh, c.tris, rays[r], tally);
-            if (testing::Test::HasFatalFailure()) return;
-        }
+        for (const TriangleBvh<T>& bvh : trees)
+            for (std::size_t r = 0; r < rays.size(); ++r) {
+                SCOPED_TRACE("ray " + std::to_string(r) +
+                             (bvh.has_split_references() ? ", spatial splits" : ""));
+                check_ray(bvh, c.tris, rays[r], tally);
+                if (testing::Test::HasFatalFailure()) return;
+            }
         // The rays must mostly be decided, or the test proves little (on needles many rays pass
         // within the band of an edge, in float most).
-        EXPECT_GT(tally.certain_hits, rays.size() / (c.name == std::string("needles") ? 20 : 3));
+        EXPECT_GT(tally.certain_hits,
+                  2 * rays.size() / (c.name == std::string("needles") ? 20 : 3));
     }
 }
 
@@ -171,10 +179,13 @@ TYPED_TEST(RayExactness, HardGeometryAgreesWithTheLongDoubleReference) {
 /// triangle around that vertex or edge faces the ray the same way (so that in exact arithmetic the
 /// ray crosses the surface there). Returns how many found nothing at or before the aimed point.
 template <class T>
-std::size_t gaps(const TriangleMesh& mesh, TriangleTest test, std::size_t n, std::uint64_t seed) {
+std::size_t gaps(const TriangleMesh& mesh, TriangleTest test, std::size_t n, std::uint64_t seed,
+                 bool spatial_splits = false) {
     const std::vector<Triangle<T>> tris = placed<T>(mesh, 1.0, 0.0);
     TriangleBvhOptions options;
     options.triangle_test = test;
+    options.spatial_splits = spatial_splits;
+    options.spatial.alpha = 0;  // split wherever it pays: many leaf boxes cut through edges
     const TriangleBvh<T> bvh(tris, options);
     // Triangles around each edge and each vertex.
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> edges;
@@ -243,6 +254,7 @@ TEST(Watertight, NoGapAtSharedEdgesAndVerticesOfClosedMeshes) {
         SCOPED_TRACE(name);
         EXPECT_EQ(gaps<float>(mesh, TriangleTest::Watertight, n, 5), 0u);
         EXPECT_EQ(gaps<double>(mesh, TriangleTest::Watertight, n / 4, 6), 0u);
+        EXPECT_EQ(gaps<float>(mesh, TriangleTest::Watertight, n / 2, 7, true), 0u);
         const std::size_t f = gaps<float>(mesh, TriangleTest::Fast, n, 5);
         std::printf("%s: the fast test let %zu of %zu aimed rays through\n", name.c_str(), f, n);
         fast_gaps += f;

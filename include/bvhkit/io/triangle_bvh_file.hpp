@@ -85,6 +85,12 @@ struct TriangleBvhAccess {
 
     template <class T>
     static std::vector<std::uint8_t> save(const TriangleBvh<T>& tree) {
+        // The format holds each triangle once (its loader checks that); a tree with spatial
+        // splits would need the references' clipped boxes checked instead.
+        if (tree.split_references_)
+            throw Error(std::string(what) +
+                        ": a tree built with spatial splits cannot be saved; save the mesh and "
+                        "rebuild, or build without spatial_splits");
         const auto& bvh = tree.bvh_;
         const bool fast = tree.triangle_test_ == TriangleTest::Fast;
         ByteWriter w;
