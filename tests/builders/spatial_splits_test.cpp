@@ -171,18 +171,6 @@ void expect_covers(const Bvh<Aabb<T, 3>>& bvh, const std::vector<Triangle<T>>& t
 }
 
 template <class T>
-std::vector<Triangle<T>> triangles_of(const TriangleMesh& mesh, double scale, double offset) {
-    std::vector<Triangle<T>> out;
-    const auto at = [&](std::uint32_t v) {
-        Vec<T, 3> p;
-        for (int k = 0; k < 3; ++k) p[k] = T(double(mesh.vertices[v][k]) * scale + offset);
-        return p;
-    };
-    for (const auto& t : mesh.triangles) out.push_back({at(t[0]), at(t[1]), at(t[2])});
-    return out;
-}
-
-template <class T>
 class SpatialSplitTrees : public ::testing::Test {};
 using Scalars = ::testing::Types<float, double>;
 TYPED_TEST_SUITE(SpatialSplitTrees, Scalars);
@@ -194,8 +182,8 @@ TYPED_TEST(SpatialSplitTrees, EveryPointOfEveryTriangleLiesInALeafThatNamesIt) {
     const TriangleMesh room = make_room(20, 2), soup = make_soup(3000, 5);
     for (const auto& [scale, offset] :
          {std::pair{1.0, 0.0}, std::pair{1e-6, 0.0}, std::pair{1.0, 1e5}, std::pair{1e6, 1e7}}) {
-        cases.emplace_back("room", triangles_of<T>(room, scale, offset));
-        cases.emplace_back("soup", triangles_of<T>(soup, scale, offset));
+        cases.emplace_back("room", test::placed<T>(room, scale, offset));
+        cases.emplace_back("soup", test::placed<T>(soup, scale, offset));
     }
     // Needles and slivers crossing each other, with a NaN triangle and a duplicate.
     std::vector<Triangle<T>> needles;
@@ -231,7 +219,7 @@ TYPED_TEST(SpatialSplitTrees, EveryPointOfEveryTriangleLiesInALeafThatNamesIt) {
 
 TEST(SpatialSplits, BudgetBoundsTheReferences) {
     const TriangleMesh soup = make_soup(5000, 9);
-    const auto tris = triangles_of<float>(soup, 1.0, 0.0);
+    const auto tris = test::placed<float>(soup, 1.0, 0.0);
     for (const double budget : {0.0, 0.1, 0.5}) {
         SpatialSplitOptions spatial;
         spatial.budget = budget;
@@ -241,6 +229,36 @@ TEST(SpatialSplits, BudgetBoundsTheReferences) {
         if (budget > 0) {
             EXPECT_GT(bvh.primitive_indices.size(), tris.size());
         }
+    }
+}
+
+TEST(SpatialSplits, BudgetIsSharedAcrossTheTree) {
+    // Depth first, a greedy build would spend a small budget in the first subtree it builds: each
+    // half of the root must get its share.
+    const TriangleMesh soup = make_soup(20000, 3);
+    const auto tris = test::placed<float>(soup, 1.0, 0.0);
+    SpatialSplitOptions spatial;
+    spatial.budget = 0.02;
+    const auto bvh = build_spatial_split_bvh<float>([&](std::size_t i) { return tris[i]; },
+                                                    tris.size(), BuildOptions{}, spatial);
+    ASSERT_FALSE(bvh.nodes.front().is_leaf());
+    for (const std::uint32_t half : {bvh.nodes.front().left(), bvh.nodes.front().right()}) {
+        std::size_t slots = 0;
+        std::map<std::uint32_t, int> seen;
+        std::vector<std::uint32_t> stack{half};
+        while (!stack.empty()) {
+            const auto& node = bvh.nodes[stack.back()];
+            stack.pop_back();
+            if (!node.is_leaf()) {
+                stack.push_back(node.left());
+                stack.push_back(node.right());
+                continue;
+            }
+            for (std::uint32_t s = node.first; s < node.first + node.count; ++s, ++slots)
+                ++seen[bvh.primitive_indices[s]];
+        }
+        // Extra references inside this half: slots beyond one per triangle.
+        EXPECT_GT(slots - seen.size(), 0u) << "half " << half;
     }
 }
 
@@ -265,7 +283,7 @@ TYPED_TEST(SpatialSplitTrees, RaysEqualBruteForceOnEveryLayout) {
     using T = TypeParam;
     const TriangleMesh room = make_room(30, 4);
     for (const auto& [scale, offset] : {std::pair{1.0, 0.0}, std::pair{1.0, 1e5}}) {
-        const auto tris = triangles_of<T>(room, scale, offset);
+        const auto tris = test::placed<T>(room, scale, offset);
         Aabb<T, 3> bounds;
         for (const auto& t : tris) bounds.grow(t.bounds());
         const auto rays = test::random_rays<T>(test::scaled(3000, 10), bounds, 21);
@@ -313,7 +331,7 @@ TEST(SpatialSplits, RefitKeepsRaysRight) {
     ASSERT_TRUE(bvh.has_split_references());
     for (auto& v : mesh.vertices) v = v * 1.25f + Vec3f{0.5f, -0.25f, 2.0f};
     bvh.refit(mesh);
-    const auto tris = triangles_of<float>(mesh, 1.0, 0.0);
+    const auto tris = test::placed<float>(mesh, 1.0, 0.0);
     const auto rays = test::random_rays<float>(test::scaled(4000, 10), mesh.bounds(), 5);
     for (const auto& ray : rays) {
         const Hit<float> want = brute_closest(tris, ray), got = bvh.closest_hit(ray);

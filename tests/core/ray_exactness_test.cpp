@@ -17,19 +17,6 @@ using namespace bvhkit;
 
 namespace {
 
-/// The mesh scaled by `scale` and moved by `offset` (in double), then rounded to T.
-template <class T>
-std::vector<Triangle<T>> placed(const TriangleMesh& mesh, double scale, double offset) {
-    std::vector<Triangle<T>> out;
-    const auto at = [&](std::uint32_t v) {
-        Vec<T, 3> p;
-        for (int k = 0; k < 3; ++k) p[k] = T(double(mesh.vertices[v][k]) * scale + offset);
-        return p;
-    };
-    for (const auto& t : mesh.triangles) out.push_back({at(t[0]), at(t[1]), at(t[2])});
-    return out;
-}
-
 /// Needles (length ~1, width 1e-5..1e-2) and slivers (one vertex near the opposite edge).
 template <class T>
 std::vector<Triangle<T>> needles(std::size_t n, std::uint64_t seed) {
@@ -146,7 +133,7 @@ TYPED_TEST(RayExactness, HardGeometryAgreesWithTheLongDoubleReference) {
     for (const auto& [scale, offset] :
          {std::pair{1.0, 0.0}, std::pair{1e-6, 0.0}, std::pair{1e6, 0.0}, std::pair{1.0, 1e4},
           std::pair{1.0, 1e5}, std::pair{1.0, 1e6}, std::pair{1e3, 1e6}, std::pair{1e-6, 1e-3}})
-        cases.push_back({"sphere", placed<T>(sphere, scale, offset),
+        cases.push_back({"sphere", test::placed<T>(sphere, scale, offset),
                          Vec<double, 3>{offset, offset, offset}, scale});
     cases.push_back({"needles", needles<T>(1500, 4), Vec<double, 3>{0, 0, 0}, 1.5});
     const std::size_t per_case = test::scaled(1000, 10);
@@ -181,7 +168,7 @@ TYPED_TEST(RayExactness, HardGeometryAgreesWithTheLongDoubleReference) {
 template <class T>
 std::size_t gaps(const TriangleMesh& mesh, TriangleTest test, std::size_t n, std::uint64_t seed,
                  bool spatial_splits = false) {
-    const std::vector<Triangle<T>> tris = placed<T>(mesh, 1.0, 0.0);
+    const std::vector<Triangle<T>> tris = test::placed<T>(mesh, 1.0, 0.0);
     TriangleBvhOptions options;
     options.triangle_test = test;
     options.spatial_splits = spatial_splits;

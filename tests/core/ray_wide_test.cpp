@@ -24,17 +24,6 @@ bool same_bits(float a, float b) {
     return std::memcmp(&a, &b, sizeof a) == 0;
 }
 
-std::vector<Triangle<float>> placed(const TriangleMesh& mesh, double scale, double offset) {
-    std::vector<Triangle<float>> out;
-    const auto at = [&](std::uint32_t v) {
-        Vec<float, 3> p;
-        for (int k = 0; k < 3; ++k) p[k] = float(double(mesh.vertices[v][k]) * scale + offset);
-        return p;
-    };
-    for (const auto& t : mesh.triangles) out.push_back({at(t[0]), at(t[1]), at(t[2])});
-    return out;
-}
-
 /// Rays through the triangles' bounding box: from outside and inside, some aimed exactly at a
 /// vertex or along an axis, some with direction components +0, -0 or subnormal.
 std::vector<Ray3f> rays_for(const std::vector<Triangle<float>>& tris, std::size_t n,
@@ -195,11 +184,11 @@ TEST(WideRays, SameAnswersAsTheBinaryWalkOnHardGeometry) {
         std::string name;
         std::vector<Triangle<float>> tris;
     };
-    std::vector<Case> cases{{"sphere", placed(make_sphere(4), 1, 0)},
-                            {"torus", placed(make_torus(96, 48), 1, 0)},
-                            {"far sphere", placed(make_sphere(3), 1, 1e5)},
-                            {"tiny sphere", placed(make_sphere(3), 1e-6, 0)},
-                            {"huge terrain", placed(make_terrain(64), 1e6, 0)}};
+    std::vector<Case> cases{{"sphere", test::placed<float>(make_sphere(4), 1, 0)},
+                            {"torus", test::placed<float>(make_torus(96, 48), 1, 0)},
+                            {"far sphere", test::placed<float>(make_sphere(3), 1, 1e5)},
+                            {"tiny sphere", test::placed<float>(make_sphere(3), 1e-6, 0)},
+                            {"huge terrain", test::placed<float>(make_terrain(64), 1e6, 0)}};
     // Needles and slivers, duplicates and zero-area triangles.
     test::Random rng(7);
     std::vector<Triangle<float>> odd;
@@ -218,7 +207,7 @@ TEST(WideRays, SameAnswersAsTheBinaryWalkOnHardGeometry) {
     }
     cases.push_back({"needles", odd});
     if (const auto spot = test::shared_mesh("spot.obj"); !spot.empty())
-        cases.push_back({"spot", placed(read_mesh(spot), 1, 0)});
+        cases.push_back({"spot", test::placed<float>(read_mesh(spot), 1, 0)});
     TriangleBvhOptions binary, four, eight;
     binary.ray_layout = RayLayout::Binary;
     four.ray_layout = RayLayout::Wide4;
@@ -245,7 +234,7 @@ TEST(WideRays, RefitKeepsTheWideLayoutInStep) {
     for (auto& v : mesh.vertices) v = v * (1.0f + 0.3f * v[0]) + Vec3f{0.1f, 0, 0};
     wide.refit(mesh);
     flat.refit(mesh);
-    const auto tris = placed(mesh, 1, 0);
+    const auto tris = test::placed<float>(mesh, 1, 0);
     expect_same(wide, flat, tris, rays_for(tris, test::scaled(5000), 5));
 }
 
@@ -412,7 +401,7 @@ TEST(WideRays, BoxEarlyOutDecidesAsTheSlabTest) {
 // the tree answers afterwards exactly as before it (a NaN box would make rays miss silently).
 TEST(WideRays, RefitWithANonFiniteVertexIsAnError) {
     const TriangleMesh mesh = make_sphere(3);
-    const auto tris = placed(mesh, 1, 0);
+    const auto tris = test::placed<float>(mesh, 1, 0);
     const auto rays = rays_for(tris, test::scaled(2000), 7);
     for (const RayLayout layout : {RayLayout::Binary, RayLayout::Wide4, RayLayout::Wide8}) {
         TriangleBvhOptions options;
@@ -540,7 +529,7 @@ TEST(WideRays, FourAbreastTestEqualsTheScalarTest) {
 // The batch calls: trace() and occluded() on 1, 2 and every thread equal the one-by-one calls, hit
 // for hit, for every layout and both float and double; mismatched spans are an error.
 TEST(BatchRays, EqualTheOneByOneCallsOnEveryThreadCount) {
-    const auto tris = placed(make_sphere(4), 1, 1e3);
+    const auto tris = test::placed<float>(make_sphere(4), 1, 1e3);
     const auto rays = rays_for(tris, test::scaled(30000, 3), 5);
     for (const RayLayout layout : {RayLayout::Binary, RayLayout::Wide4, RayLayout::Wide8}) {
         TriangleBvhOptions options;

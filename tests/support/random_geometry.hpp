@@ -6,6 +6,7 @@
 
 #include "bvhkit/math/ray.hpp"
 #include "bvhkit/primitives/triangle.hpp"
+#include "bvhkit/primitives/triangle_mesh.hpp"
 
 namespace bvhkit::test {
 
@@ -56,6 +57,19 @@ std::vector<Ray<T, 3>> random_rays(std::size_t count, const Aabb<T, 3>& box, std
     Random rng(seed);
     std::vector<Ray<T, 3>> out(count);
     for (auto& r : out) r = Ray<T, 3>(rng.point_in(box), rng.unit_vector<T>());
+    return out;
+}
+
+/// The mesh's triangles scaled by `scale` and moved by `offset` (in double), then rounded to T.
+template <class T>
+std::vector<Triangle<T>> placed(const TriangleMesh& mesh, double scale, double offset) {
+    std::vector<Triangle<T>> out;
+    const auto at = [&](std::uint32_t v) {
+        Vec<T, 3> p;
+        for (int k = 0; k < 3; ++k) p[k] = T(double(mesh.vertices[v][k]) * scale + offset);
+        return p;
+    };
+    for (const auto& t : mesh.triangles) out.push_back({at(t[0]), at(t[1]), at(t[2])});
     return out;
 }
 
