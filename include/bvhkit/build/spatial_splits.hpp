@@ -65,8 +65,9 @@ using Point = Vec<double, 3>;
 
 /// A box that holds the part of triangle `v` that lies in `ref` and in lo <= x[axis] <= hi (lo, hi
 /// may be infinite); empty when the triangle has no part there. The corners are exact in double;
-/// a crossing of an edge with a plane, a + t (b - a), is off by at most 6 units of roundoff of
-/// |a| + |b| per coordinate, so it is padded by 8 (plus a few least denormals).
+/// a crossing of an edge with a plane, a + t (b - a), is off by at most 6 units of roundoff
+/// (3 epsilon) of |a| + |b| per coordinate when rounding to nearest, twice that under a directed
+/// rounding mode, so it is padded by 16 epsilon (plus a few least denormals).
 inline Box clip_to_slab(const Point (&v)[3], const Box& ref, std::size_t axis, double lo,
                         double hi) {
     constexpr double u = std::numeric_limits<double>::epsilon();
@@ -89,7 +90,7 @@ inline Box clip_to_slab(const Point (&v)[3], const Box& ref, std::size_t axis, d
                     continue;
                 }
                 const double x = a[c] + t * (b[c] - a[c]);
-                const double pad = 8 * u * (std::fabs(a[c]) + std::fabs(b[c])) + tiny;
+                const double pad = 16 * u * (std::fabs(a[c]) + std::fabs(b[c])) + tiny;
                 low[c] = x - pad;
                 high[c] = x + pad;
             }
