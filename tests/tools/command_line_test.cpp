@@ -148,6 +148,17 @@ TEST(CommandLine, UnknownBuilderPrintsOnlyTheError) {
                                                              << o.output;
 }
 
+TEST(CommandLine, InfoReportsTheSpatialSplitBuild) {
+    // A room: walls of two triangles each among small objects, where spatial splits pay.
+    const Outcome o = run("info room:objects=20 --spatial-splits");
+    EXPECT_EQ(o.status, 0) << o.output;
+    const auto row = o.output.find("spatial-splits");
+    ASSERT_NE(row, std::string::npos) << o.output;
+    EXPECT_NE(o.output.find("binned-sah"), std::string::npos) << o.output;
+    EXPECT_NE(o.output.find("references"), std::string::npos) << "no reference count:\n"
+                                                              << o.output;
+}
+
 TEST(CommandLine, RenderSizeIsCheckedNotWrapped) {
     for (const char* size : {"4294967312x16", "16384x16384", "15x16", "x16", "16x", "-16x16"}) {
         const Outcome o = run(std::string("render sphere:subdiv=1 --size ") + size + " -o " +
