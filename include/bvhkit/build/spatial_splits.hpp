@@ -63,6 +63,16 @@ namespace spatial_detail {
 using Box = Aabb<double, 3>;
 using Point = Vec<double, 3>;
 
+/// Whether edge a-b crosses the plane x[axis] = q strictly between its ends (an end on the plane
+/// is a corner; an infinite plane crosses nothing), and where: x = a + t (b - a), x[axis] = q.
+inline bool crossing(const Point& a, const Point& b, std::size_t axis, double q, Point& x) {
+    if (!((a[axis] < q && q < b[axis]) || (b[axis] < q && q < a[axis]))) return false;
+    const double t = (q - a[axis]) / (b[axis] - a[axis]);
+    for (std::size_t c = 0; c < 3; ++c) x[c] = a[c] + t * (b[c] - a[c]);
+    x[axis] = q;
+    return true;
+}
+
 /// A box that holds the part of triangle `v` that lies in `ref` and in lo <= x[axis] <= hi (lo, hi
 /// may be infinite); empty when the triangle has no part there. The corners are exact in double;
 /// a crossing of an edge with a plane, a + t (b - a), is off by at most 6 units of roundoff
@@ -78,21 +88,14 @@ inline Box clip_to_slab(const Point (&v)[3], const Box& ref, std::size_t axis, d
         const Point& b = v[(k + 1) % 3];
         if (a[axis] >= lo && a[axis] <= hi) out.grow(a);
         for (const double plane : {lo, hi}) {
-            // Only a plane strictly between the two ends crosses the edge inside it (an end on the
-            // plane is a corner, taken above); infinite planes never do.
-            if (!((a[axis] < plane && plane < b[axis]) || (b[axis] < plane && plane < a[axis])))
-                continue;
-            const double t = (plane - a[axis]) / (b[axis] - a[axis]);
-            Point low, high;
+            Point x;
+            if (!crossing(a, b, axis, plane, x)) continue;
+            Point low = x, high = x;
             for (std::size_t c = 0; c < 3; ++c) {
-                if (c == axis) {
-                    low[c] = high[c] = plane;
-                    continue;
-                }
-                const double x = a[c] + t * (b[c] - a[c]);
+                if (c == axis) continue;
                 const double pad = 16 * u * (std::fabs(a[c]) + std::fabs(b[c])) + tiny;
-                low[c] = x - pad;
-                high[c] = x + pad;
+                low[c] = x[c] - pad;
+                high[c] = x[c] + pad;
             }
             out.grow(low);
             out.grow(high);
@@ -214,10 +217,8 @@ class Builder {
             Box left_box, right_box;
             const std::size_t refs_before = ref_count_;
             budget_ = w.budget;
-            const std::uint32_t left_count = count == 1 || w.depth >= max_depth
-                                                 ? 0
-                                                 : split(rule, w.begin, count, w.depth, w.bounds,
-                                                         max_depth, max_leaf, left_box, right_box);
+            const std::uint32_t left_count = split(rule, w.begin, count, w.depth, w.bounds,
+                                                   max_depth, max_leaf, left_box, right_box);
             if (left_count == 0) {
                 Aabb<T, 3> box;
                 for (std::uint32_t k = w.begin; k < w.end; ++k) {
@@ -264,32 +265,25 @@ class Builder {
     std::uint32_t split(BinnedSahRule<double, 3>& rule, std::uint32_t begin, std::uint32_t count,
                         std::uint32_t depth, const Box& bounds, std::uint32_t max_depth,
                         std::uint32_t max_leaf, Box& left_box, Box& right_box) {
+        // The object split is the top-down driver's own step (the rule, the halting rules, the
+        // median fallback); a spatial split may then replace it.
         const BuildInput<double, 3> refs{ref_box_, ref_centroid_};
-        const std::span<std::uint32_t> range(ids_.data() + begin, count);
-        Box centroid_bounds;
-        for (std::uint32_t id : range) centroid_bounds.grow(ref_centroid_[id]);
-        // As the top-down driver: halve when the depth left only just suffices.
-        const bool must_halve =
-            count > max_leaf && levels_to_halve(count, max_leaf) + 1 >= max_depth - depth;
-        const Split<double> object =
-            must_halve ? Split<double>::leaf()
-                       : rule(SplitTask<double, 3>{range, bounds, centroid_bounds, depth},
-                              Executor::serial());
-        if (object.kind == Split<double>::Kind::Leaf && count <= max_leaf) return 0;
+        const top_down_detail::Context<double, 3> cx{refs, ids_.data(), nullptr, max_depth,
+                                                     max_leaf};
+        top_down_detail::Work<double, 3> work{0, begin, begin + count, depth, {}};
+        work.bounds.boxes.grow(bounds);
+        for (std::uint32_t k = begin; k < begin + count; ++k)
+            work.bounds.centroids.grow_point(ref_centroid_[ids_[k]]);
         RangeBounds<double, 3> left, right;
-        std::uint32_t left_count =
-            must_halve ? 0 : partition_primitives(refs, range, object, left, right);
-        const bool fell_back = left_count == 0 || left_count == count;
-        if (fell_back) {
-            left = right = RangeBounds<double, 3>{};
-            left_count = partition_primitives(
-                refs, range,
-                Split<double>::at_count(std::uint32_t(centroid_bounds.largest_axis()), count / 2),
-                left, right);
-        }
+        const std::uint32_t left_count =
+            top_down_detail::split_node(cx, work, rule, Executor::serial(), left, right);
+        if (left_count == 0) return 0;
         left_box = left.boxes.box();
         right_box = right.boxes.box();
-        if (fell_back || budget_ == 0 || count <= min_spatial_count || !(root_area_ > 0))
+        // Where the depth left only just suffices, the driver halved: no spatial split there.
+        const bool halved =
+            count > max_leaf && levels_to_halve(count, max_leaf) + 1 >= max_depth - depth;
+        if (halved || budget_ == 0 || count <= min_spatial_count || !(root_area_ > 0))
             return left_count;
         const Box overlap = intersect(left_box, right_box);
         if (overlap.is_empty() || !(overlap.area() > spatial_.alpha * root_area_))
@@ -379,15 +373,9 @@ class Builder {
         for (std::uint32_t b = first; b <= last; ++b) parts[b - first] = Box{};
         for (const Point& p : v) parts[std::clamp(bin(p[axis]), first, last) - first].grow(p);
         for (std::uint32_t b = first + 1; b <= last; ++b) {
-            const double q = planes_[b];
             for (int k = 0; k < 3; ++k) {
-                const Point& a = v[k];
-                const Point& c = v[(k + 1) % 3];
-                if (!((a[axis] < q && q < c[axis]) || (c[axis] < q && q < a[axis]))) continue;
-                const double t = (q - a[axis]) / (c[axis] - a[axis]);
                 Point x;
-                for (std::size_t d = 0; d < 3; ++d) x[d] = a[d] + t * (c[d] - a[d]);
-                x[axis] = q;
+                if (!crossing(v[k], v[(k + 1) % 3], axis, planes_[b], x)) continue;
                 parts[b - 1 - first].grow(x);
                 parts[b - first].grow(x);
             }
