@@ -21,6 +21,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "bvhkit/bvh/huge_page_allocator.hpp"
 #include "bvhkit/bvh/wide_bvh.hpp"
 #include "bvhkit/primitives/triangle_group.hpp"
 #include "bvhkit/query/stats.hpp"
@@ -47,8 +48,9 @@ struct alignas(64) RayNode {
 template <int W>
 struct WideRayBvh {
     using Group = TriangleGroup<W == 8 ? 8 : 4>;  // as wide as the walk's registers
-    std::vector<RayNode<W>> nodes;                // nodes[0] is the root; empty for an empty tree
-    std::vector<Group> groups;
+    // On huge pages once large (bvh/huge_page_allocator.hpp): incoherent rays read both at random.
+    std::vector<RayNode<W>, HugePageAllocator<RayNode<W>>> nodes;  // nodes[0] is the root
+    std::vector<Group, HugePageAllocator<Group>> groups;
 
     bool empty() const { return nodes.empty(); }
 };
