@@ -58,6 +58,7 @@ TEST(HugePageAllocator, LargeArraysOnHugePageBoundariesSmallOnesNot) {
     EXPECT_FALSE(Alloc::uses_huge_pages(huge_page / sizeof(float) - 1));
 #if defined(__linux__)
     EXPECT_TRUE(Alloc::uses_huge_pages(huge_page / sizeof(float)));
+    EXPECT_TRUE(Alloc::uses_huge_pages(std::size_t(1) << 62));  // n * 4 would wrap to 0
 #endif
     std::vector<float, Alloc> small(1000, 1.0f);
     EXPECT_EQ(small[999], 1.0f);

@@ -27,7 +27,8 @@ struct HugePageAllocator {
 
     static bool uses_huge_pages(std::size_t n) {
 #if defined(__linux__)
-        return n * sizeof(T) >= huge_page && alignof(T) <= huge_page;
+        // n * sizeof(T) >= huge_page, without overflow for any n.
+        return n >= (huge_page + sizeof(T) - 1) / sizeof(T) && alignof(T) <= huge_page;
 #else
         (void)n;
         return false;
@@ -41,7 +42,9 @@ struct HugePageAllocator {
             const std::size_t bytes = (n * sizeof(T) + huge_page - 1) / huge_page * huge_page;
             void* p = std::aligned_alloc(huge_page, bytes);
             if (!p) throw std::bad_alloc();
+#if defined(MADV_HUGEPAGE)
             madvise(p, bytes, MADV_HUGEPAGE);  // only a hint: the memory is usable whatever it says
+#endif
             return static_cast<T*>(p);
         }
 #endif
