@@ -1,29 +1,32 @@
 #pragma once
-// HugePageAllocator: an array of 2 MB or more is placed on 2 MB boundaries and, on Linux, marked
+// HugePageAllocator: on Linux, an array of 2 MB or more is placed on 2 MB boundaries and marked
 // for transparent huge pages (madvise MADV_HUGEPAGE: a hint, ignored where the kernel has them
 // off). Rays through a large tree read its nodes and leaves at random; with 4 KB pages a tree of
 // tens of megabytes spans more pages than the TLB holds, and most steps of the walk would add a
-// page walk to their cache miss. Embree places its trees the same way. Smaller arrays take the
-// default allocator.
+// page walk to their cache miss. Embree places its trees the same way. Smaller arrays, and every
+// array elsewhere, take the default allocator.
 #include <cstddef>
-#include <cstdlib>
 #include <memory>
 #include <new>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 namespace bvhkit {
+
+namespace detail {
+/// `bytes` (a multiple of huge_page_bytes) on a huge_page_bytes boundary, advised for huge pages
+/// (src/bvh/huge_pages.cpp, which keeps <sys/mman.h> out of this header); throws std::bad_alloc.
+void* allocate_huge_pages(std::size_t bytes);
+void free_huge_pages(void* p) noexcept;
+inline constexpr std::size_t huge_page_bytes = std::size_t(2) << 20;
+}  // namespace detail
 
 template <class T>
 struct HugePageAllocator {
     using value_type = T;
-    static constexpr std::size_t huge_page = std::size_t(2) << 20;
+    static constexpr std::size_t huge_page = detail::huge_page_bytes;
 
     HugePageAllocator() = default;
     template <class U>
-    HugePageAllocator(const HugePageAllocator<U>&) {}
+    HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
 
     static bool uses_huge_pages(std::size_t n) {
 #if defined(__linux__)
@@ -37,22 +40,15 @@ struct HugePageAllocator {
 
     T* allocate(std::size_t n) {
         if (n > (std::size_t(-1) - huge_page) / sizeof(T)) throw std::bad_array_new_length();
-#if defined(__linux__)
         if (uses_huge_pages(n)) {
             const std::size_t bytes = (n * sizeof(T) + huge_page - 1) / huge_page * huge_page;
-            void* p = std::aligned_alloc(huge_page, bytes);
-            if (!p) throw std::bad_alloc();
-#if defined(MADV_HUGEPAGE)
-            madvise(p, bytes, MADV_HUGEPAGE);  // only a hint: the memory is usable whatever it says
-#endif
-            return static_cast<T*>(p);
+            return static_cast<T*>(detail::allocate_huge_pages(bytes));
         }
-#endif
         return std::allocator<T>{}.allocate(n);
     }
     void deallocate(T* p, std::size_t n) {
         if (uses_huge_pages(n))
-            std::free(p);
+            detail::free_huge_pages(p);
         else
             std::allocator<T>{}.deallocate(p, n);
     }
