@@ -33,7 +33,8 @@ def test_readme_example_runs_as_written():
     # icosphere being above 0.995.
     t = namespace["t"]  # (`face` is reused by the example for the closest points' faces)
     assert t.shape == (1,) and 4.0 - 1e-6 <= t[0] <= 4.005
-    assert np.all(namespace["face"] >= 0) and namespace["face"].shape == (100_000,)
+    face, n_faces = namespace["face"], len(namespace["faces"])
+    assert face.shape == (100_000,) and np.all((face >= 0) & (face < n_faces))
 
     # Points uniform in [-2, 2]^3: the nearest surface point of one outside the sphere is about
     # |p| - 1 away, and the share of points inside is about the volume ratio (4/3 pi) / 64.

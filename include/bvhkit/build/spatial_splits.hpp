@@ -281,9 +281,8 @@ class Builder {
         left_box = left.boxes.box();
         right_box = right.boxes.box();
         // Where the depth left only just suffices, the driver halved: no spatial split there.
-        const bool halved =
-            count > max_leaf && levels_to_halve(count, max_leaf) + 1 >= max_depth - depth;
-        if (halved || budget_ == 0 || count <= min_spatial_count || !(root_area_ > 0))
+        if (must_halve(count, depth, max_leaf, max_depth) || budget_ == 0 ||
+            count <= min_spatial_count || !(root_area_ > 0))
             return left_count;
         const Box overlap = intersect(left_box, right_box);
         if (overlap.is_empty() || !(overlap.area() > spatial_.alpha * root_area_))

@@ -389,6 +389,14 @@ inline std::uint32_t levels_to_halve(std::uint64_t count, std::uint64_t max_leaf
     return levels;
 }
 
+/// Whether a node of `count` primitives at `depth` must be halved: the depth left only just
+/// suffices for halving down to `max_leaf` primitives a leaf. A rule peeling off a few primitives
+/// per level (extents spanning many decades) would otherwise reach max_depth with a huge leaf.
+inline bool must_halve(std::uint64_t count, std::uint32_t depth, std::uint64_t max_leaf,
+                       std::uint32_t max_depth) {
+    return count > max_leaf && levels_to_halve(count, max_leaf) + 1 >= max_depth - depth;
+}
+
 namespace top_down_detail {
 
 /// A node waiting to be split: its slot in the node array, its range of the index array, its
@@ -429,19 +437,15 @@ std::uint32_t split_node(const Context<T, N>& cx, const Work<T, N>& w, SplitRule
     const std::span<std::uint32_t> range(cx.indices + w.begin, count);
     const std::span<std::uint32_t> scratch(cx.scratch ? cx.scratch + w.begin : nullptr,
                                            cx.scratch ? count : 0);
-    // When the depth left only just suffices for halving down to max_leaf primitives, halve:
-    // a rule peeling off a few primitives per level (extents spanning many decades) would
-    // otherwise reach max_depth with a huge leaf.
-    const bool must_halve =
-        count > cx.max_leaf && levels_to_halve(count, cx.max_leaf) + 1 >= cx.max_depth - w.depth;
+    const bool halve = must_halve(count, w.depth, cx.max_leaf, cx.max_depth);
     const Split<T> split =
-        must_halve
+        halve
             ? Split<T>::leaf()
             : ask_rule(rule, SplitTask<T, N>{range, w.bounds.boxes.box(), centroid_bounds, w.depth},
                        exec);
     if (split.kind == Split<T>::Kind::Leaf && count <= cx.max_leaf) return 0;
     std::uint32_t left_count =
-        must_halve ? 0 : partition_primitives(cx.in, range, split, left, right, scratch, exec);
+        halve ? 0 : partition_primitives(cx.in, range, split, left, right, scratch, exec);
     if (left_count == 0 || left_count == count) {
         // The rule gave no split (or could not split). Fall back to the object median on the
         // centroids' longest axis; if all centroids coincide the order is arbitrary, so halve.
