@@ -8,7 +8,9 @@
 // BuildReport / skipped()); degenerate (zero-area) triangles stay in the tree and are never hit.
 // A ray with a NaN or infinite component or a zero direction misses without walking the tree.
 //
-// Batches of rays: trace() and occluded() over spans, on every core with oneTBB.
+// Batches of rays: trace() and occluded() over spans, on every core with oneTBB; trace_stream()
+// and occluded_stream() on the calling thread. On the eight-wide layout a batch walks several
+// rays at once (query/ray_stream.hpp): the one-by-one calls' answers, bit for bit.
 //
 // The triangle test is TriangleBvhOptions::triangle_test: watertight by default (no ray slips
 // through a shared edge or vertex of a closed mesh), or the fast Moller-Trumbore test, which can
@@ -28,6 +30,7 @@
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/ray.hpp"
+#include "bvhkit/query/ray_stream.hpp"
 #include "bvhkit/query/ray_wide.hpp"
 #include "bvhkit/query/triangle_rays.hpp"
 
@@ -99,7 +102,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
                     int lane;
                     if (!closest_hit_wide(wide, ray, k, prep, h, group, lane, stats))
                         return Hit<T>{};
-                    return Hit<T>{h.t, group->slot[lane], h.u, h.v, group->triangle(lane).normal()};
+                    return wide_hit(h, *group, lane);
                 };
                 return wide8_.empty() ? trace(wide4_) : trace(wide8_);
             }
@@ -141,7 +144,42 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
             stats);
     }
 
-    // Batches: trace() and occluded(), from RayBatches (query/triangle_rays.hpp).
+    // Batches: trace() and occluded(), from RayBatches (query/triangle_rays.hpp), which run these
+    // two on chunks of rays.
+
+    /// hits[i] = closest_hit(rays[i]) for every ray, on the calling thread (an Error when the
+    /// spans differ in length).
+    void trace_stream(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
+#if BVHKIT_RAY_AVX2
+        if constexpr (std::is_same_v<T, float>)
+            if (streams_rays()) {
+                this->check_lengths(rays.size(), hits.size(), "trace_stream: hits");
+                stream<false>(
+                    rays,
+                    [&](const detail::StreamRay& s) {
+                        hits[s.index] =
+                            s.hit_group ? wide_hit(s.best, *s.hit_group, s.hit_lane) : Hit<T>{};
+                    },
+                    [&](std::size_t i) { hits[i] = closest_hit(rays[i]); });
+                return;
+            }
+#endif
+        RayBatches<TriangleBvh<T>, T>::trace_stream(rays, hits);
+    }
+    /// occluded[i] = any_hit(rays[i]) (1 or 0) for every ray, on the calling thread.
+    void occluded_stream(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded) const {
+#if BVHKIT_RAY_AVX2
+        if constexpr (std::is_same_v<T, float>)
+            if (streams_rays()) {
+                this->check_lengths(rays.size(), occluded.size(), "occluded_stream: occluded");
+                stream<true>(
+                    rays, [&](const detail::StreamRay& s) { occluded[s.index] = s.found ? 1 : 0; },
+                    [&](std::size_t i) { occluded[i] = any_hit(rays[i]) ? 1 : 0; });
+                return;
+            }
+#endif
+        RayBatches<TriangleBvh<T>, T>::occluded_stream(rays, occluded);
+    }
 
     TriangleTest triangle_test() const {
         return triangle_test_;
@@ -152,6 +190,15 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
     bool traces_wide() const {
         return ray_width() > 2;
+    }
+    /// Whether the batch calls walk several rays at once (query/ray_stream.hpp): on the
+    /// eight-wide layout once it is 2 MB or more (about 45,000 triangles).
+    bool streams_rays() const {
+#if BVHKIT_RAY_AVX2
+        return !wide8_.empty() && detail::stream_pays(wide8_);
+#else
+        return false;
+#endif
     }
 
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
@@ -254,6 +301,48 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         return false;
 #endif
     }
+
+    /// A wide walk's hit as a Hit: the group holds the triangle's index and a copy of its corners
+    /// (the same normal as exact_'s, from the line just tested).
+    template <class Group>
+    static Hit<T> wide_hit(const TriangleHit<float>& h, const Group& group, int lane) {
+        return Hit<T>{h.t, group.slot[lane], h.u, h.v, group.triangle(lane).normal()};
+    }
+
+#if BVHKIT_RAY_AVX2
+    /// The rays through the eight-wide layout in a stream (query/ray_stream.hpp): finish(s) takes
+    /// each walked ray; a ray the wide walk does not serve goes to alone(i) (the one-ray call,
+    /// which walks the binary tree), one that misses the bounds is a miss without a walk.
+    template <bool AnyHit, class Finish, class Alone>
+    void stream(std::span<const Ray<float, 3>> rays, Finish&& finish, Alone&& alone) const {
+        const Aabb<float, 3>& bounds = bvh_.root().bounds;
+        std::size_t next = 0;
+        const auto start = [&](detail::StreamRay& s) {
+            while (next < rays.size()) {
+                const std::size_t i = next++;
+                const Ray<float, 3>& ray = rays[i];
+                if (!wide_ray_usable(ray)) {
+                    alone(i);
+                    continue;
+                }
+                s.index = i;
+                s.k = detail::SlabConstants(ray);
+                s.ray = ray;
+                if (!s.k.meets(bounds, ray.tmin, ray.tmax)) {
+                    s.hit_group = nullptr;
+                    s.found = false;
+                    finish(s);
+                    continue;
+                }
+                s.prep = WatertightRay<float>(ray, WatertightRay<float>::KnownValid{});
+                return true;
+            }
+            return false;
+        };
+        detail::StreamRay slots[detail::stream_width];
+        detail::stream8<AnyHit>(wide8_, slots, start, finish);
+    }
+#endif
 
     // The wide ray layout (query/ray_wide.hpp), derived from the tree and the triangles: made
     // after a build, a refit or a load.

@@ -103,6 +103,32 @@ class Scene {
         });
     }
 
+    /// Calls per_chunk(first, rays) for runs of up to ray_chunk rays, rays[j] the batch's ray
+    /// first + j: the tree's stream calls walk several at once (query/ray_stream.hpp).
+    static constexpr std::size_t ray_chunk = 256;
+    template <class PerChunk>
+    void ray_chunks(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
+                    const Column<T>& tmax, unsigned threads, PerChunk&& per_chunk) const {
+        const std::size_t k = origins.shape(0);
+        expect_rows(directions, k, "directions");
+        expect_rows(tmin, k, "tmin");
+        expect_rows(tmax, k, "tmax");
+        const T *o = origins.data(), *d = directions.data(), *t0 = tmin.data(), *t1 = tmax.data();
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        run_batch(k, 1024, threads, [&](std::size_t b, std::size_t e) {
+            Ray3 chunk[ray_chunk];
+            for (std::size_t first = b; first < e; first += ray_chunk) {
+                const std::size_t n = std::min(ray_chunk, e - first);
+                for (std::size_t j = 0; j < n; ++j) {
+                    const std::size_t i = first + j;
+                    chunk[j] = Ray3(row(o, i), row(d, i), t0[i], t1[i]);
+                }
+                per_chunk(first, std::span<const Ray3>(chunk, n));
+            }
+        });
+    }
+
     void intersect(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
                    const Column<T>& tmax, OutColumn<T> t, OutColumn<std::int64_t> face,
                    OutRows<T, 3> barycentric, unsigned threads) const {
@@ -111,21 +137,31 @@ class Scene {
         expect_rows(barycentric, origins.shape(0), "barycentric");
         T *tp = t.data(), *bp = barycentric.data();
         std::int64_t* fp = face.data();
-        rays(origins, directions, tmin, tmax, threads, [&](std::size_t i, const Ray3& ray) {
-            const Hit<T> h = rays_.closest_hit(ray);
-            tp[i] = h ? h.t : std::numeric_limits<T>::infinity();
-            fp[i] = h ? std::int64_t(h.primitive) : -1;
-            bp[3 * i] = h ? T(1) - h.u - h.v : T(0);
-            bp[3 * i + 1] = h.u;
-            bp[3 * i + 2] = h.v;
-        });
+        ray_chunks(origins, directions, tmin, tmax, threads,
+                   [&](std::size_t first, std::span<const Ray3> chunk) {
+                       Hit<T> hits[ray_chunk];
+                       rays_.trace_stream(chunk, std::span<Hit<T>>(hits, chunk.size()));
+                       for (std::size_t j = 0; j < chunk.size(); ++j) {
+                           const Hit<T>& h = hits[j];
+                           const std::size_t i = first + j;
+                           tp[i] = h ? h.t : std::numeric_limits<T>::infinity();
+                           fp[i] = h ? std::int64_t(h.primitive) : -1;
+                           bp[3 * i] = h ? T(1) - h.u - h.v : T(0);
+                           bp[3 * i + 1] = h.u;
+                           bp[3 * i + 2] = h.v;
+                       }
+                   });
     }
     void occluded(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
                   const Column<T>& tmax, OutColumn<bool> out, unsigned threads) const {
         expect_rows(out, origins.shape(0), "out");
         bool* op = out.data();
-        rays(origins, directions, tmin, tmax, threads,
-             [&](std::size_t i, const Ray3& ray) { op[i] = rays_.any_hit(ray); });
+        ray_chunks(origins, directions, tmin, tmax, threads,
+                   [&](std::size_t first, std::span<const Ray3> chunk) {
+                       std::uint8_t flags[ray_chunk];
+                       rays_.occluded_stream(chunk, std::span<std::uint8_t>(flags, chunk.size()));
+                       for (std::size_t j = 0; j < chunk.size(); ++j) op[first + j] = flags[j] != 0;
+                   });
     }
     void count_intersections(const Rows<T, 3>& origins, const Rows<T, 3>& directions,
                              const Column<T>& tmin, const Column<T>& tmax,

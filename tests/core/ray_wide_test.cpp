@@ -578,3 +578,67 @@ TEST(BatchRays, EqualTheOneByOneCallsOnEveryThreadCount) {
     EXPECT_THROW(bvh.occluded(rays, short_flags), Error);
     bvh.trace(std::span<const Ray3f>(), std::span<Hit<float>>());  // empty: nothing to do
 }
+
+// Streams (query/ray_stream.hpp): a layout of 2 MB or more walks a batch's rays several at once.
+// Their answers must be the one-by-one calls', bit for bit (t, u, v, triangle, normal, and the
+// any-hit flag), for every batch length (a stream of fewer rays than it keeps in flight, and
+// chunks that leave it part full), on the far side of the origin and tiny, with the rays the wide
+// walk does not take (subnormal direction components, NaN, tmin > tmax) mixed in.
+TEST(BatchRays, StreamsEqualTheOneByOneCalls) {
+    for (const auto& [scale, offset] : {std::pair{1.0, 1e5}, std::pair{1e-6, 0.0}}) {
+        const auto tris = test::placed<float>(make_sphere(6), scale, offset);
+        std::vector<Ray3f> rays = rays_for(tris, test::scaled(40000, 4), 11);
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        for (std::size_t i = 0; i < rays.size(); i += 97) rays[i].direction[i % 3] = nan;
+        for (std::size_t i = 50; i < rays.size(); i += 101) rays[i].tmin = rays[i].tmax + 1;
+        const TriangleBvh<float> bvh(tris);
+        if (!bvh.streams_rays()) GTEST_SKIP() << "no eight-wide layout on this CPU";
+        SCOPED_TRACE(scale);
+        std::vector<Hit<float>> one(rays.size());
+        std::vector<std::uint8_t> one_blocked(rays.size());
+        std::size_t hit_count = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            one[i] = bvh.closest_hit(rays[i]);
+            one_blocked[i] = bvh.any_hit(rays[i]) ? 1 : 0;
+            hit_count += bool(one[i]);
+        }
+        EXPECT_GT(hit_count, rays.size() / 10);  // the rays do reach the sphere
+        EXPECT_LT(hit_count, rays.size());
+        const auto expect_same = [&](const std::vector<Hit<float>>& hits,
+                                     const std::vector<std::uint8_t>& blocked) {
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                ASSERT_EQ(bool(hits[i]), bool(one[i])) << i;
+                ASSERT_EQ(blocked[i], one_blocked[i]) << i;
+                if (!one[i]) continue;
+                ASSERT_TRUE(same_bits(hits[i].t, one[i].t) && same_bits(hits[i].u, one[i].u) &&
+                            same_bits(hits[i].v, one[i].v))
+                    << i;
+                ASSERT_EQ(hits[i].primitive, one[i].primitive) << i;
+                ASSERT_EQ(hits[i].normal, one[i].normal) << i;
+            }
+        };
+        for (const unsigned threads : {1u, 2u}) {
+            std::vector<Hit<float>> hits(rays.size());
+            std::vector<std::uint8_t> blocked(rays.size(), 7);
+            bvh.trace(rays, hits, threads);
+            bvh.occluded(rays, blocked, threads);
+            expect_same(hits, blocked);
+        }
+        // The stream calls on runs of 1, 3, 7, 8, 9, ... rays.
+        std::vector<Hit<float>> hits(rays.size());
+        std::vector<std::uint8_t> blocked(rays.size(), 7);
+        const std::size_t runs[] = {1, 3, 7, 8, 9, 100, 1000};
+        for (std::size_t b = 0, r = 0; b < rays.size(); ++r) {
+            const std::size_t n = std::min(runs[r % std::size(runs)], rays.size() - b);
+            const std::span<const Ray3f> chunk(rays.data() + b, n);
+            bvh.trace_stream(chunk, std::span<Hit<float>>(hits.data() + b, n));
+            bvh.occluded_stream(chunk, std::span<std::uint8_t>(blocked.data() + b, n));
+            b += n;
+        }
+        expect_same(hits, blocked);
+        EXPECT_THROW(bvh.trace_stream(rays, std::span<Hit<float>>(hits.data(), 3)), Error);
+        EXPECT_THROW(bvh.occluded_stream(rays, std::span<std::uint8_t>(blocked.data(), 3)), Error);
+    }
+    // A small layout keeps one ray at a time.
+    EXPECT_FALSE(TriangleBvh<float>(test::placed<float>(make_sphere(3), 1, 0)).streams_rays());
+}

@@ -340,6 +340,23 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
 }
 
 #if BVHKIT_RAY_AVX2
+/// An eight-wide node's clip: the hit lanes' mask, their entry distances in `entry`. The ray's
+/// constants come as registers (origin, inv and inv_far per axis) and as the rows of its near and
+/// far planes (SlabConstants::near and far).
+[[gnu::target("avx2"), gnu::always_inline]] inline unsigned clip8(
+    const RayNode<8>& node, const __m256* origin, const __m256* inv, const __m256* inv_far,
+    const std::uint32_t* near_row, const std::uint32_t* far_row, __m256 t0, __m256 t1,
+    float* entry) {
+    for (int a = 0; a < 3; ++a) {
+        const __m256 near = _mm256_load_ps(node.lo[near_row[a]]);
+        const __m256 far = _mm256_load_ps(node.lo[far_row[a]]);
+        t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, origin[a]), inv[a]), t0);
+        t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, origin[a]), inv_far[a]), t1);
+    }
+    _mm256_store_ps(entry, t0);
+    return unsigned(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+}
+
 // walk4 in AVX registers. It is written out again because its AVX intrinsics must sit in a function
 // that carries the target attribute itself (GCC will not inline them into a lambda or a generic
 // helper of the default target), and walk4 must not carry it.
@@ -369,17 +386,10 @@ template <class OnLeaf, class Stats>
             const RayNode<8>& node = nodes[current.child];
             for (std::uint32_t c : node.child)
                 if (c != invalid_index) stats.node();
-            __m256 t0 = tmin, t1 = tmax;
-            for (int a = 0; a < 3; ++a) {
-                const __m256 near = _mm256_load_ps(node.lo[k.near[a]]);
-                const __m256 far = _mm256_load_ps(node.lo[k.far[a]]);
-                t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, origin[a]), inv[a]), t0);
-                t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, origin[a]), inv_far[a]), t1);
-            }
-            const unsigned mask = unsigned(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+            alignas(32) float entry[8];
+            const unsigned mask =
+                clip8(node, origin, inv, inv_far, k.near, k.far, tmin, tmax, entry);
             if (mask != 0) {
-                alignas(32) float entry[8];
-                _mm256_store_ps(entry, t0);
                 if constexpr (OnLeaf::any_hit)
                     take_hits_unordered<8>(mask, entry, node, current, stack, size, line);
                 else

@@ -105,7 +105,7 @@ class RayBatches {
     void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
                const Executor& exec) const {
         for_each(rays, hits, exec, "trace: hits",
-                 [&](const Ray<T, 3>& ray) { return tree().closest_hit(ray); });
+                 [&](auto chunk, auto out) { tree().trace_stream(chunk, out); });
     }
     void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
                   unsigned threads = 0) const {
@@ -114,20 +114,39 @@ class RayBatches {
     void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
                   const Executor& exec) const {
         for_each(rays, occluded, exec, "occluded: occluded",
-                 [&](const Ray<T, 3>& ray) { return std::uint8_t(tree().any_hit(ray) ? 1 : 0); });
+                 [&](auto chunk, auto out) { tree().occluded_stream(chunk, out); });
+    }
+
+    /// trace() on the calling thread: hits[i] = closest_hit(rays[i]). A tree that walks several
+    /// rays at once (TriangleBvh) hides this with its own, of the same answers.
+    void trace_stream(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
+        check_lengths(rays.size(), hits.size(), "trace_stream: hits");
+        for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = tree().closest_hit(rays[i]);
+    }
+    /// occluded() on the calling thread: occluded[i] = any_hit(rays[i]) (1 or 0).
+    void occluded_stream(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded) const {
+        check_lengths(rays.size(), occluded.size(), "occluded_stream: occluded");
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            occluded[i] = std::uint8_t(tree().any_hit(rays[i]) ? 1 : 0);
+    }
+
+  protected:
+    static void check_lengths(std::size_t rays, std::size_t out, const char* what) {
+        if (rays != out)
+            throw Error(std::string(what) + " holds " + std::to_string(out) + " entries for " +
+                        std::to_string(rays) + " rays");
     }
 
   private:
     const Tree& tree() const { return static_cast<const Tree&>(*this); }
 
-    template <class Out, class Answer>
+    /// Runs chunk(rays, out) over chunks of batch_grain on the executor's threads.
+    template <class Out, class Chunk>
     static void for_each(std::span<const Ray<T, 3>> rays, std::span<Out> out, const Executor& exec,
-                         const char* what, Answer&& answer) {
-        if (rays.size() != out.size())
-            throw Error(std::string(what) + " holds " + std::to_string(out.size()) +
-                        " entries for " + std::to_string(rays.size()) + " rays");
+                         const char* what, Chunk&& chunk) {
+        check_lengths(rays.size(), out.size(), what);
         exec.parallel_for(rays.size(), batch_grain, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) out[i] = answer(rays[i]);
+            chunk(rays.subspan(b, e - b), out.subspan(b, e - b));
         });
     }
 };

@@ -1,0 +1,146 @@
+#pragma once
+// Batches of rays through the eight-wide layout with several rays in flight on one thread.
+//
+// One ray at a time, each step of the walk needs the node or leaf the step before chose, so once
+// the tree outgrows the caches the walk waits for memory at nearly every step, and out-of-order
+// execution cannot reach into the next ray (hundreds of instructions on). Here a stream keeps
+// eight rays' walks at once: each in turn takes one step (a node's clip, or a leaf's groups),
+// asks for the lines of the entry it will take next, and yields, so that those lines arrive while
+// the other seven work (the interleaving of independent pointer chases of Kocberber, Falsafi and
+// Grot 2015, "Asynchronous memory access chaining").
+//
+// Each ray's walk is walk8's, step for step, with the same arithmetic (clip8, the same leaf
+// tests): the answers are the one-by-one calls', bit for bit; only the order in which the rays'
+// steps run is interleaved. Measured in docs/rays.md ("Streams").
+#include <cstddef>
+#include <limits>
+
+#include "bvhkit/query/ray_wide.hpp"
+
+namespace bvhkit {
+
+#if BVHKIT_RAY_AVX2
+namespace detail {
+
+/// Rays a stream keeps in flight. Four to sixteen measured within a few percent of each other on
+/// the 1.3M-triangle sphere; eight gave the most.
+inline constexpr int stream_width = 8;
+
+/// Whether a stream pays for `tree`: once its layout is 2 MB or more. A layout that stays in a
+/// core's L2 has little latency to hide, and the walks' interleaving costs it some (the branch
+/// history of one ray's walk no longer predicts its next step): on the machine of
+/// docs/rays.md, 0.91-0.95x one ray at a time below 1 MB, 1.0x at 2-4 MB, 1.03-1.3x above.
+inline bool stream_pays(const WideRayBvh<8>& tree) {
+    const std::size_t bytes =
+        tree.nodes.size() * sizeof(RayNode<8>) + tree.groups.size() * sizeof(TriangleGroup8);
+    return bytes >= (std::size_t(2) << 20);
+}
+
+/// One ray's walk in a stream: its constants and its stack, kept in memory between its steps.
+struct StreamRay {
+    SlabConstants k;
+    WatertightRay<float> prep;
+    Ray<float, 3> ray;  // ray.tmax shrinks to the closest hit so far
+    WideEntry current;
+    std::uint32_t size = 0;
+    std::size_t index = 0;  // the ray's place in the batch
+    TriangleHit<float> best{};
+    const TriangleGroup8* hit_group = nullptr;  // closest hit: where the hit lies; null on none
+    int hit_lane = 0;
+    bool found = false;  // any hit
+    bool live = false;   // walking
+    WideStack<8> stack;
+
+    StreamRay() : k(Ray<float, 3>({0, 0, 0}, {1, 0, 0})) {}
+};
+
+/// Walks rays through `tree`, stream_width at a time. start(StreamRay&) -> bool fills a slot with
+/// the next ray that needs a walk (its index, ray, SlabConstants and WatertightRay) or returns
+/// false when there is none; finish(const StreamRay&) takes a ray whose walk ended. AnyHit: stop
+/// at the first hit, children in any order (walk8 with AnyLeaves); else the closest hit
+/// (ClosestLeaves).
+template <bool AnyHit, class Start, class Finish>
+[[gnu::target("avx2")]] void stream8(const WideRayBvh<8>& tree, StreamRay* slots, Start&& start,
+                                     Finish&& finish) {
+    const RayNode<8>* nodes = tree.nodes.data();
+    const TriangleGroup8* groups = tree.groups.data();
+    const auto line = [&](const WideEntry& e) {  // both addresses, then a select
+        const char* node = reinterpret_cast<const char*>(nodes + e.child);
+        const char* group = reinterpret_cast<const char*>(groups + e.child);
+        return e.groups == 0 ? node : group;
+    };
+    // Asks for the lines of the entry a ray takes next, from line `from` on: a node's four, or up
+    // to ten of a leaf's (two groups of eight; the rest of a leaf of up to six arrive while the
+    // first are tested).
+    const auto ask = [&](const WideEntry& e, std::uint32_t from) {
+        const char* p = line(e);
+        const std::uint32_t lines = e.groups == 0 ? 4 : std::min<std::uint32_t>(10, 5 * e.groups);
+        for (std::uint32_t q = from; q < lines; ++q) _mm_prefetch(p + 64 * q, _MM_HINT_T0);
+    };
+    const auto begin = [&](StreamRay& s) {
+        s.live = start(s);
+        if (!s.live) return false;
+        s.current = WideEntry{0, 0, s.ray.tmin};
+        s.size = 0;
+        s.hit_group = nullptr;
+        s.found = false;
+        return true;
+    };
+    int live = 0;
+    for (int j = 0; j < stream_width; ++j) live += begin(slots[j]);
+    NoStats stats;
+    while (live > 0)
+        for (int j = 0; j < stream_width; ++j) {
+            StreamRay& s = slots[j];
+            if (!s.live) continue;
+            if (s.current.groups == 0) {
+                const RayNode<8>& node = nodes[s.current.child];
+                __m256 origin[3], inv[3], inv_far[3];
+                for (int a = 0; a < 3; ++a) {
+                    origin[a] = _mm256_set1_ps(s.k.origin[a]);
+                    inv[a] = _mm256_set1_ps(s.k.inv[a]);
+                    inv_far[a] = _mm256_set1_ps(s.k.inv_far[a]);
+                }
+                alignas(32) float entry[8];
+                const unsigned mask =
+                    clip8(node, origin, inv, inv_far, s.k.near, s.k.far, _mm256_set1_ps(s.ray.tmin),
+                          _mm256_set1_ps(s.ray.tmax), entry);
+                if (mask != 0) {
+                    // take_hits asks for the next entry's first three lines; the others here.
+                    if constexpr (AnyHit)
+                        take_hits_unordered<8>(mask, entry, node, s.current, s.stack, s.size, line);
+                    else
+                        take_hits<8>(mask, entry, node, s.current, s.stack, s.size, line);
+                    ask(s.current, 3);
+                    continue;
+                }
+            } else {
+                bool stop;
+                if constexpr (AnyHit) {
+                    AnyLeaves<TriangleGroup8, NoStats> leaves{groups, s.prep, s.ray, s.found,
+                                                              stats};
+                    stop = leaves.wide8(s.current.child, s.current.groups);
+                } else {
+                    ClosestLeaves<TriangleGroup8, NoStats> leaves{
+                        groups, s.prep, s.ray, s.best, s.hit_group, s.hit_lane, stats};
+                    stop = leaves.wide8(s.current.child, s.current.groups);
+                }
+                if (stop) {
+                    finish(s);
+                    live -= !begin(s);
+                    continue;
+                }
+            }
+            if (pop(s.stack, s.size, s.ray.tmax, s.current)) {
+                ask(s.current, 0);
+                continue;
+            }
+            finish(s);
+            live -= !begin(s);
+        }
+}
+
+}  // namespace detail
+#endif
+
+}  // namespace bvhkit
