@@ -147,3 +147,44 @@ def test_refit_moves_the_hits():
     assert abs(t0 - 4) < 1e-5 and abs(t1 - 3) < 1e-5
     # The proximity structures follow the refit too.
     assert abs(scene.closest_point([[0, 0, 0]]).distance[0] - 2) < 0.05
+
+
+def test_large_mesh_batches_match_per_ray_answers():
+    # 82k triangles: the batch calls walk eight rays at once (docs/rays.md, "Streams"). Each ray's
+    # answer must be its own whatever its place in a chunk: a permuted batch gives the permuted
+    # answers, hit/miss equals count_intersections > 0 (all hits, walked one ray at a time), and a
+    # sample equals the float64 brute force.
+    v, f = bvhkit.load_mesh("sphere:subdiv=6")
+    scene = bvhkit.TriangleMesh(v, f)
+    rng = np.random.default_rng(3)
+    k = 3000  # two batches of 1024 and a part one, chunks of 256 and a part one
+    o, d = random_rays(rng, k)
+    d[::7, 1] = 0.0  # zero direction components
+    d[::11, 2] = 1e-40  # a subnormal component: the one-ray walk
+    o[5::97, 0] = np.nan  # NaN rays miss
+    hits = scene.intersect(o, d)
+    counts = scene.count_intersections(o, d)
+    assert 0.3 * k < (counts > 0).sum() < k
+    np.testing.assert_array_equal(hits.face >= 0, counts > 0)
+    np.testing.assert_array_equal(scene.occluded(o, d), counts > 0)
+    perm = rng.permutation(k)
+    for threads in (1, 2):
+        again = scene.intersect(o[perm], d[perm], threads=threads)
+        np.testing.assert_array_equal(again.t, hits.t[perm])
+        np.testing.assert_array_equal(again.face, hits.face[perm])
+        np.testing.assert_array_equal(again.barycentric, hits.barycentric[perm])
+        np.testing.assert_array_equal(scene.occluded(o[perm], d[perm], threads=threads),
+                                      counts[perm] > 0)
+    vs = v.astype(np.float32).astype(np.float64)
+    sample = np.flatnonzero(np.isfinite(o).all(axis=1))[:64]
+    for part in np.array_split(sample, 8):
+        with np.errstate(invalid="ignore"):  # inf - inf in the reference's margin: no margin
+            t_ref, margin = ray_hits(vs, f, o[part].astype(np.float32),
+                                     d[part].astype(np.float32))
+        best = t_ref.min(axis=1)
+        clean = ((margin >= 1e-3) | ~np.isfinite(margin)).all(axis=1)
+        np.testing.assert_array_equal(np.isfinite(hits.t[part])[clean], np.isfinite(best)[clean])
+        both = clean & np.isfinite(best)
+        np.testing.assert_allclose(hits.t[part][both], best[both], rtol=1e-2)
+        np.testing.assert_allclose(t_ref[np.flatnonzero(both), hits.face[part][both]], best[both],
+                                   rtol=1e-2)
