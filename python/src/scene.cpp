@@ -86,23 +86,6 @@ class Scene {
     }
 
     using Ray3 = Ray<T, 3>;
-    /// Calls per_ray(i, ray) for each ray of the batch, on `threads` threads, without the GIL.
-    template <class PerRay>
-    void rays(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
-              const Column<T>& tmax, unsigned threads, PerRay&& per_ray) const {
-        const std::size_t k = origins.shape(0);
-        expect_rows(directions, k, "directions");
-        expect_rows(tmin, k, "tmin");
-        expect_rows(tmax, k, "tmax");
-        const T *o = origins.data(), *d = directions.data(), *t0 = tmin.data(), *t1 = tmax.data();
-        nb::gil_scoped_release release;
-        const std::shared_lock<std::shared_mutex> lock(mutex_);
-        run_batch(k, 1024, threads, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i)
-                per_ray(i, Ray3(row(o, i), row(d, i), t0[i], t1[i]));
-        });
-    }
-
     /// Calls per_chunk(first, rays) for runs of up to ray_chunk rays, rays[j] the batch's ray
     /// first + j: the tree's stream calls walk several at once (query/ray_stream.hpp).
     static constexpr std::size_t ray_chunk = 256;
@@ -168,11 +151,14 @@ class Scene {
                              OutColumn<std::int64_t> out, unsigned threads) const {
         expect_rows(out, origins.shape(0), "out");
         std::int64_t* op = out.data();
-        rays(origins, directions, tmin, tmax, threads, [&](std::size_t i, const Ray3& ray) {
-            std::int64_t n = 0;
-            rays_.all_hits(ray, [&](const Hit<T>&) { return ++n, true; });
-            op[i] = n;
-        });
+        ray_chunks(origins, directions, tmin, tmax, threads,
+                   [&](std::size_t first, std::span<const Ray3> chunk) {
+                       for (std::size_t j = 0; j < chunk.size(); ++j) {
+                           std::int64_t n = 0;
+                           rays_.all_hits(chunk[j], [&](const Hit<T>&) { return ++n, true; });
+                           op[first + j] = n;
+                       }
+                   });
     }
 
     /// A thread's storage for point queries: the walk's, and the previous point's closest point,

@@ -64,11 +64,7 @@ template <bool AnyHit, class Start, class Finish>
                                      Finish&& finish) {
     const RayNode<8>* nodes = tree.nodes.data();
     const TriangleGroup8* groups = tree.groups.data();
-    const auto line = [&](const WideEntry& e) {  // both addresses, then a select
-        const char* node = reinterpret_cast<const char*>(nodes + e.child);
-        const char* group = reinterpret_cast<const char*>(groups + e.child);
-        return e.groups == 0 ? node : group;
-    };
+    const auto line = [&](const WideEntry& e) { return entry_address(nodes, groups, e); };
     // Asks for the lines of the entry a ray takes next, from line `from` on: a node's four, or up
     // to ten of a leaf's (two groups of eight; the rest of a leaf of up to six arrive while the
     // first are tested).

@@ -214,6 +214,15 @@ template <int W, class Line>
     _mm_prefetch(next + 128, _MM_HINT_T0);
 }
 
+/// Where entry `e` starts: its node, or its leaf's first group (both addresses, then a select).
+template <class Node, class Group>
+[[gnu::always_inline]] inline const char* entry_address(const Node* nodes, const Group* groups,
+                                                        const WideEntry& e) {
+    const char* node = reinterpret_cast<const char*>(nodes + e.child);
+    const char* group = reinterpret_cast<const char*>(groups + e.child);
+    return e.groups == 0 ? node : group;
+}
+
 /// Pops the next entry the ray can still reach; false when none is left.
 [[gnu::always_inline]] inline bool pop(WideEntry* stack, std::uint32_t& size, float tmax,
                                        WideEntry& current) {
@@ -300,11 +309,7 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
     }
     const RayNode<4>* nodes = tree.nodes.data();
     const TriangleGroup4* groups = tree.groups.data();
-    const auto line = [&](const WideEntry& e) {  // both addresses, then a select
-        const char* node = reinterpret_cast<const char*>(nodes + e.child);
-        const char* group = reinterpret_cast<const char*>(groups + e.child);
-        return e.groups == 0 ? node : group;
-    };
+    const auto line = [&](const WideEntry& e) { return entry_address(nodes, groups, e); };
     std::uint32_t size = 0;
     WideEntry current{0, 0, ray.tmin};
     const __m128 tmin = _mm_set1_ps(ray.tmin);
@@ -372,11 +377,7 @@ template <class OnLeaf, class Stats>
     }
     const RayNode<8>* nodes = tree.nodes.data();
     const TriangleGroup8* groups = tree.groups.data();
-    const auto line = [&](const WideEntry& e) {  // both addresses, then a select
-        const char* node = reinterpret_cast<const char*>(nodes + e.child);
-        const char* group = reinterpret_cast<const char*>(groups + e.child);
-        return e.groups == 0 ? node : group;
-    };
+    const auto line = [&](const WideEntry& e) { return entry_address(nodes, groups, e); };
     std::uint32_t size = 0;
     WideEntry current{0, 0, ray.tmin};
     const __m256 tmin = _mm256_set1_ps(ray.tmin);
