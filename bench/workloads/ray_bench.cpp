@@ -34,6 +34,8 @@ struct Workload {
 
 /// A peer's answer for one ray (hit or occluded); empty without a peer.
 using PeerRay = std::function<bool(const Ray3f&, bool occlusion)>;
+/// The peer's own batch call on a chunk: found[i] = whether rays[i] hits.
+using PeerStream = std::function<void(std::span<const Ray3f>, bool occlusion, std::uint8_t*)>;
 
 /// The time of the row made before for `workload` on the mesh and library of `like`; 0 if none.
 double earlier_ms(const std::vector<Row>& rows, const Row& like, const std::string& workload) {
@@ -48,15 +50,18 @@ double earlier_ms(const std::vector<Row>& rows, const Row& like, const std::stri
 }
 
 /// R2-mt and R3-mt: the batch API (trace, occluded) on every core against the peer's one-ray calls
-/// (Embree's rtcIntersect1 and rtcOccluded1) made from the same chunks on every core.
+/// (Embree's rtcIntersect1 and rtcOccluded1) made from the same chunks on every core, and against
+/// its stream calls (rtcIntersect1M and rtcOccluded1M, flagged incoherent) on those chunks. The
+/// speedup is over the faster of the two.
 template <class RowFor>
 void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
                     const std::vector<Ray3f>& rays, RowFor&& row_for, int repetitions,
-                    const PeerRay& peer) {
+                    const PeerRay& peer, const PeerStream& peer_stream) {
     const Executor every_core(0);
     for (const Workload& w : {Workload{"R2-mt", &rays, false}, Workload{"R3-mt", &rays, true}}) {
         std::vector<Hit<float>> hits(rays.size());
-        std::vector<std::uint8_t> flags(rays.size()), peer_flags(rays.size());
+        std::vector<std::uint8_t> flags(rays.size()), peer_flags(rays.size()),
+            stream_flags(rays.size());
         std::vector<std::function<void()>> runs{[&] {
             if (w.occlusion)
                 tree.occluded(rays, flags, every_core);
@@ -71,11 +76,20 @@ void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
                                                 peer_flags[i] = peer(rays[i], w.occlusion);
                                         });
             });
+        if (peer_stream)
+            runs.push_back([&] {
+                every_core.parallel_for(rays.size(), TriangleBvh<float>::batch_grain,
+                                        [&](std::size_t b, std::size_t e) {
+                                            peer_stream(std::span(rays).subspan(b, e - b),
+                                                        w.occlusion, stream_flags.data() + b);
+                                        });
+            });
         const std::vector<double> ms = median_ms_interleaved(repetitions, runs);
-        long long found = 0, peer_found = 0;
+        long long found = 0, peer_found = 0, stream_found = 0;
         for (std::size_t i = 0; i < rays.size(); ++i) {
             found += w.occlusion ? flags[i] : bool(hits[i]);
             peer_found += peer_flags[i];
+            stream_found += stream_flags[i];
         }
         const double n = double(rays.size());
         const long long threads = have_parallel() ? (long long)hardware_threads() : 1;
@@ -84,7 +98,7 @@ void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
         Row row = row_for(w.name, "bvhkit");
         row.set("rays", (long long)rays.size()).set("hits", found).set("threads", threads);
         row.set("ms", ms[0]).set("mrays_per_s", n / ms[0] / 1e3);
-        if (peer) row.set("speedup", ms[1] / ms[0]);
+        if (peer) row.set("speedup", (peer_stream ? std::min(ms[1], ms[2]) : ms[1]) / ms[0]);
         if (const double t = earlier_ms(rows, row, one_thread); t > 0)
             row.set("scaling", t / ms[0]);
         rows.push_back(row);
@@ -94,6 +108,14 @@ void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
             p.set("ms", ms[1]).set("mrays_per_s", n / ms[1] / 1e3);
             if (const double t = earlier_ms(rows, p, one_thread); t > 0)
                 p.set("scaling", t / ms[1]);
+            rows.push_back(p);
+        }
+        if (peer_stream) {
+            Row p = row_for(w.name, "embree3-1M");
+            p.set("rays", (long long)rays.size()).set("hits", stream_found).set("threads", threads);
+            p.set("ms", ms[2]).set("mrays_per_s", n / ms[2] / 1e3);
+            if (const double t = earlier_ms(rows, row_for(w.name, "embree3"), one_thread); t > 0)
+                p.set("scaling", t / ms[2]);
             rows.push_back(p);
         }
     }
@@ -219,14 +241,19 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
             }
         }
         PeerRay peer_ray;
+        PeerStream peer_stream;
 #if BVHKIT_HAVE_EMBREE
         embree.clear();
         const EmbreeScene embree_all(mesh, 0);
         peer_ray = [&embree_all](const Ray3f& r, bool occlusion) {
             return occlusion ? embree_all.any_hit(r) : bool(embree_all.closest_hit(r));
         };
+        peer_stream = [&embree_all](std::span<const Ray3f> chunk, bool occlusion,
+                                    std::uint8_t* found) {
+            embree_all.stream_hits(chunk, occlusion, found);
+        };
 #endif
-        add_batch_rows(rows, trees[0], r2, row_for, options.repetitions, peer_ray);
+        add_batch_rows(rows, trees[0], r2, row_for, options.repetitions, peer_ray, peer_stream);
     }
     return rows;
 }
