@@ -22,8 +22,8 @@ namespace bvhkit {
 #if BVHKIT_RAY_AVX2
 namespace detail {
 
-/// Rays a stream keeps in flight. Four to sixteen measured within a few percent of each other on
-/// the 1.3M-triangle sphere; eight gave the most.
+/// Rays a stream keeps in flight. Four, eight and sixteen measured within a few percent of each
+/// other on igea and the 1.3M-triangle sphere (docs/rays.md); eight is kept.
 inline constexpr int stream_width = 8;
 
 /// Whether a stream pays for `tree`: once its layout is 2 MB or more. A layout that stays in a
