@@ -329,9 +329,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
                 s.k = detail::SlabConstants(ray);
                 s.ray = ray;
                 if (!s.k.meets(bounds, ray.tmin, ray.tmax)) {
-                    s.hit_group = nullptr;
-                    s.found = false;
-                    finish(s);
+                    finish(s);  // no hit: stream8 cleared the slot's hit
                     continue;
                 }
                 s.prep = WatertightRay<float>(ray, WatertightRay<float>::KnownValid{});

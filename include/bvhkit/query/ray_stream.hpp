@@ -12,8 +12,9 @@
 // Each ray's walk is walk8's, step for step, with the same arithmetic (clip8, the same leaf
 // tests): the answers are the one-by-one calls', bit for bit; only the order in which the rays'
 // steps run is interleaved. Measured in docs/rays.md ("Streams").
+#include <algorithm>
 #include <cstddef>
-#include <limits>
+#include <cstdint>
 
 #include "bvhkit/query/ray_wide.hpp"
 
@@ -58,7 +59,8 @@ struct StreamRay {
 
 /// Walks rays through `tree`, stream_width at a time. start(StreamRay&) -> bool fills a slot with
 /// the next ray that needs a walk (its index, ray, SlabConstants and WatertightRay) or returns
-/// false when there is none; finish(const StreamRay&) takes a ray whose walk ended. AnyHit: stop
+/// false when there is none; finish(const StreamRay&) takes a ray whose walk ended (start may
+/// pass it rays it answers without a walk: the slot then holds no hit). AnyHit: stop
 /// at the first hit, children in any order (walk8 with AnyLeaves); else the closest hit
 /// (ClosestLeaves).
 template <bool AnyHit, class Start, class Finish>
@@ -76,13 +78,12 @@ template <bool AnyHit, class Start, class Finish>
         for (std::uint32_t q = from; q < lines; ++q) _mm_prefetch(p + 64 * q, _MM_HINT_T0);
     };
     const auto begin = [&](StreamRay& s) {
-        s.live = start(s);
-        if (!s.live) return false;
-        s.current = WideEntry{0, 0, s.ray.tmin};
         s.size = 0;
         s.hit_group = nullptr;
         s.found = false;
-        return true;
+        s.live = start(s);
+        if (s.live) s.current = WideEntry{0, 0, s.ray.tmin};
+        return s.live;
     };
     int live = 0;
     for (int j = 0; j < stream_width; ++j) live += begin(slots[j]);
