@@ -92,6 +92,10 @@ class TriangleMesh:
     ``"sweep_sah"``, ``"bottom_up"``, ``"lbvh"``, ``"insertion"``, ...; ``+opt`` adds the
     reinsertion optimizer). ``ray_test`` is ``"watertight"`` (the default; Woop et al. 2013: a ray through a shared edge
     never slips between the two faces) or ``"fast"`` (Moller-Trumbore, which can).
+    ``spatial_splits=True`` builds the ray tree with spatial splits (Stich, Friedrich and
+    Dietrich 2009; ``builder="binned_sah"`` only): several times the build time, for faster rays
+    on meshes of long, thin or very unequal triangles (CAD tessellations, architecture, soups;
+    on even scans it buys nothing). Same answers; docs/rays.md has the figures.
 
     Faces with a NaN or infinite coordinate are left out of every query (see :meth:`skipped`);
     zero-area faces are never hit by rays. The ray tree is built at once; the closest point and
@@ -106,17 +110,26 @@ class TriangleMesh:
         dtype: Any = np.float32,
         ray_test: str = "watertight",
         threads: int = 0,
+        spatial_splits: bool = False,
     ) -> None:
         self.dtype: np.dtype = _a.scalar_type(dtype)
         if not isinstance(builder, str):
             raise TypeError(f"builder: must be a str, not {type(builder).__name__}")
         if not isinstance(ray_test, str):
             raise TypeError(f"ray_test: must be a str, not {type(ray_test).__name__}")
+        if not isinstance(spatial_splits, (bool, np.bool_)):
+            raise TypeError(
+                f"spatial_splits: must be a bool, not {type(spatial_splits).__name__}"
+            )
+        if spatial_splits and builder.replace("-", "_") != "binned_sah":
+            raise ValueError(f"spatial_splits: needs builder='binned_sah', not {builder!r}")
         v = _a.vertices("vertices", vertices, self.dtype)
         f = _a.faces(faces, len(v))
         impl = _bvhkit.Scene32 if self.dtype == np.float32 else _bvhkit.Scene64
         try:
-            self._impl = impl(v, f, builder.replace("_", "-"), ray_test, _a.threads(threads))
+            self._impl = impl(
+                v, f, builder.replace("_", "-"), ray_test, _a.threads(threads), bool(spatial_splits)
+            )
         except ValueError as e:
             raise ValueError(f"builder or ray_test: {e}") from None
         self._vertex_count = len(v)
@@ -266,7 +279,8 @@ class TriangleMesh:
 
     def stats(self) -> dict:
         """Measures of the ray tree: triangles, skipped, nodes, leaves, depth, average leaf size,
-        SAH cost and builder."""
+        SAH cost, builder, whether it has spatial splits, and its triangle references (more than
+        the triangles where spatial splits cut some)."""
         return dict(self._impl.stats())
 
     def skipped(self) -> np.ndarray:
@@ -287,7 +301,9 @@ class TriangleMesh:
     def to_bytes(self) -> bytes:
         """The scene as bytes (format: docs/scale-out.md): the mesh (as refitted, if it was) and
         the trees built so far, the proximity ones only if a query has built them. Reading it back
-        with :meth:`from_bytes` rebuilds nothing and answers bit for bit as this scene does."""
+        with :meth:`from_bytes` rebuilds nothing and answers bit for bit as this scene does; a ray
+        tree with spatial splits alone has no file format and is built again on reading (the same
+        tree, unless the scene was refitted: then a new one over the refitted mesh)."""
         return _scene_file.encode(self.dtype, self._builder, self._impl.state())
 
     @classmethod
@@ -324,7 +340,17 @@ class TriangleMesh:
         d = _scene_file.decode(data, what)
         impl = _bvhkit.Scene32 if d.dtype == np.float32 else _bvhkit.Scene64
         try:
-            self._impl = impl(d.vertices, d.faces, d.builder, threads, d.tree, d.sdf, d.winding)
+            self._impl = impl(
+                d.vertices,
+                d.faces,
+                d.builder,
+                threads,
+                d.tree,
+                d.sdf,
+                d.winding,
+                d.spatial_splits,
+                d.fast,
+            )
         except ValueError as e:
             raise ValueError(f"{what}: {e}") from None
         self.dtype = d.dtype

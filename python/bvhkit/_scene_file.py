@@ -20,6 +20,10 @@ _HEADER = struct.Struct("<8sIBBH7Q")  # magic, version, scalar, flags, reserved,
 HEADER_SIZE = _HEADER.size + 8  # + the checksum
 _SCALARS = {1: np.dtype("<f4"), 2: np.dtype("<f8")}
 _HAS_SDF, _HAS_WINDING = 1, 2
+# A ray tree with spatial splits has no file: the section is empty and loading builds it again,
+# with the fast ray test when _FAST is set too.
+_SPATIAL_SPLITS, _FAST = 4, 8
+_FLAGS = _HAS_SDF | _HAS_WINDING | _SPATIAL_SPLITS | _FAST
 
 load_count: int = 0
 """How many scenes this process has loaded (from_bytes, load, unpickling); a diagnostic, read by
@@ -60,10 +64,12 @@ def _split_sections(payload: Any, sizes: list, fail: Any) -> list:
 
 def encode(dtype: np.dtype, builder: str, state: tuple) -> bytes:
     """The container's bytes from the scene's ``state()`` (C++: mesh arrays and tree files)."""
-    vertices, faces, _ray_test, tree, sdf, winding = state
+    vertices, faces, ray_test, tree, sdf, winding, spatial_splits = state
     scalar = 1 if dtype == np.float32 else 2
     name = builder.encode("utf-8")
     flags = (_HAS_SDF if sdf is not None else 0) | (_HAS_WINDING if winding is not None else 0)
+    if spatial_splits:
+        flags |= _SPATIAL_SPLITS | (_FAST if ray_test == "fast" else 0)
     sections = [
         name,
         np.ascontiguousarray(vertices, _SCALARS[scalar]).tobytes(),
@@ -101,6 +107,8 @@ class Decoded:
     tree: bytes
     sdf: Optional[bytes]
     winding: Optional[bytes]
+    spatial_splits: bool  # the ray tree is built again (tree is empty)
+    fast: bool  # ... with the fast ray test
 
 
 def decode(data: Any, what: str) -> Decoded:
@@ -126,14 +134,20 @@ def decode(data: Any, what: str) -> Decoded:
         raise fail(f"format version {version}, this bvhkit reads {VERSION}")
     if scalar not in _SCALARS:
         raise fail(f"unknown scalar code {scalar}")
-    if flags & ~(_HAS_SDF | _HAS_WINDING) or reserved:
+    if flags & ~_FLAGS or reserved:
         raise fail("reserved bits set")
+    if flags & _FAST and not flags & _SPATIAL_SPLITS:
+        raise fail("the fast-test flag without the spatial-splits flag")
     if npayload != len(view) - HEADER_SIZE:
         raise fail(f"the header says {npayload} payload bytes, there are {len(view) - HEADER_SIZE}")
     payload = view[HEADER_SIZE:]
     if _checksum(bytes(view[: _HEADER.size]), payload) != bytes(view[_HEADER.size : HEADER_SIZE]):
         raise fail("checksum mismatch (the data is damaged)")
-    if bool(flags & _HAS_SDF) != (nsdf > 0) or bool(flags & _HAS_WINDING) != (nwinding > 0):
+    if (
+        bool(flags & _HAS_SDF) != (nsdf > 0)
+        or bool(flags & _HAS_WINDING) != (nwinding > 0)
+        or bool(flags & _SPATIAL_SPLITS) != (ntree == 0)
+    ):
         raise fail("flags and section sizes disagree")
     dtype = _SCALARS[scalar]
     sizes = [nname, 3 * nv * dtype.itemsize, 3 * nf * 4, ntree, nsdf, nwinding]
@@ -149,4 +163,6 @@ def decode(data: Any, what: str) -> Decoded:
     d.tree = bytes(parts[3])
     d.sdf = bytes(parts[4]) if nsdf else None
     d.winding = bytes(parts[5]) if nwinding else None
+    d.spatial_splits = bool(flags & _SPATIAL_SPLITS)
+    d.fast = bool(flags & _FAST)
     return d

@@ -35,27 +35,32 @@ Vec<T, 3> row(const T* p, std::size_t i) {
 template <class T>
 class Scene {
   public:
+    /// With `spatial_splits` the ray tree is the high-quality build (TriangleBvhOptions::
+    /// spatial_splits), which needs the binned SAH builder without the optimizer.
     Scene(const Rows<T, 3>& vertices, const Faces& faces, const std::string& builder,
-          const std::string& ray_test, unsigned threads)
+          const std::string& ray_test, unsigned threads, bool spatial_splits)
         : mesh_(make_mesh<T>(vertices, faces)), options_(parse_builder(builder)) {
         if (ray_test != "fast" && ray_test != "watertight")
             throw Error("ray_test: '" + ray_test + "' is not one of 'fast', 'watertight'");
         options_.threads = threads;
         nb::gil_scoped_release release;
-        TriangleBvhOptions ray_options(options_);
-        ray_options.triangle_test =
-            ray_test == "fast" ? TriangleTest::Fast : TriangleTest::Watertight;
-        rays_ = TriangleBvh<T>(mesh_, ray_options);
+        build_rays(ray_test == "fast", spatial_splits);
     }
 
     /// A scene from the parts state() gave (bvhkit/_scene_file.py holds them in one container):
-    /// the trees are loaded from their files, checked as every load is, never rebuilt, and must
-    /// cover exactly the mesh's faces. Any failure is a bvhkit::Error (ValueError).
+    /// the trees are loaded from their files, checked as every load is, and must cover exactly
+    /// the mesh's faces. Nothing is rebuilt, except a ray tree with spatial splits, which has no
+    /// file format: `tree` is then empty and the tree is built again, as it was (the build is
+    /// serial and deterministic), with `fast` for its ray test. Any failure is a bvhkit::Error
+    /// (ValueError).
     Scene(const Rows<T, 3>& vertices, const Faces& faces, const std::string& builder,
           unsigned threads, const nb::bytes& tree, const std::optional<nb::bytes>& sdf,
-          const std::optional<nb::bytes>& winding)
+          const std::optional<nb::bytes>& winding, bool spatial_splits, bool fast)
         : mesh_(make_mesh<T>(vertices, faces)), options_(parse_builder(builder)) {
         options_.threads = threads;
+        if (spatial_splits != (tree.size() == 0))
+            throw Error(spatial_splits ? "a scene with spatial splits holds no ray tree file"
+                                       : "the ray tree file is empty");
         const auto span = [](const nb::bytes& b) {
             return std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(b.c_str()),
                                                  b.size());
@@ -73,7 +78,10 @@ class Scene {
         const std::optional<std::span<const std::uint8_t>> winding_bytes =
             winding ? std::optional(span(*winding)) : std::nullopt;
         nb::gil_scoped_release release;
-        rays_ = triangle_bvh_from_bytes<T>(tree_bytes);
+        if (spatial_splits)
+            build_rays(fast, true);
+        else
+            rays_ = triangle_bvh_from_bytes<T>(tree_bytes);
         check(rays_.triangle_count(), "ray tree");
         if (sdf_bytes) {
             sdf_ = std::make_unique<SignedDistanceMesh<T>>(
@@ -266,6 +274,8 @@ class Scene {
         d["average_leaf_size"] = s.average_leaf_size();
         d["sah_cost"] = s.sah_cost;
         d["builder"] = to_string(options_.builder);
+        d["spatial_splits"] = spatial_splits_;
+        d["references"] = s.primitive_count;  // above the triangles where splits cut some
         return d;
     }
     nb::ndarray<nb::numpy, std::int64_t> skipped() const {
@@ -276,9 +286,10 @@ class Scene {
     }
     std::size_t triangle_count() const { return mesh_.triangles.size(); }
 
-    /// What the loading constructor takes: (vertices, faces int64, ray_test, ray tree file bytes,
-    /// signed distance file bytes or None, winding number file bytes or None), the proximity
-    /// files only where those structures have been built. One consistent snapshot.
+    /// What the loading constructor takes: (vertices, faces int64, ray_test, ray tree file bytes
+    /// (empty with spatial splits), signed distance file bytes or None, winding number file bytes
+    /// or None, spatial_splits), the proximity files only where those structures have been built.
+    /// One consistent snapshot.
     nb::tuple state() const {
         std::vector<T> v;
         std::vector<std::int64_t> f;
@@ -293,7 +304,7 @@ class Scene {
             f.reserve(3 * mesh_.triangles.size());
             for (const auto& t : mesh_.triangles) f.insert(f.end(), {t[0], t[1], t[2]});
             fast = rays_.triangle_test() == TriangleTest::Fast;
-            tree = to_bytes(rays_);
+            if (!spatial_splits_) tree = to_bytes(rays_);
             if ((has_sdf = bool(sdf_))) sdf = to_bytes(*sdf_);
             if ((has_winding = bool(winding_))) winding = to_bytes(*winding_);
         }
@@ -304,10 +315,20 @@ class Scene {
         return nb::make_tuple(owned_array(std::move(v), nv, 3), owned_array(std::move(f), nf, 3),
                               fast ? "fast" : "watertight", bytes(tree),
                               has_sdf ? nb::object(bytes(sdf)) : nb::none(),
-                              has_winding ? nb::object(bytes(winding)) : nb::none());
+                              has_winding ? nb::object(bytes(winding)) : nb::none(),
+                              spatial_splits_);
     }
 
   private:
+    /// The ray tree over the mesh, by the scene's builder (the caller has released the GIL).
+    void build_rays(bool fast, bool spatial_splits) {
+        TriangleBvhOptions ray_options(options_);
+        ray_options.triangle_test = fast ? TriangleTest::Fast : TriangleTest::Watertight;
+        ray_options.spatial_splits = spatial_splits;
+        rays_ = TriangleBvh<T>(mesh_, ray_options);
+        spatial_splits_ = spatial_splits;
+    }
+
     /// Builds what a query needs, once (the caller holds the shared lock; builders take this one).
     void prepare(bool need_sdf, bool need_winding) const {
         const std::lock_guard<std::mutex> lock(build_mutex_);
@@ -319,6 +340,7 @@ class Scene {
     BasicTriangleMesh<T> mesh_;
     BuildOptions options_;
     TriangleBvh<T> rays_;
+    bool spatial_splits_ = false;  // rays_ is the high-quality build (rebuilt on loading)
     mutable std::unique_ptr<SignedDistanceMesh<T>> sdf_;
     mutable std::unique_ptr<WindingNumberMesh<T>> winding_;
     mutable std::shared_mutex mutex_;
@@ -331,15 +353,17 @@ void bind_scene_type(nb::module_& m, const char* name) {
     nb::class_<S>(m, name,
                   "A triangle mesh ready for ray and proximity queries (see bvhkit.TriangleMesh).")
         .def(nb::init<const Rows<T, 3>&, const Faces&, const std::string&, const std::string&,
-                      unsigned>(),
+                      unsigned, bool>(),
              nb::arg("vertices"), nb::arg("faces"), nb::arg("builder"), nb::arg("ray_test"),
-             nb::arg("threads"), "Builds the ray tree over the mesh.")
+             nb::arg("threads"), nb::arg("spatial_splits"), "Builds the ray tree over the mesh.")
         .def(nb::init<const Rows<T, 3>&, const Faces&, const std::string&, unsigned,
                       const nb::bytes&, const std::optional<nb::bytes>&,
-                      const std::optional<nb::bytes>&>(),
+                      const std::optional<nb::bytes>&, bool, bool>(),
              nb::arg("vertices"), nb::arg("faces"), nb::arg("builder"), nb::arg("threads"),
              nb::arg("tree"), nb::arg("sdf").none(), nb::arg("winding").none(),
-             "Loads the scene from the parts state() gave (nothing is rebuilt).")
+             nb::arg("spatial_splits"), nb::arg("fast"),
+             "Loads the scene from the parts state() gave (only a spatial-split ray tree is "
+             "rebuilt).")
         .def("state", &S::state, "The mesh and the built trees' files, for saving.")
         .def("intersect", &S::intersect, nb::arg("origins"), nb::arg("directions"), nb::arg("tmin"),
              nb::arg("tmax"), nb::arg("t"), nb::arg("face"), nb::arg("barycentric"),

@@ -188,3 +188,70 @@ def test_large_mesh_batches_match_per_ray_answers():
         np.testing.assert_allclose(hits.t[part][both], best[both], rtol=1e-2)
         np.testing.assert_allclose(t_ref[np.flatnonzero(both), hits.face[part][both]], best[both],
                                    rtol=1e-2)
+
+
+def needle_scene(rng, offset, scale):
+    """Long needles across the cube, a floor of two large triangles, small triangles among them:
+    the unequal, overlapping triangles where spatial splits cut references."""
+    k = 40
+    a = rng.uniform(-1, 1, (k, 3))
+    b = -a + rng.uniform(-0.2, 0.2, (k, 3))
+    c = a + rng.uniform(-1e-3, 1e-3, (k, 3))  # width about 1e-3 against a length about 3
+    needles = np.stack([a, b, c], axis=1)
+    floor = np.array([[[-1, -1, -0.9], [1, -1, -0.9], [1, 1, -0.9]],
+                      [[-1, -1, -0.9], [1, 1, -0.9], [-1, 1, -0.9]]], float)
+    sv, _ = random_soup(rng, 200, size=0.05)
+    tris = np.concatenate([needles, floor, sv.reshape(-1, 3, 3)])
+    return tris.reshape(-1, 3) * scale + offset, np.arange(3 * len(tris)).reshape(-1, 3)
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+@pytest.mark.parametrize("case", ["unit", "far", "tiny"])
+def test_spatial_splits_answer_as_the_default_tree(dtype, case):
+    # The same triangle test on a different tree: t and barycentrics bit for bit, each triangle
+    # counted once although the split tree holds parts of it in several leaves, and the float64
+    # brute force agrees.
+    rng = np.random.default_rng(23)
+    offset, scale = {"unit": (0.0, 1.0), "far": (1e4, 100.0), "tiny": (0.0, 1e-6)}[case]
+    v, f = needle_scene(rng, offset, scale)
+    v = v.astype(dtype).astype(np.float64)
+    plain = bvhkit.TriangleMesh(v, f, dtype=dtype)
+    split = bvhkit.TriangleMesh(v, f, dtype=dtype, spatial_splits=True)
+    stats = split.stats()
+    assert stats["spatial_splits"] and not plain.stats()["spatial_splits"]
+    assert stats["references"] > len(f) == plain.stats()["references"]
+    o, d = random_rays(rng, 3000, spread=1.5)
+    o, d = (o * scale + offset).astype(dtype), (d * scale).astype(dtype)
+    d[::13, 0] = 0.0
+    for _ in range(2):  # as built, then both refitted the same way
+        a, b = plain.intersect(o, d), split.intersect(o, d)
+        np.testing.assert_array_equal(a.t, b.t)
+        same = a.face == b.face  # a different face only at an equal t (a tie)
+        assert same.mean() > 0.999
+        np.testing.assert_array_equal(a.barycentric[same], b.barycentric[same])
+        np.testing.assert_array_equal(plain.occluded(o, d), split.occluded(o, d))
+        np.testing.assert_array_equal(plain.count_intersections(o, d),
+                                      split.count_intersections(o, d))
+        t_ref, margin = ray_hits(v, f, o[:600], d[:600])
+        clean = ((margin >= MARGIN[dtype]) | ~np.isfinite(margin)).all(axis=1)
+        best = t_ref.min(axis=1)
+        assert clean.sum() > 300 and np.isfinite(best[clean]).sum() > 100
+        np.testing.assert_array_equal(np.isfinite(b.t[:600][clean]), np.isfinite(best[clean]))
+        hit = clean & np.isfinite(best)
+        np.testing.assert_allclose(b.t[:600][hit], best[hit], rtol=RTOL[dtype] * 100)
+        np.testing.assert_array_equal(split.count_intersections(o[:600], d[:600])[clean],
+                                      np.isfinite(t_ref).sum(axis=1)[clean])
+        moved = (v - offset) * 1.25 + offset
+        plain.refit(moved)
+        split.refit(moved)
+        v = moved.astype(dtype).astype(np.float64)
+
+
+def test_spatial_splits_bad_arguments():
+    v, f = bvhkit.load_mesh("sphere:subdiv=1")
+    with pytest.raises(TypeError, match="spatial_splits"):
+        bvhkit.TriangleMesh(v, f, spatial_splits="yes")
+    for builder in ["lbvh", "binned_sah+opt", "sweep_sah"]:
+        with pytest.raises(ValueError, match="spatial_splits"):
+            bvhkit.TriangleMesh(v, f, builder=builder, spatial_splits=True)
+    assert bvhkit.TriangleMesh(v, f, spatial_splits=np.bool_(True)).stats()["spatial_splits"]

@@ -190,3 +190,34 @@ def test_to_bytes_while_other_threads_query_and_build():
     for s in saved:
         copy = bvhkit.TriangleMesh.from_bytes(s.result())
         np.testing.assert_array_equal(copy.signed_distance(p, sign="winding_number"), want)
+
+
+@pytest.mark.parametrize("ray_test", ["watertight", "fast"])
+def test_spatial_split_scenes_rebuild_their_ray_tree(ray_test):
+    # A ray tree with spatial splits has no file: the container holds no tree and flags the
+    # rebuild (with the fast test when it was used), and the copy answers bit for bit.
+    rng = np.random.default_rng(9)
+    v = rng.uniform(-1, 1, (300, 3))
+    v[::3] *= 0.02  # long triangles among small ones
+    f = rng.integers(0, len(v), (400, 3))
+    scene = bvhkit.TriangleMesh(v, f, ray_test=ray_test, spatial_splits=True)
+    assert scene.stats()["spatial_splits"]
+    # (With the fast test the tree is binary and priced per triangle: here it splits none.)
+    assert scene.stats()["references"] > 400 or ray_test == "fast"
+    scene.closest_point(np.zeros((1, 3)))
+    data = scene.to_bytes()
+    d = _scene_file.decode(data, "data")
+    assert d.tree == b"" and d.spatial_splits and d.fast == (ray_test == "fast")
+    pts, o, dirs = queries(rng, 5000)
+    expected = answers(scene, pts, o, dirs)
+    for copy in [bvhkit.TriangleMesh.from_bytes(data), pickle.loads(pickle.dumps(scene))]:
+        assert copy.stats() == scene.stats()
+        assert_same(answers(copy, pts, o, dirs), expected)
+    assert bvhkit.TriangleMesh.from_bytes(data).to_bytes() == data
+    # The two flags and the tree section must agree.
+    flags_at = 13
+    for flags, tree_kept in [(8, True), (4 | 8, True), (0, False)]:
+        b = bytearray(data if not tree_kept else small_scene_bytes())
+        b[flags_at] = (b[flags_at] & 3) | flags
+        with pytest.raises(ValueError, match="flag|disagree|empty"):
+            bvhkit.TriangleMesh.from_bytes(reseal(b))
