@@ -10,7 +10,8 @@
 //
 // Batches of rays: trace() and occluded() over spans, on every core with oneTBB; trace_stream()
 // and occluded_stream() on the calling thread. On the eight-wide layout a batch walks several
-// rays at once (query/ray_stream.hpp): the one-by-one calls' answers, bit for bit.
+// rays at once (query/ray_stream.hpp; occlusion rays below 8 MB in octant streams,
+// query/ray_octant_stream.hpp): the one-by-one calls' answers, bit for bit.
 //
 // The triangle test is TriangleBvhOptions::triangle_test: watertight by default (no ray slips
 // through a shared edge or vertex of a closed mesh), or the fast Moller-Trumbore test, which can
@@ -30,6 +31,7 @@
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/ray.hpp"
+#include "bvhkit/query/ray_octant_stream.hpp"
 #include "bvhkit/query/ray_stream.hpp"
 #include "bvhkit/query/ray_wide.hpp"
 #include "bvhkit/query/triangle_rays.hpp"
@@ -169,14 +171,19 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     /// occluded[i] = any_hit(rays[i]) (1 or 0) for every ray, on the calling thread.
     void occluded_stream(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded) const {
 #if BVHKIT_RAY_AVX2
-        if constexpr (std::is_same_v<T, float>)
-            if (streams_rays()) {
+        if constexpr (std::is_same_v<T, float>) {
+            if (!wide8_.empty()) {
                 this->check_lengths(rays.size(), occluded.size(), "occluded_stream: occluded");
-                stream<true>(
-                    rays, [&](const detail::StreamRay& s) { occluded[s.index] = s.found ? 1 : 0; },
-                    [&](std::size_t i) { occluded[i] = any_hit(rays[i]) ? 1 : 0; });
+                if (detail::octant_streams_pay(wide8_))
+                    occlude_in_octants(rays, occluded);
+                else
+                    stream<true>(
+                        rays,
+                        [&](const detail::StreamRay& s) { occluded[s.index] = s.found ? 1 : 0; },
+                        [&](std::size_t i) { occluded[i] = any_hit(rays[i]) ? 1 : 0; });
                 return;
             }
+        }
 #endif
         RayBatches<TriangleBvh<T>, T>::occluded_stream(rays, occluded);
     }
@@ -191,8 +198,14 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     bool traces_wide() const {
         return ray_width() > 2;
     }
-    /// Whether the batch calls walk several rays at once (query/ray_stream.hpp): on the
-    /// eight-wide layout once it is 2 MB or more (about 45,000 triangles).
+    /// The bytes of the wide ray layout (0 when rays walk the binary tree).
+    std::size_t ray_layout_bytes() const {
+        return wide8_.empty() ? wide4_.bytes() : wide8_.bytes();
+    }
+    /// Whether trace batches walk several rays at once (query/ray_stream.hpp): on the eight-wide
+    /// layout once it is 2 MB or more (about 45,000 triangles). Occlusion batches on the
+    /// eight-wide layout always do: in octant streams below 8 MB (query/ray_octant_stream.hpp),
+    /// as trace batches above.
     bool streams_rays() const {
 #if BVHKIT_RAY_AVX2
         return !wide8_.empty() && detail::stream_pays(wide8_);
@@ -339,6 +352,29 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         };
         detail::StreamRay slots[detail::stream_width];
         detail::stream8<AnyHit>(wide8_, slots, start, finish);
+    }
+
+    // occluded_stream on an eight-wide layout below 8 MB: the rays in octant streams
+    // (query/ray_octant_stream.hpp); those the wide walk does not take go one by one.
+    void occlude_in_octants(std::span<const Ray<float, 3>> rays,
+                            std::span<std::uint8_t> occluded) const {
+        const Aabb<float, 3>& bounds = bvh_.root().bounds;
+        const auto blocked = [&](std::size_t i, bool b) { occluded[i] = b ? 1 : 0; };
+        detail::OctantStreams streams;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            const Ray<float, 3>& ray = rays[i];
+            if (!wide_ray_usable(ray)) {
+                occluded[i] = any_hit(ray) ? 1 : 0;
+                continue;
+            }
+            const detail::SlabConstants k(ray);
+            if (!k.meets(bounds, ray.tmin, ray.tmax)) {
+                occluded[i] = 0;
+                continue;
+            }
+            streams.add(wide8_, ray, k, i, blocked);
+        }
+        streams.finish(wide8_, blocked);
     }
 #endif
 

@@ -642,3 +642,88 @@ TEST(BatchRays, StreamsEqualTheOneByOneCalls) {
     // A small layout keeps one ray at a time.
     EXPECT_FALSE(TriangleBvh<float>(test::placed<float>(make_sphere(3), 1, 0)).streams_rays());
 }
+
+// Occlusion batches on a layout of 8 MB or more go back to the interleaved walks of
+// query/ray_stream.hpp (on smaller ones octant streams serve them, below): the same answers.
+TEST(BatchRays, LargeOcclusionBatchesEqualTheOneByOneCalls) {
+    if (test::small_scale()) GTEST_SKIP() << "328k triangles: Release only";
+    const auto tris = test::placed<float>(make_sphere(7), 1, 1e4);
+    const TriangleBvh<float> bvh(tris);
+    if (bvh.ray_width() != 8) GTEST_SKIP() << "no eight-wide layout on this CPU";
+    ASSERT_GE(bvh.ray_layout_bytes(), std::size_t(8) << 20);
+    std::vector<Ray3f> rays = rays_for(tris, 20000, 17);
+    for (std::size_t i = 0; i < rays.size(); i += 97)
+        rays[i].direction[i % 3] = std::numeric_limits<float>::quiet_NaN();
+    for (std::size_t i = 50; i < rays.size(); i += 101) rays[i].tmin = rays[i].tmax + 1;
+    std::vector<std::uint8_t> one(rays.size()), blocked(rays.size(), 7);
+    std::size_t blocked_count = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) blocked_count += one[i] = bvh.any_hit(rays[i]);
+    EXPECT_GT(blocked_count, rays.size() / 10);
+    bvh.occluded(rays, blocked, 2);
+    for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(blocked[i], one[i]) << i;
+    for (std::size_t b = 0; b < rays.size(); b += 9) {  // runs of 9: streams part full
+        const std::size_t n = std::min<std::size_t>(9, rays.size() - b);
+        bvh.occluded_stream(std::span<const Ray3f>(rays.data() + b, n),
+                            std::span<std::uint8_t>(blocked.data() + b, n));
+    }
+    for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(blocked[i], one[i]) << i;
+}
+
+// Octant streams (query/ray_octant_stream.hpp): below 2 MB the eight-wide layout's occlusion
+// batches walk up to 32 rays of one direction octant together. Each answer must be the one-ray
+// any_hit's: -0 and +0 direction components (which octant a ray joins), rays from inside the
+// boxes, rays aimed at vertices, NaN, subnormal components and empty intervals, short rays; runs
+// of 1 to 1,000 rays (streams left part full), 1 and 2 threads; needles, far and tiny meshes.
+TEST(BatchRays, OctantStreamsEqualTheOneByOneCalls) {
+    test::Random rng(29);
+    std::vector<Triangle<float>> needles;
+    for (int i = 0; i < 3000; ++i) {
+        Vec3f a, d, w;
+        for (int k = 0; k < 3; ++k) {
+            a[k] = float(rng.uniform(-1, 1));
+            d[k] = float(rng.uniform(-1, 1));
+            w[k] = float(rng.uniform(-1, 1));
+        }
+        needles.push_back(
+            {a, a + d, a + d * 0.5f + w * float(std::pow(10.0, rng.uniform(-6, -2)))});
+        if (i % 10 == 0) needles.push_back(needles.back());  // a duplicate
+    }
+    const std::vector<std::pair<std::string, std::vector<Triangle<float>>>> meshes{
+        {"far sphere", test::placed<float>(make_sphere(4), 1, 1e5)},
+        {"tiny torus", test::placed<float>(make_torus(64, 32), 1e-6, 0)},
+        {"needles", needles}};
+    for (const auto& [name, tris] : meshes) {
+        SCOPED_TRACE(name);
+        const TriangleBvh<float> bvh(tris);
+        if (bvh.ray_width() != 8) GTEST_SKIP() << "no eight-wide layout on this CPU";
+        ASSERT_LT(bvh.ray_layout_bytes(), std::size_t(8) << 20);
+        std::vector<Ray3f> rays = rays_for(tris, test::scaled(6000, 4), 5);
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        for (std::size_t i = 3; i < rays.size(); i += 89) rays[i].direction[i % 3] = nan;
+        for (std::size_t i = 6; i < rays.size(); i += 83) rays[i].direction[i % 3] = 1e-41f;
+        for (std::size_t i = 9; i < rays.size(); i += 79) rays[i].tmin = rays[i].tmax + 1;
+        for (std::size_t i = 12; i < rays.size(); i += 7) rays[i].tmax = 0.3f;  // short
+        for (std::size_t i = 15; i < rays.size(); i += 71) rays[i].tmin = rays[i].tmax = 0.5f;
+        std::vector<std::uint8_t> one(rays.size());
+        std::size_t blocked_count = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            blocked_count += one[i] = bvh.any_hit(rays[i]);
+        EXPECT_GT(blocked_count, rays.size() / 20);  // the rays do reach the mesh
+        EXPECT_LT(blocked_count, rays.size() * 9 / 10);
+        for (const unsigned threads : {1u, 2u}) {
+            std::vector<std::uint8_t> blocked(rays.size(), 7);
+            bvh.occluded(rays, blocked, threads);
+            for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(blocked[i], one[i]) << i;
+        }
+        std::vector<std::uint8_t> blocked(rays.size(), 7);
+        const std::size_t runs[] = {1, 7, 31, 32, 33, 100, 1000};
+        for (std::size_t b = 0, r = 0; b < rays.size(); ++r) {
+            const std::size_t n = std::min(runs[r % std::size(runs)], rays.size() - b);
+            bvh.occluded_stream(std::span<const Ray3f>(rays.data() + b, n),
+                                std::span<std::uint8_t>(blocked.data() + b, n));
+            b += n;
+        }
+        for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(blocked[i], one[i]) << i;
+        EXPECT_THROW(bvh.occluded_stream(rays, std::span<std::uint8_t>(blocked.data(), 3)), Error);
+    }
+}

@@ -32,9 +32,7 @@ inline constexpr int stream_width = 8;
 /// history of one ray's walk no longer predicts its next step): on the machine of
 /// docs/rays.md, 0.91-0.95x one ray at a time below 1 MB, 1.0x at 2-4 MB, 1.03-1.3x above.
 inline bool stream_pays(const WideRayBvh<8>& tree) {
-    const std::size_t bytes =
-        tree.nodes.size() * sizeof(RayNode<8>) + tree.groups.size() * sizeof(TriangleGroup8);
-    return bytes >= (std::size_t(2) << 20);
+    return tree.bytes() >= (std::size_t(2) << 20);
 }
 
 /// One ray's walk in a stream: its constants and its stack, kept in memory between its steps

@@ -53,6 +53,10 @@ struct WideRayBvh {
     std::vector<Group, HugePageAllocator<Group>> groups;
 
     bool empty() const { return nodes.empty(); }
+    /// The layout's size: what a walk reads from.
+    std::size_t bytes() const {
+        return nodes.size() * sizeof(RayNode<W>) + groups.size() * sizeof(Group);
+    }
 };
 
 /// Whether this CPU runs the eight-wide walk (AVX2), asked once.

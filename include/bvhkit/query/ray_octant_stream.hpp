@@ -1,0 +1,211 @@
+#pragma once
+// Occlusion rays of one direction octant walking the eight-wide layout together.
+//
+// Up to 32 rays whose directions share their signs go down the tree as one walk: each stack entry
+// carries a 32-bit mask of the rays still to visit it. At a node every such ray is clipped against
+// the node's eight boxes (the near and far planes are the same rows for the whole octant), and the
+// hit lanes are gathered into one register of per-child ray masks, a ray's bit or-ed into the
+// lanes it hits, so the walk pushes each hit child once, with the rays that hit it. At a leaf each
+// of its rays tests the leaf's groups; a ray that hits is done and leaves every mask. The node's
+// boxes, the push and the pop are paid once for all of its rays rather than once per ray (the
+// ray-stream traversal of Tsakok 2009 and Fuetterling et al. 2015, with incoherent rays sorted
+// by octant as Embree's stream calls do).
+//
+// Each ray's clip is clip8's arithmetic, lane for lane, and its leaf tests are walk8's: a ray
+// reaches a leaf here exactly when the one-ray walk, not stopping early, would, so the any-hit
+// answer is the one-ray call's. Measured in docs/rays.md ("Occlusion in octant streams").
+#include <cstddef>
+#include <cstdint>
+
+#include "bvhkit/query/ray_wide.hpp"
+
+namespace bvhkit {
+
+#if BVHKIT_RAY_AVX2
+namespace detail {
+
+/// Rays an octant stream holds: one bit each in a 32-bit mask (16 measured slower on igea).
+inline constexpr int octant_stream_size = 32;
+
+/// Whether octant streams serve an occlusion batch on `tree` better than the interleaved walks of
+/// query/ray_stream.hpp: below 8 MB. Occlusion batches against the one-ray loop, 500,000 random
+/// rays, one thread (docs/rays.md): octant streams 1.27x / 1.21x / 1.15x / 1.13x on layouts of
+/// 0.3 / 1.1 / 3.2 / 3.7 MB (the interleaved walks 1.02x and 1.00x on the last two, and slower
+/// than one ray at a time below 2 MB); at 13 and 17 MB 1.11x and 0.98x against the interleaved
+/// walks' 1.19x and 1.18x: there a node's rays are few and the walk waits for memory, which the
+/// interleaving hides.
+inline bool octant_streams_pay(const WideRayBvh<8>& tree) {
+    return tree.bytes() < (std::size_t(8) << 20);
+}
+
+/// The rays of one octant, their slab constants one array per component.
+struct OctantStream {
+    alignas(32) float origin[3][octant_stream_size];
+    alignas(32) float inv[3][octant_stream_size];
+    alignas(32) float inv_far[3][octant_stream_size];
+    alignas(32) float tmin[octant_stream_size];
+    alignas(32) float tmax[octant_stream_size];
+    WatertightRay<float> prep[octant_stream_size];
+    std::size_t index[octant_stream_size];  // the ray's place in the batch
+    int count = 0;
+
+    /// Adds a ray wide_ray_usable accepts, with its slab constants k.
+    void add(const Ray<float, 3>& ray, const SlabConstants& k, std::size_t i) {
+        const int r = count++;
+        for (int a = 0; a < 3; ++a) {
+            origin[a][r] = k.origin[a];
+            inv[a][r] = k.inv[a];
+            inv_far[a][r] = k.inv_far[a];
+        }
+        tmin[r] = ray.tmin;
+        tmax[r] = ray.tmax;
+        prep[r] = WatertightRay<float>(ray, WatertightRay<float>::KnownValid{});
+        index[r] = i;
+    }
+};
+
+/// The octant of a ray's direction: bit a set when component a's sign bit is (-0 included, as
+/// SlabConstants reads its planes).
+inline int direction_octant(const SlabConstants& k) {
+    return int(k.near[0] >= 3) | int(k.near[1] >= 3) << 1 | int(k.near[2] >= 3) << 2;
+}
+
+/// Walks the stream's rays (all of octant `octant`) through `tree`; calls blocked(index, bool)
+/// once for each.
+template <class Blocked>
+[[gnu::target("avx2")]] void occlude_octant_stream(const WideRayBvh<8>& tree, const OctantStream& s,
+                                                   int octant, Blocked&& blocked) {
+    struct Entry {
+        std::uint32_t child, groups, rays;  // groups > 0: a leaf; rays: the mask of its rays
+    };
+    const RayNode<8>* nodes = tree.nodes.data();
+    const TriangleGroup8* groups = tree.groups.data();
+    std::uint32_t near[3], far[3];  // SlabConstants' rows, the same for every ray of the octant
+    for (int a = 0; a < 3; ++a) {
+        const bool negative = (octant >> a) & 1;
+        near[a] = std::uint32_t(a + (negative ? 3 : 0));
+        far[a] = std::uint32_t(a + (negative ? 0 : 3));
+    }
+    const std::uint32_t all = s.count == 32 ? ~0u : (1u << s.count) - 1;
+    std::uint32_t live = all;  // rays not yet blocked
+    Entry stack[(8 - 1) * max_bvh_depth + 1];
+    std::uint32_t size = 0;
+    Entry current{0, 0, all};
+    while (true) {
+        if (current.groups == 0) {
+            const RayNode<8>& node = nodes[current.child];
+            const __m256 near_x = _mm256_load_ps(node.lo[near[0]]);
+            const __m256 near_y = _mm256_load_ps(node.lo[near[1]]);
+            const __m256 near_z = _mm256_load_ps(node.lo[near[2]]);
+            const __m256 far_x = _mm256_load_ps(node.lo[far[0]]);
+            const __m256 far_y = _mm256_load_ps(node.lo[far[1]]);
+            const __m256 far_z = _mm256_load_ps(node.lo[far[2]]);
+            // Lane c: the rays that hit child c.
+            __m256i rays_of = _mm256_setzero_si256();
+            for (std::uint32_t m = current.rays; m; m &= m - 1) {
+                const int r = __builtin_ctz(m);
+                // clip8's operations in clip8's order, for this ray.
+                const __m256 ox = _mm256_set1_ps(s.origin[0][r]);
+                const __m256 oy = _mm256_set1_ps(s.origin[1][r]);
+                const __m256 oz = _mm256_set1_ps(s.origin[2][r]);
+                __m256 t0 = _mm256_set1_ps(s.tmin[r]), t1 = _mm256_set1_ps(s.tmax[r]);
+                t0 = _mm256_max_ps(
+                    _mm256_mul_ps(_mm256_sub_ps(near_x, ox), _mm256_set1_ps(s.inv[0][r])), t0);
+                t1 = _mm256_min_ps(
+                    _mm256_mul_ps(_mm256_sub_ps(far_x, ox), _mm256_set1_ps(s.inv_far[0][r])), t1);
+                t0 = _mm256_max_ps(
+                    _mm256_mul_ps(_mm256_sub_ps(near_y, oy), _mm256_set1_ps(s.inv[1][r])), t0);
+                t1 = _mm256_min_ps(
+                    _mm256_mul_ps(_mm256_sub_ps(far_y, oy), _mm256_set1_ps(s.inv_far[1][r])), t1);
+                t0 = _mm256_max_ps(
+                    _mm256_mul_ps(_mm256_sub_ps(near_z, oz), _mm256_set1_ps(s.inv[2][r])), t0);
+                t1 = _mm256_min_ps(
+                    _mm256_mul_ps(_mm256_sub_ps(far_z, oz), _mm256_set1_ps(s.inv_far[2][r])), t1);
+                const __m256i hit = _mm256_castps_si256(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+                rays_of = _mm256_or_si256(rays_of,
+                                          _mm256_and_si256(hit, _mm256_set1_epi32(int(1u << r))));
+            }
+            unsigned children = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(
+                                    _mm256_cmpeq_epi32(rays_of, _mm256_setzero_si256())))) ^
+                                0xFFu;
+            if (children != 0) {
+                alignas(32) std::uint32_t mask[8];
+                _mm256_store_si256(reinterpret_cast<__m256i*>(mask), rays_of);
+                // Any order serves occlusion: the first hit child goes on, the others wait.
+                const int first = __builtin_ctz(children);
+                children &= children - 1;
+                current = Entry{node.child[first], node.groups[first], mask[first]};
+                for (; children; children &= children - 1) {
+                    const int c = __builtin_ctz(children);
+                    const Entry e{node.child[c], node.groups[c], mask[c]};
+                    stack[size++] = e;
+                    _mm_prefetch(entry_address(nodes, groups, WideEntry{e.child, e.groups, 0}),
+                                 _MM_HINT_T0);
+                }
+                continue;
+            }
+        } else {
+            for (std::uint32_t m = current.rays; m; m &= m - 1) {
+                const int r = __builtin_ctz(m);
+                bool found = false;
+                const auto record = [&](int, const TriangleHit<float>& h) {
+                    found = true;
+                    return h.t;
+                };
+                // AnyLeaves::wide8's tests, for this ray.
+                for (std::uint32_t g = current.child; g < current.child + current.groups && !found;
+                     ++g) {
+                    float tmax = s.tmax[r];
+                    intersect_watertight8(s.prep[r], groups[g], s.tmin[r], tmax, record);
+                }
+                if (found) live &= ~(1u << r);
+            }
+            if (live == 0) break;
+        }
+        // The next entry that still has live rays.
+        do {
+            if (size == 0) goto done;
+            current = stack[--size];
+            current.rays &= live;
+        } while (current.rays == 0);
+    }
+done:
+    for (int r = 0; r < s.count; ++r) blocked(s.index[r], ((live >> r) & 1) == 0);
+}
+
+/// Sorts a batch's rays into one stream per octant, walks a stream whenever it fills, and the
+/// part-full ones at the end. blocked(index, bool) gets each ray's answer. 26 KB: kept on the
+/// calling thread's stack for one batch.
+class OctantStreams {
+  public:
+    /// Adds ray i (one wide_ray_usable accepts, with its slab constants k); walks its octant's
+    /// stream if that is now full.
+    template <class Blocked>
+    void add(const WideRayBvh<8>& tree, const Ray<float, 3>& ray, const SlabConstants& k,
+             std::size_t i, Blocked&& blocked) {
+        const int octant = direction_octant(k);
+        OctantStream& s = streams_[octant];
+        s.add(ray, k, i);
+        if (s.count == octant_stream_size) {
+            occlude_octant_stream(tree, s, octant, blocked);
+            s.count = 0;
+        }
+    }
+    /// Walks the rays still waiting.
+    template <class Blocked>
+    void finish(const WideRayBvh<8>& tree, Blocked&& blocked) {
+        for (int octant = 0; octant < 8; ++octant) {
+            OctantStream& s = streams_[octant];
+            if (s.count > 0) occlude_octant_stream(tree, s, octant, blocked);
+            s.count = 0;
+        }
+    }
+
+  private:
+    OctantStream streams_[8];
+};
+
+}  // namespace detail
+#endif
+
+}  // namespace bvhkit
