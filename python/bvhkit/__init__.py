@@ -279,8 +279,8 @@ class TriangleMesh:
 
     def stats(self) -> dict:
         """Measures of the ray tree: triangles, skipped, nodes, leaves, depth, average leaf size,
-        SAH cost, builder, whether it has spatial splits, and its triangle references (more than
-        the triangles where spatial splits cut some)."""
+        SAH cost, builder, whether it has spatial splits, and its triangle references (the faces
+        in the tree, or more where spatial splits cut some)."""
         return dict(self._impl.stats())
 
     def skipped(self) -> np.ndarray:

@@ -1,6 +1,7 @@
 """The file format of a :class:`bvhkit.TriangleMesh` (``save``/``load``, ``to_bytes``/``from_bytes``
 and pickling): the mesh, the builder's name and the files of the trees built so far, so that a
-loaded scene rebuilds nothing and answers bit for bit as the saved one. Layout: docs/scale-out.md.
+loaded scene rebuilds nothing (but a ray tree with spatial splits, which has no file) and answers
+bit for bit as the saved one. Layout: docs/scale-out.md.
 
 The trees are stored as the library's own tree files (docs/serialization.md), which the C++ loaders
 check in full; this container adds a header, the mesh arrays and a checksum over everything.
@@ -20,8 +21,8 @@ _HEADER = struct.Struct("<8sIBBH7Q")  # magic, version, scalar, flags, reserved,
 HEADER_SIZE = _HEADER.size + 8  # + the checksum
 _SCALARS = {1: np.dtype("<f4"), 2: np.dtype("<f8")}
 _HAS_SDF, _HAS_WINDING = 1, 2
-# A ray tree with spatial splits has no file: the section is empty and loading builds it again,
-# with the fast ray test when _FAST is set too.
+# A ray tree with spatial splits has no file: its section lists the faces left out of it (u32,
+# ascending) and loading builds it again without them, with the fast ray test when _FAST is set.
 _SPATIAL_SPLITS, _FAST = 4, 8
 _FLAGS = _HAS_SDF | _HAS_WINDING | _SPATIAL_SPLITS | _FAST
 
@@ -107,7 +108,7 @@ class Decoded:
     tree: bytes
     sdf: Optional[bytes]
     winding: Optional[bytes]
-    spatial_splits: bool  # the ray tree is built again (tree is empty)
+    spatial_splits: bool  # the ray tree is built again (tree lists the faces left out)
     fast: bool  # ... with the fast ray test
 
 
@@ -143,11 +144,7 @@ def decode(data: Any, what: str) -> Decoded:
     payload = view[HEADER_SIZE:]
     if _checksum(bytes(view[: _HEADER.size]), payload) != bytes(view[_HEADER.size : HEADER_SIZE]):
         raise fail("checksum mismatch (the data is damaged)")
-    if (
-        bool(flags & _HAS_SDF) != (nsdf > 0)
-        or bool(flags & _HAS_WINDING) != (nwinding > 0)
-        or bool(flags & _SPATIAL_SPLITS) != (ntree == 0)
-    ):
+    if bool(flags & _HAS_SDF) != (nsdf > 0) or bool(flags & _HAS_WINDING) != (nwinding > 0):
         raise fail("flags and section sizes disagree")
     dtype = _SCALARS[scalar]
     sizes = [nname, 3 * nv * dtype.itemsize, 3 * nf * 4, ntree, nsdf, nwinding]

@@ -8,7 +8,8 @@ single-process call gives (every point and ray is answered on its own).
 The scene reaches each worker once, not once per partition: with a distributed Client active it
 is scattered to every worker (``client.scatter(scene, broadcast=True)``); without one it is a
 single key of the graph, which the local threaded scheduler uses in place. It travels in
-TriangleMesh's file format, trees included, so no worker rebuilds them (docs/scale-out.md).
+TriangleMesh's file format, trees included, so no worker rebuilds them (docs/scale-out.md; a
+ray tree with spatial splits alone is rebuilt by each worker that loads the scene).
 To reuse one shipment for several calls, pass ``share(scene)`` instead of the scene.
 
 ``threads`` is per partition and defaults to 1: dask already runs partitions in parallel.

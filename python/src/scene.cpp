@@ -4,12 +4,15 @@
 //
 // Thread safety: queries hold a shared lock, refit an exclusive one, so Python threads may call
 // anything at any time (the GIL is released during the work).
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
 #include <span>
+#include <vector>
 
 #include <nanobind/stl/optional.h>
 
@@ -50,17 +53,15 @@ class Scene {
     /// A scene from the parts state() gave (bvhkit/_scene_file.py holds them in one container):
     /// the trees are loaded from their files, checked as every load is, and must cover exactly
     /// the mesh's faces. Nothing is rebuilt, except a ray tree with spatial splits, which has no
-    /// file format: `tree` is then empty and the tree is built again, as it was (the build is
-    /// serial and deterministic), with `fast` for its ray test. Any failure is a bvhkit::Error
-    /// (ValueError).
+    /// file format: `tree` then lists the faces left out of it (u32, ascending) and the tree is
+    /// built again without them, with `fast` for its ray test (the build is serial and
+    /// deterministic: the same tree unless the mesh was refitted). Any failure is a
+    /// bvhkit::Error (ValueError).
     Scene(const Rows<T, 3>& vertices, const Faces& faces, const std::string& builder,
           unsigned threads, const nb::bytes& tree, const std::optional<nb::bytes>& sdf,
           const std::optional<nb::bytes>& winding, bool spatial_splits, bool fast)
         : mesh_(make_mesh<T>(vertices, faces)), options_(parse_builder(builder)) {
         options_.threads = threads;
-        if (spatial_splits != (tree.size() == 0))
-            throw Error(spatial_splits ? "a scene with spatial splits holds no ray tree file"
-                                       : "the ray tree file is empty");
         const auto span = [](const nb::bytes& b) {
             return std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(b.c_str()),
                                                  b.size());
@@ -78,10 +79,16 @@ class Scene {
         const std::optional<std::span<const std::uint8_t>> winding_bytes =
             winding ? std::optional(span(*winding)) : std::nullopt;
         nb::gil_scoped_release release;
-        if (spatial_splits)
-            build_rays(fast, true);
-        else
+        if (spatial_splits) {
+            const std::vector<std::uint32_t> left_out = read_left_out(tree_bytes, nt);
+            build_rays(fast, true, left_out);
+            if (!std::ranges::equal(rays_.skipped(), left_out))
+                throw Error("ray tree: the faces left out are not the ones the data lists (" +
+                            std::to_string(rays_.skipped().size()) + " against " +
+                            std::to_string(left_out.size()) + ")");
+        } else {
             rays_ = triangle_bvh_from_bytes<T>(tree_bytes);
+        }
         check(rays_.triangle_count(), "ray tree");
         if (sdf_bytes) {
             sdf_ = std::make_unique<SignedDistanceMesh<T>>(
@@ -287,9 +294,9 @@ class Scene {
     std::size_t triangle_count() const { return mesh_.triangles.size(); }
 
     /// What the loading constructor takes: (vertices, faces int64, ray_test, ray tree file bytes
-    /// (empty with spatial splits), signed distance file bytes or None, winding number file bytes
-    /// or None, spatial_splits), the proximity files only where those structures have been built.
-    /// One consistent snapshot.
+    /// (with spatial splits, the faces left out of the tree as u32), signed distance file bytes or
+    /// None, winding number file bytes or None, spatial_splits), the proximity files only where
+    /// those structures have been built. One consistent snapshot.
     nb::tuple state() const {
         std::vector<T> v;
         std::vector<std::int64_t> f;
@@ -304,7 +311,13 @@ class Scene {
             f.reserve(3 * mesh_.triangles.size());
             for (const auto& t : mesh_.triangles) f.insert(f.end(), {t[0], t[1], t[2]});
             fast = rays_.triangle_test() == TriangleTest::Fast;
-            if (!spatial_splits_) tree = to_bytes(rays_);
+            if (spatial_splits_) {
+                // Little-endian, whatever this machine's order.
+                for (const std::uint32_t face : rays_.skipped())
+                    for (int b = 0; b < 4; ++b) tree.push_back(std::uint8_t(face >> (8 * b)));
+            } else {
+                tree = to_bytes(rays_);
+            }
             if ((has_sdf = bool(sdf_))) sdf = to_bytes(*sdf_);
             if ((has_winding = bool(winding_))) winding = to_bytes(*winding_);
         }
@@ -320,13 +333,43 @@ class Scene {
     }
 
   private:
-    /// The ray tree over the mesh, by the scene's builder (the caller has released the GIL).
-    void build_rays(bool fast, bool spatial_splits) {
+    /// The ray tree over the mesh, by the scene's builder, without the faces of `left_out` (the
+    /// caller has released the GIL).
+    void build_rays(bool fast, bool spatial_splits, std::span<const std::uint32_t> left_out = {}) {
         TriangleBvhOptions ray_options(options_);
         ray_options.triangle_test = fast ? TriangleTest::Fast : TriangleTest::Watertight;
         ray_options.spatial_splits = spatial_splits;
-        rays_ = TriangleBvh<T>(mesh_, ray_options);
+        if (left_out.empty()) {
+            rays_ = TriangleBvh<T>(mesh_, ray_options);
+        } else {
+            // A NaN corner leaves a face out, as it left it out of the tree that was saved.
+            std::vector<Triangle<T>> triangles(mesh_.triangles.size());
+            for (std::size_t i = 0; i < triangles.size(); ++i)
+                triangles[i] = triangle_at<T>(mesh_, i);
+            for (const std::uint32_t face : left_out)
+                triangles[face].p0[0] = std::numeric_limits<T>::quiet_NaN();
+            rays_ = TriangleBvh<T>(triangles, ray_options);
+        }
         spatial_splits_ = spatial_splits;
+    }
+
+    /// The faces a spatial-split scene's data says were left out of its ray tree: u32
+    /// little-endian, ascending, each below `faces`.
+    static std::vector<std::uint32_t> read_left_out(std::span<const std::uint8_t> bytes,
+                                                    std::size_t faces) {
+        if (bytes.size() % 4 != 0)
+            throw Error("ray tree: the list of faces left out has " + std::to_string(bytes.size()) +
+                        " bytes, not a multiple of 4");
+        std::vector<std::uint32_t> left_out(bytes.size() / 4);
+        for (std::size_t k = 0; k < left_out.size(); ++k) {
+            std::uint32_t face = 0;
+            for (int b = 0; b < 4; ++b) face |= std::uint32_t(bytes[4 * k + b]) << (8 * b);
+            if (face >= faces || (k > 0 && face <= left_out[k - 1]))
+                throw Error("ray tree: the faces left out are not ascending face indices below " +
+                            std::to_string(faces));
+            left_out[k] = face;
+        }
+        return left_out;
     }
 
     /// Builds what a query needs, once (the caller holds the shared lock; builders take this one).

@@ -207,7 +207,7 @@ def test_spatial_split_scenes_rebuild_their_ray_tree(ray_test):
     scene.closest_point(np.zeros((1, 3)))
     data = scene.to_bytes()
     d = _scene_file.decode(data, "data")
-    assert d.tree == b"" and d.spatial_splits and d.fast == (ray_test == "fast")
+    assert d.tree == b"" and d.spatial_splits and d.fast == (ray_test == "fast")  # none left out
     pts, o, dirs = queries(rng, 5000)
     expected = answers(scene, pts, o, dirs)
     for copy in [bvhkit.TriangleMesh.from_bytes(data), pickle.loads(pickle.dumps(scene))]:
@@ -219,5 +219,48 @@ def test_spatial_split_scenes_rebuild_their_ray_tree(ray_test):
     for flags, tree_kept in [(8, True), (4 | 8, True), (0, False)]:
         b = bytearray(data if not tree_kept else small_scene_bytes())
         b[flags_at] = (b[flags_at] & 3) | flags
-        with pytest.raises(ValueError, match="flag|disagree|empty"):
+        with pytest.raises(ValueError, match="flag|left out|TriangleBvh file"):
             bvhkit.TriangleMesh.from_bytes(reseal(b))
+
+
+def with_tree_section(data: bytes, section: bytes) -> bytes:
+    """A spatial-split container whose ray tree section is replaced by `section`."""
+    d = _scene_file.decode(data, "data")
+    assert d.spatial_splits
+    state = (d.vertices, d.faces, "fast" if d.fast else "watertight", section, d.sdf, d.winding,
+             True)
+    return _scene_file.encode(d.dtype, d.builder, state)
+
+
+def test_spatial_split_scenes_keep_the_faces_left_out():
+    # A face with a NaN corner is left out of the tree; a refit that makes it finite keeps it out.
+    # The rebuilt tree of a loaded copy must leave out the same faces.
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [0, 1, 1]], float)
+    f = np.array([[0, 1, 2], [3, 4, 5]])
+    bad = v.copy()
+    bad[3, 0] = np.nan
+    scene = bvhkit.TriangleMesh(bad, f, spatial_splits=True)
+    scene.refit(v)
+    o, d = [[0.2, 0.2, 2.0]], [[0.0, 0.0, -1.0]]
+    data = scene.to_bytes()
+    for copy in [bvhkit.TriangleMesh.from_bytes(data), pickle.loads(pickle.dumps(scene))]:
+        np.testing.assert_array_equal(copy.skipped(), [1])
+        np.testing.assert_array_equal(copy.intersect(o, d).face, [0])
+        np.testing.assert_array_equal(copy.count_intersections(o, d), [1])
+    # A list of faces left out that is not one: each a ValueError.
+    clean = bvhkit.TriangleMesh(v, f, spatial_splits=True).to_bytes()
+    for section, message in [
+        (b"\1\0\0", "multiple of 4"),
+        (np.array([2], "<u4").tobytes(), "ascending face indices"),
+        (np.array([1, 0], "<u4").tobytes(), "ascending face indices"),
+        (np.array([1, 1], "<u4").tobytes(), "ascending face indices"),
+    ]:
+        with pytest.raises(ValueError, match=message):
+            bvhkit.TriangleMesh.from_bytes(with_tree_section(clean, section))
+    # The list must name every face with a non-finite corner, and only those it may leave out.
+    nan_mesh = bvhkit.TriangleMesh(bad, f, spatial_splits=True).to_bytes()
+    with pytest.raises(ValueError, match="faces left out are not the ones"):
+        bvhkit.TriangleMesh.from_bytes(with_tree_section(nan_mesh, b""))
+    kept_out = bvhkit.TriangleMesh.from_bytes(
+        with_tree_section(clean, np.array([0], "<u4").tobytes()))
+    np.testing.assert_array_equal(kept_out.skipped(), [0])
