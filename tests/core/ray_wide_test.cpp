@@ -669,7 +669,7 @@ TEST(BatchRays, LargeOcclusionBatchesEqualTheOneByOneCalls) {
     for (std::size_t i = 0; i < rays.size(); ++i) ASSERT_EQ(blocked[i], one[i]) << i;
 }
 
-// Octant streams (query/ray_octant_stream.hpp): below 2 MB the eight-wide layout's occlusion
+// Octant streams (query/ray_octant_stream.hpp): below 8 MB the eight-wide layout's occlusion
 // batches walk up to 32 rays of one direction octant together. Each answer must be the one-ray
 // any_hit's: -0 and +0 direction components (which octant a ray joins), rays from inside the
 // boxes, rays aimed at vertices, NaN, subnormal components and empty intervals, short rays; runs

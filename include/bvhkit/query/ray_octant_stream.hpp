@@ -24,16 +24,17 @@ namespace bvhkit {
 #if BVHKIT_RAY_AVX2
 namespace detail {
 
-/// Rays an octant stream holds: one bit each in a 32-bit mask (16 measured slower on igea).
+/// Rays an octant stream holds: one bit each in a 32-bit mask (16 measured 1.14x the one-ray
+/// loop on the bunny against 1.16x with 32, and 1.06x against 1.12x on igea).
 inline constexpr int octant_stream_size = 32;
 
 /// Whether octant streams serve an occlusion batch on `tree` better than the interleaved walks of
 /// query/ray_stream.hpp: below 8 MB. Occlusion batches against the one-ray loop, 500,000 random
-/// rays, one thread (docs/rays.md): octant streams 1.27x / 1.21x / 1.15x / 1.13x on layouts of
-/// 0.3 / 1.1 / 3.2 / 3.7 MB (the interleaved walks 1.02x and 1.00x on the last two, and slower
-/// than one ray at a time below 2 MB); at 13 and 17 MB 1.11x and 0.98x against the interleaved
-/// walks' 1.19x and 1.18x: there a node's rays are few and the walk waits for memory, which the
-/// interleaving hides.
+/// rays, one thread (docs/rays.md): octant streams 1.28x / 1.22x / 1.19-1.22x / 1.19-1.21x on
+/// layouts of 0.3 / 1.1 / 3.2 / 3.7 MB, where the interleaved walks gave 1.02x and 1.00x on the
+/// last two (and lose below 2 MB); at 13 MB 1.15-1.17x against 1.13-1.22x, at 17 and 60 MB 1.19x
+/// and 1.09x against 1.25x and 1.22x: there a node's rays are few and the walk waits for memory,
+/// which the interleaving hides better.
 inline bool octant_streams_pay(const WideRayBvh<8>& tree) {
     return tree.bytes() < (std::size_t(8) << 20);
 }
@@ -94,33 +95,20 @@ template <class Blocked>
     while (true) {
         if (current.groups == 0) {
             const RayNode<8>& node = nodes[current.child];
-            const __m256 near_x = _mm256_load_ps(node.lo[near[0]]);
-            const __m256 near_y = _mm256_load_ps(node.lo[near[1]]);
-            const __m256 near_z = _mm256_load_ps(node.lo[near[2]]);
-            const __m256 far_x = _mm256_load_ps(node.lo[far[0]]);
-            const __m256 far_y = _mm256_load_ps(node.lo[far[1]]);
-            const __m256 far_z = _mm256_load_ps(node.lo[far[2]]);
+            __m256 near_planes[3], far_planes[3];
+            for (int a = 0; a < 3; ++a) {
+                near_planes[a] = _mm256_load_ps(node.lo[near[a]]);
+                far_planes[a] = _mm256_load_ps(node.lo[far[a]]);
+            }
             // Lane c: the rays that hit child c.
             __m256i rays_of = _mm256_setzero_si256();
             for (std::uint32_t m = current.rays; m; m &= m - 1) {
                 const int r = __builtin_ctz(m);
-                // clip8's operations in clip8's order, for this ray.
-                const __m256 ox = _mm256_set1_ps(s.origin[0][r]);
-                const __m256 oy = _mm256_set1_ps(s.origin[1][r]);
-                const __m256 oz = _mm256_set1_ps(s.origin[2][r]);
                 __m256 t0 = _mm256_set1_ps(s.tmin[r]), t1 = _mm256_set1_ps(s.tmax[r]);
-                t0 = _mm256_max_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(near_x, ox), _mm256_set1_ps(s.inv[0][r])), t0);
-                t1 = _mm256_min_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(far_x, ox), _mm256_set1_ps(s.inv_far[0][r])), t1);
-                t0 = _mm256_max_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(near_y, oy), _mm256_set1_ps(s.inv[1][r])), t0);
-                t1 = _mm256_min_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(far_y, oy), _mm256_set1_ps(s.inv_far[1][r])), t1);
-                t0 = _mm256_max_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(near_z, oz), _mm256_set1_ps(s.inv[2][r])), t0);
-                t1 = _mm256_min_ps(
-                    _mm256_mul_ps(_mm256_sub_ps(far_z, oz), _mm256_set1_ps(s.inv_far[2][r])), t1);
+                for (int a = 0; a < 3; ++a)  // clip8's clip, for this ray
+                    clip_axis8(near_planes[a], far_planes[a], _mm256_set1_ps(s.origin[a][r]),
+                               _mm256_set1_ps(s.inv[a][r]), _mm256_set1_ps(s.inv_far[a][r]), t0,
+                               t1);
                 const __m256i hit = _mm256_castps_si256(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
                 rays_of = _mm256_or_si256(rays_of,
                                           _mm256_and_si256(hit, _mm256_set1_epi32(int(1u << r))));
@@ -135,6 +123,14 @@ template <class Blocked>
                 const int first = __builtin_ctz(children);
                 children &= children - 1;
                 current = Entry{node.child[first], node.groups[first], mask[first]};
+                {  // walk8 asks for the same lines (bunny 1.14-1.16x -> 1.20-1.22x the one-ray
+                   // loop)
+                    const char* next =
+                        entry_address(nodes, groups, WideEntry{current.child, current.groups, 0});
+                    _mm_prefetch(next, _MM_HINT_T0);
+                    _mm_prefetch(next + 64, _MM_HINT_T0);
+                    _mm_prefetch(next + 128, _MM_HINT_T0);
+                }
                 for (; children; children &= children - 1) {
                     const int c = __builtin_ctz(children);
                     const Entry e{node.child[c], node.groups[c], mask[c]};

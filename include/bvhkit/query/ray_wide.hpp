@@ -349,6 +349,17 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
 }
 
 #if BVHKIT_RAY_AVX2
+/// One axis of the eight-wide slab test: [t0, t1] narrowed to the ray's stretch between the near
+/// and far planes of the eight boxes. Every eight-wide clip goes through it (clip8, the octant
+/// streams), so that all of them round alike.
+[[gnu::target("avx2"), gnu::always_inline]] inline void clip_axis8(__m256 near, __m256 far,
+                                                                   __m256 origin, __m256 inv,
+                                                                   __m256 inv_far, __m256& t0,
+                                                                   __m256& t1) {
+    t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, origin), inv), t0);
+    t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, origin), inv_far), t1);
+}
+
 /// An eight-wide node's clip: the hit lanes' mask, their entry distances in `entry`. The ray's
 /// constants come as registers (origin, inv and inv_far per axis) and as the rows of its near and
 /// far planes (SlabConstants::near and far).
@@ -356,12 +367,9 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
     const RayNode<8>& node, const __m256* origin, const __m256* inv, const __m256* inv_far,
     const std::uint32_t* near_row, const std::uint32_t* far_row, __m256 t0, __m256 t1,
     float* entry) {
-    for (int a = 0; a < 3; ++a) {
-        const __m256 near = _mm256_load_ps(node.lo[near_row[a]]);
-        const __m256 far = _mm256_load_ps(node.lo[far_row[a]]);
-        t0 = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, origin[a]), inv[a]), t0);
-        t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, origin[a]), inv_far[a]), t1);
-    }
+    for (int a = 0; a < 3; ++a)
+        clip_axis8(_mm256_load_ps(node.lo[near_row[a]]), _mm256_load_ps(node.lo[far_row[a]]),
+                   origin[a], inv[a], inv_far[a], t0, t1);
     _mm256_store_ps(entry, t0);
     return unsigned(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
 }
