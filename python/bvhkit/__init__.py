@@ -93,9 +93,10 @@ class TriangleMesh:
     reinsertion optimizer). ``ray_test`` is ``"watertight"`` (the default; Woop et al. 2013: a ray through a shared edge
     never slips between the two faces) or ``"fast"`` (Moller-Trumbore, which can).
     ``spatial_splits=True`` builds the ray tree with spatial splits (Stich, Friedrich and
-    Dietrich 2009; ``builder="binned_sah"`` only): several times the build time, for faster rays
+    Dietrich 2009; ``builder="binned_sah"`` only): 6-21x the build time (serial), for faster rays
     on meshes of long, thin or very unequal triangles (CAD tessellations, architecture, soups;
-    on even scans it buys nothing). Same answers; docs/rays.md has the figures.
+    on even scans it buys nothing). The same hits, but that among faces hit at the same t up to
+    rounding another may be named; docs/python.md has the figures.
 
     Faces with a NaN or infinite coordinate are left out of every query (see :meth:`skipped`);
     zero-area faces are never hit by rays. The ray tree is built at once; the closest point and
@@ -303,7 +304,8 @@ class TriangleMesh:
         the trees built so far, the proximity ones only if a query has built them. Reading it back
         with :meth:`from_bytes` rebuilds nothing and answers bit for bit as this scene does; a ray
         tree with spatial splits alone has no file format and is built again on reading (the same
-        tree, unless the scene was refitted: then a new one over the refitted mesh)."""
+        tree on the same kind of machine, unless the scene was refitted: then a new one over the
+        refitted mesh)."""
         return _scene_file.encode(self.dtype, self._builder, self._impl.state())
 
     @classmethod
