@@ -113,11 +113,11 @@ TEST(ExactTriangleTriangle, DoubleHardPairsMatchExactReference) {
 }
 
 TEST(ExactTriangleTriangle, ZeroAreaTrianglesAreSegmentsAndPoints) {
-    using Tri = Triangle<double>;
-    const Tri a{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-    const Tri needle{{0.2, 0.2, -1}, {0.2, 0.2, 1}, {0.2, 0.2, 0}};  // collinear, through a
-    const Tri point{{0.2, 0.2, 0}, {0.2, 0.2, 0}, {0.2, 0.2, 0}};    // on a
-    const Tri above{{0.2, 0.2, 1e-9}, {0.2, 0.2, 1e-9}, {0.2, 0.2, 1e-9}};
+    using Tri3 = Triangle<double>;
+    const Tri3 a{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const Tri3 needle{{0.2, 0.2, -1}, {0.2, 0.2, 1}, {0.2, 0.2, 0}};  // collinear, through a
+    const Tri3 point{{0.2, 0.2, 0}, {0.2, 0.2, 0}, {0.2, 0.2, 0}};    // on a
+    const Tri3 above{{0.2, 0.2, 1e-9}, {0.2, 0.2, 1e-9}, {0.2, 0.2, 1e-9}};
     EXPECT_TRUE(is_degenerate(needle));
     EXPECT_TRUE(is_degenerate(point));
     EXPECT_FALSE(is_degenerate(a));

@@ -86,7 +86,7 @@ TEST(SharedMeshesQuality, SweepSahCostIsNoWorseThanBinnedOnEveryMesh) {
         // with them.
         const TriangleBvh<float> binned_tree(mesh), sweep_tree(mesh, sweep);
         SahCosts costs;
-        costs.leaf_block = binned_tree.ray_width() > 2 ? 4 : 1;
+        costs.leaf_block = binned_tree.ray_width() > 2 ? binned_tree.ray_width() : 1;
         const double binned_cost = statistics(binned_tree.bvh(), costs).sah_cost;
         const double sweep_cost = statistics(sweep_tree.bvh(), costs).sah_cost;
         std::printf("%-20s SAH cost: binned %.3f, sweep %.3f\n", name, binned_cost, sweep_cost);

@@ -17,12 +17,9 @@
 #include "test_support.hpp"
 
 using namespace bvhkit;
+using bvhkit::test::same_bits;
 
 namespace {
-
-bool same_bits(float a, float b) {
-    return std::memcmp(&a, &b, sizeof a) == 0;
-}
 
 /// Rays through the triangles' bounding box: from outside and inside, some aimed exactly at a
 /// vertex or along an axis, some with direction components +0, -0 or subnormal.

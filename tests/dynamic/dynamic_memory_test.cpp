@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bvhkit/dynamic/dynamic_tree.hpp"
+#include "test_geometry.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -16,9 +17,7 @@ using bvhkit::DynamicTree;
 using bvhkit::ProxyId;
 using Tree = DynamicTree<float, 2>;
 
-Aabb2f box2(float x, float y, float w = 1, float h = 1) {
-    return {{x, y}, {x + w, y + h}};
-}
+using bvhkit::test::box2;
 
 TEST(DynamicTreeMemory, MoveBufferIsBoundedWithoutFindPairs) {
     Tree t;

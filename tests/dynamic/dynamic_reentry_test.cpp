@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bvhkit/dynamic/dynamic_tree.hpp"
+#include "test_geometry.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -19,9 +20,7 @@ using bvhkit::ProxyId;
 using bvhkit::Vec2f;
 using Tree = DynamicTree<float, 2>;
 
-Aabb2f box2(float x, float y, float w = 1, float h = 1) {
-    return {{x, y}, {x + w, y + h}};
-}
+using bvhkit::test::box2;
 
 /// Eight overlapping proxies: 15 nodes in a pool of 16, so a create() needing two more nodes
 /// grows (moves) the pool.

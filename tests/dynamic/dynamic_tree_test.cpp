@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bvhkit/dynamic/dynamic_tree.hpp"
+#include "test_geometry.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -22,9 +23,7 @@ using bvhkit::InsertionStrategy;
 using bvhkit::ProxyId;
 using bvhkit::Vec2f;
 
-Aabb2f box2(float x, float y, float w = 1, float h = 1) {
-    return {{x, y}, {x + w, y + h}};
-}
+using bvhkit::test::box2;
 
 std::vector<ProxyId> query_ids(const DynamicTree<float, 2>& t, const Aabb2f& b) {
     std::vector<ProxyId> ids;

@@ -12,6 +12,7 @@
 #include "bvhkit/mesh/procedural.hpp"
 #include "byte_flips.hpp"
 #include "random_geometry.hpp"
+#include "test_geometry.hpp"
 #include "test_support.hpp"
 
 using namespace bvhkit;
@@ -73,21 +74,15 @@ void round_trip(const ClosestPointMesh<T>& mesh, const Aabb<T, 3>& bounds,
     }
 }
 
-template <class T>
-Aabb<T, 3> bounds_of(const TriangleMesh& mesh) {
-    const Aabb3f b = mesh.bounds();
-    return {Vec<T, 3>(b.min), Vec<T, 3>(b.max)};
-}
-
 TEST(ClosestPointMeshFile, RoundTrips) {
     BVHKIT_REQUIRE_MESH(path, "spot.obj");
     const TriangleMesh spot = read_mesh(path);
-    round_trip(ClosestPointMesh<float>(spot), bounds_of<float>(spot), "spot float");
-    round_trip(ClosestPointMesh<double>(spot), bounds_of<double>(spot), "spot double");
+    round_trip(ClosestPointMesh<float>(spot), bounds_as<float>(spot), "spot float");
+    round_trip(ClosestPointMesh<double>(spot), bounds_as<double>(spot), "spot double");
     for (const char* spec : {"sphere:subdiv=3,displacement=0.3", "terrain:n=20", "soup:n=2000"}) {
         const TriangleMesh m = make_procedural(spec);
-        round_trip(ClosestPointMesh<float>(m), bounds_of<float>(m), spec);
-        round_trip(ClosestPointMesh<double>(m), bounds_of<double>(m), spec);
+        round_trip(ClosestPointMesh<float>(m), bounds_as<float>(m), spec);
+        round_trip(ClosestPointMesh<double>(m), bounds_as<double>(m), spec);
     }
     // Triangles left out of the tree, one with a finite edge that counts in the longest edge.
     std::vector<Triangle<float>> soup = random_soup<float>(300, 9);

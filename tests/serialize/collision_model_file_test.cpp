@@ -34,11 +34,6 @@ Transform<T> random_pose(SplitMix64& rng, double reach) {
     return pose;
 }
 
-template <class T>
-bool same_bits(const T& a, const T& b) {
-    return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
-
 template <class V>
 void expect_same_model(const CollisionModel<V>& got, const CollisionModel<V>& want) {
     const auto &g = got.bvh(), &w = want.bvh();
@@ -212,7 +207,7 @@ TEST(CollisionModelFile, SavesAndLoadsFiles) {
     }
 }
 
-std::vector<std::uint8_t> small_file() {
+std::vector<std::uint8_t> small_model_file() {
     return to_bytes(CollisionModel<Obb<float>>(make_sphere(1)));  // 80 triangles
 }
 
@@ -229,7 +224,7 @@ void expect_error(std::span<const std::uint8_t> bytes, const std::string& what,
 }
 
 TEST(CollisionModelFile, EveryTruncationIsAnError) {
-    const std::vector<std::uint8_t> file = small_file();
+    const std::vector<std::uint8_t> file = small_model_file();
     ASSERT_NO_THROW((void)collision_model_from_bytes<Obb<float>>(file));
     for (std::size_t n = 0; n < file.size(); ++n)
         expect_error<Obb<float>>(std::span(file).first(n), "truncated to " + std::to_string(n));
@@ -239,7 +234,7 @@ TEST(CollisionModelFile, EveryTruncationIsAnError) {
 }
 
 TEST(CollisionModelFile, WrongKindVolumeOrScalarIsAnError) {
-    const std::vector<std::uint8_t> file = small_file();
+    const std::vector<std::uint8_t> file = small_model_file();
     expect_error<Aabb<float, 3>>(file, "as aabb", "bounding volume Obb");
     expect_error<ObbRss<float>>(file, "as obbrss", "bounding volume Obb");
     expect_error<Kdop<float, 14>>(file, "as kdop14", "bounding volume Obb");
@@ -254,7 +249,7 @@ TEST(CollisionModelFile, WrongKindVolumeOrScalarIsAnError) {
 // FNV-1a changes with any one-byte change; resealed, the flips reach the other checks: a load is
 // an Error or a model that answers queries with indices in range.
 TEST(CollisionModelFile, ByteFlipsAreErrorsOrUsableModels) {
-    const std::vector<std::uint8_t> file = small_file();
+    const std::vector<std::uint8_t> file = small_model_file();
     const CollisionModel<Obb<float>> other(make_sphere(1));
     SplitMix64 rng(11);
     const std::size_t rounds = full_scale() ? 100000 : scaled(10000, 10);
@@ -288,7 +283,7 @@ TEST(CollisionModelFile, ByteFlipsAreErrorsOrUsableModels) {
     EXPECT_LE(loaded[1], loaded[0]);
 }
 
-// Offsets of the sections of small_file() (docs/serialization.md).
+// Offsets of the sections of small_model_file() (docs/serialization.md).
 constexpr std::size_t header = 72;
 constexpr std::size_t obb_node = 15 * 4 + 8;
 
@@ -311,7 +306,7 @@ float get_f32(const std::vector<std::uint8_t>& f, std::size_t at) {
 }
 
 TEST(CollisionModelFile, HostileHeadersAreErrors) {
-    const std::vector<std::uint8_t> file = small_file();
+    const std::vector<std::uint8_t> file = small_model_file();
     using O = Obb<float>;
     // Counts that claim more than the file holds, before anything is allocated.
     for (int c = 0; c < 3; ++c)
@@ -343,7 +338,7 @@ TEST(CollisionModelFile, HostileHeadersAreErrors) {
 // validate(): a volume shrunk (so it would cull a pair that meets) fails; grown, it loads (it
 // only costs time); axes that are not orthonormal and negative sizes fail.
 TEST(CollisionModelFile, CorruptedVolumesFailValidate) {
-    const std::vector<std::uint8_t> file = small_file();
+    const std::vector<std::uint8_t> file = small_model_file();
     using O = Obb<float>;
     const CollisionModel<O> model = collision_model_from_bytes<O>(file);
     const std::size_t nodes = model.bvh().nodes.size();

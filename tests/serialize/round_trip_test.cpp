@@ -17,17 +17,13 @@
 #include "bvhkit/math/random.hpp"
 #include "bvhkit/mesh/procedural.hpp"
 #include "random_geometry.hpp"
+#include "test_geometry.hpp"
 #include "test_support.hpp"
 
 using namespace bvhkit;
 using namespace bvhkit::test;
 
 namespace {
-
-template <class T>
-bool same_bits(T a, T b) {
-    return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
 
 template <class T>
 bool same_hit(const Hit<T, 3>& a, const Hit<T, 3>& b) {
@@ -141,12 +137,6 @@ void round_trip(const TriangleBvh<T>& tree, const Aabb<T, 3>& bounds, const std:
     expect_same_answers(mapped, tree, bounds, scaled(2000, 10), 8, true);
 }
 
-template <class T>
-Aabb<T, 3> bounds_of(const TriangleMesh& mesh) {
-    const Aabb3f b = mesh.bounds();
-    return {Vec<T, 3>(b.min), Vec<T, 3>(b.max)};
-}
-
 TEST(TriangleBvhFile, SpotRoundTripsInBothScalarsAndTests) {
     BVHKIT_REQUIRE_MESH(path, "spot.obj");
     const TriangleMesh mesh = read_mesh(path);
@@ -154,8 +144,8 @@ TEST(TriangleBvhFile, SpotRoundTripsInBothScalarsAndTests) {
         TriangleBvhOptions options;
         options.triangle_test = test;
         const std::string name = test == TriangleTest::Fast ? "spot fast" : "spot watertight";
-        round_trip(TriangleBvh<float>(mesh, options), bounds_of<float>(mesh), name + " float");
-        round_trip(TriangleBvh<double>(mesh, options), bounds_of<double>(mesh), name + " double");
+        round_trip(TriangleBvh<float>(mesh, options), bounds_as<float>(mesh), name + " float");
+        round_trip(TriangleBvh<double>(mesh, options), bounds_as<double>(mesh), name + " double");
     }
 }
 
@@ -174,8 +164,8 @@ TEST(TriangleBvhFile, ProceduralMeshesAndBuildersRoundTrip) {
                 options.triangle_test = test;
                 const std::string what = std::string(spec) + " " + bname +
                                          (test == TriangleTest::Fast ? " fast" : " watertight");
-                round_trip(TriangleBvh<float>(mesh, options), bounds_of<float>(mesh), what);
-                round_trip(TriangleBvh<double>(mesh, options), bounds_of<double>(mesh), what);
+                round_trip(TriangleBvh<float>(mesh, options), bounds_as<float>(mesh), what);
+                round_trip(TriangleBvh<double>(mesh, options), bounds_as<double>(mesh), what);
             }
     }
 }
@@ -233,7 +223,7 @@ TEST(TriangleBvhFile, RefittedTreeRoundTrips) {
     TriangleBvh<float> tree(mesh);
     for (auto& v : mesh.vertices) v = v * 1.5f + Vec3f(0.25f, 0, 0);
     tree.refit(mesh);
-    round_trip(tree, bounds_of<float>(mesh), "refitted torus");
+    round_trip(tree, bounds_as<float>(mesh), "refitted torus");
 }
 
 TEST(TriangleBvhFile, SaveAndLoadThroughAFile) {
@@ -249,7 +239,7 @@ TEST(TriangleBvhFile, SaveAndLoadThroughAFile) {
     EXPECT_EQ(std::filesystem::file_size(path), to_bytes(tree).size());
     const TriangleBvh<float> loaded = load_triangle_bvh<float>(path);
     expect_same_tree(loaded, tree);
-    expect_same_answers(loaded, tree, bounds_of<float>(mesh), 1000, 11);
+    expect_same_answers(loaded, tree, bounds_as<float>(mesh), 1000, 11);
     // A double load of a float file names both types; a missing file is an Error too.
     try {
         (void)load_triangle_bvh<double>(path);
@@ -263,7 +253,7 @@ TEST(TriangleBvhFile, SaveAndLoadThroughAFile) {
     // Mapped: the arrays in the mapping, the answers of the same tree walked binary.
     const MappedTriangleBvh<float> mapped = map_triangle_bvh<float>(path);
     expect_same_arrays(mapped, tree);
-    expect_same_answers(mapped, binary_twin<float>(to_bytes(tree)), bounds_of<float>(mesh), 1000,
+    expect_same_answers(mapped, binary_twin<float>(to_bytes(tree)), bounds_as<float>(mesh), 1000,
                         11);
     try {
         (void)map_triangle_bvh<double>(path);

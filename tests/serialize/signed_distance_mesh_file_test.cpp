@@ -20,7 +20,7 @@ using namespace bvhkit::test;
 namespace {
 
 template <class T>
-bool same_bits(const SignedDistance<T>& a, const SignedDistance<T>& b) {
+bool same_answer_bits(const SignedDistance<T>& a, const SignedDistance<T>& b) {
     const auto& p = a.closest;
     const auto& q = b.closest;
     return std::memcmp(&a.distance, &b.distance, sizeof(T)) == 0 && p.triangle == q.triangle &&
@@ -46,7 +46,7 @@ void round_trip(const TriangleMesh& source, const std::string& what) {
     for (std::size_t i = 0; i < count; ++i) {
         const Vec<T, 3> p = rng.point_in(box);
         const SignedDistance<T> a = loaded.signed_distance(p, s1), e = mesh.signed_distance(p, s2);
-        ASSERT_TRUE(same_bits(a, e)) << i;
+        ASSERT_TRUE(same_answer_bits(a, e)) << i;
         inside += e.distance < 0;
     }
     EXPECT_GT(inside, 0u);

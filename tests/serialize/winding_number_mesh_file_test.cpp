@@ -12,17 +12,13 @@
 #include "bvhkit/mesh/procedural.hpp"
 #include "byte_flips.hpp"
 #include "random_geometry.hpp"
+#include "test_geometry.hpp"
 #include "test_support.hpp"
 
 using namespace bvhkit;
 using namespace bvhkit::test;
 
 namespace {
-
-template <class T>
-bool same_bits(T a, T b) {
-    return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
 
 template <class T>
 void round_trip(const WindingNumberMesh<T>& mesh, const Aabb<T, 3>& bounds,
@@ -45,19 +41,13 @@ void round_trip(const WindingNumberMesh<T>& mesh, const Aabb<T, 3>& bounds,
     }
 }
 
-template <class T>
-Aabb<T, 3> bounds_of(const TriangleMesh& mesh) {
-    const Aabb3f b = mesh.bounds();
-    return {Vec<T, 3>(b.min), Vec<T, 3>(b.max)};
-}
-
 TEST(WindingNumberMeshFile, RoundTrips) {
     BVHKIT_REQUIRE_MESH(path, "spot.obj");
     const TriangleMesh spot = read_mesh(path);
-    round_trip(WindingNumberMesh<float>(spot), bounds_of<float>(spot), "spot float");
-    round_trip(WindingNumberMesh<double>(spot), bounds_of<double>(spot), "spot double");
+    round_trip(WindingNumberMesh<float>(spot), bounds_as<float>(spot), "spot float");
+    round_trip(WindingNumberMesh<double>(spot), bounds_as<double>(spot), "spot double");
     const TriangleMesh terrain = make_procedural("terrain:n=16");  // open
-    round_trip(WindingNumberMesh<float>(terrain), bounds_of<float>(terrain), "terrain");
+    round_trip(WindingNumberMesh<float>(terrain), bounds_as<float>(terrain), "terrain");
     TriangleMesh holes = make_sphere(2);
     holes.vertices[3][0] = std::numeric_limits<float>::quiet_NaN();  // its triangles left out
     round_trip(WindingNumberMesh<float>(holes), Aabb3f({-1, -1, -1}, {1, 1, 1}), "with NaN");

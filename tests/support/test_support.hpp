@@ -6,6 +6,7 @@
 
 #include <cctype>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -46,6 +47,13 @@ inline bool full_scale() {
 /// `full` in the Release run, `full / divisor` (at least 1) under the sanitizers.
 inline std::size_t scaled(std::size_t full, std::size_t divisor = 20) {
     return small_scale() ? std::max<std::size_t>(1, full / divisor) : full;
+}
+
+/// Whether a and b hold the same bytes (+0 and -0 differ, a NaN equals itself): for answers that
+/// must be identical, not merely equal.
+template <class T>
+bool same_bits(const T& a, const T& b) {
+    return std::memcmp(&a, &b, sizeof(T)) == 0;
 }
 
 /// Test names for tests parameterized by a mesh file name ("teapot.obj" -> "teapot_obj").

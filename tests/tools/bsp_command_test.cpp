@@ -17,9 +17,9 @@
 
 namespace {
 
-using Result = test::CliOutcome;
+using Result = bvhkit::test::CliOutcome;
 
-using test::run_cli;
+using bvhkit::test::run_cli;
 
 Result run_bsp(const std::string& args) {
     return run_cli("bsp " + args);

@@ -14,10 +14,10 @@
 
 namespace {
 
-using Outcome = test::CliOutcome;
+using Outcome = bvhkit::test::CliOutcome;
 
 Outcome run(const std::string& args) {
-    return test::run_cli(args);
+    return bvhkit::test::run_cli(args);
 }
 
 std::filesystem::path temp_file(const std::string& name) {

@@ -10,7 +10,7 @@
 #include <iterator>
 #include <string>
 
-namespace test {
+namespace bvhkit::test {
 
 struct CliOutcome {
     int status;          // the exit status; -1 when it did not exit normally
@@ -31,4 +31,4 @@ inline CliOutcome run_cli(const std::string& args) {
     return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, text};
 }
 
-}  // namespace test
+}  // namespace bvhkit::test
