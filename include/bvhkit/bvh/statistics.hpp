@@ -18,8 +18,8 @@ struct SahCosts {
     double intersection = 1.0;
     /// Primitives a leaf tests at once: a leaf of n costs intersection * ceil(n / leaf_block)
     /// (Embree's SAH block size), so a builder stops splitting where the halves would cost a test
-    /// each. 1..64, or 0 for the tree's own choice: 4 for TriangleBvh's wide ray layouts, whose
-    /// leaves test triangles four abreast, 1 everywhere else.
+    /// each. 1..64, or 0 for the tree's own choice: 8 or 4 for TriangleBvh's eight- or four-wide
+    /// ray layouts, whose leaves test that many triangles abreast, 1 everywhere else.
     std::uint32_t leaf_block = 0;
 
     std::uint32_t block() const { return leaf_block ? leaf_block : 1; }
