@@ -91,10 +91,10 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     Hit<T> closest_hit(const Ray<T, 3>& ray, Stats&& stats) const {
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>) {
-            if (traces_wide() && wide_ray_usable(ray)) {
-                // The slab constants serve the bounds test and then the walk.
-                const detail::SlabConstants k(ray);
-                if (!k.meets(bvh_.root().bounds, ray.tmin, ray.tmax)) return Hit<T>{};
+            detail::SlabConstants k;
+            const WideRoute route = traces_wide() ? route_wide(ray, k) : WideRoute::Binary;
+            if (route == WideRoute::Miss) return Hit<T>{};
+            if (route == WideRoute::Walk) {
                 const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
                 // The groups hold the primitive index and a copy of the corners: the same normal
                 // as exact_'s, from the line just tested.
@@ -330,26 +330,37 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         return Hit<T>{h.t, group.slot[lane], h.u, h.v, group.triangle(lane).normal()};
     }
 
+#if defined(__SSE2__)
+    // Where a wide walk sends `ray`: to the binary tree's one-ray call (the wide walk does not
+    // serve it), nowhere (it misses the tree's bounds: no hit) or down the wide layout, with its
+    // slab constants in `k` (which also served the bounds test).
+    enum class WideRoute{Binary, Miss, Walk};
+    WideRoute route_wide(const Ray<float, 3>& ray, detail::SlabConstants& k) const {
+        if (!wide_ray_usable(ray)) return WideRoute::Binary;
+        k = detail::SlabConstants(ray);
+        return k.meets(bvh_.root().bounds, ray.tmin, ray.tmax) ? WideRoute::Walk : WideRoute::Miss;
+    }
+#endif
+
 #if BVHKIT_RAY_AVX2
     /// The rays through the eight-wide layout in a stream (query/ray_stream.hpp): finish(s) takes
     /// each walked ray; a ray the wide walk does not serve goes to alone(i) (the one-ray call,
     /// which walks the binary tree), one that misses the bounds is a miss without a walk.
     template <bool AnyHit, class Finish, class Alone>
     void stream(std::span<const Ray<float, 3>> rays, Finish&& finish, Alone&& alone) const {
-        const Aabb<float, 3>& bounds = bvh_.root().bounds;
         std::size_t next = 0;
         const auto start = [&](detail::StreamRay& s) {
             while (next < rays.size()) {
                 const std::size_t i = next++;
                 const Ray<float, 3>& ray = rays[i];
-                if (!wide_ray_usable(ray)) {
+                const WideRoute route = route_wide(ray, s.k);
+                if (route == WideRoute::Binary) {
                     alone(i);
                     continue;
                 }
                 s.index = i;
-                s.k = detail::SlabConstants(ray);
                 s.ray = ray;
-                if (!s.k.meets(bounds, ray.tmin, ray.tmax)) {
+                if (route == WideRoute::Miss) {
                     finish(s);  // no hit: stream8 cleared the slot's hit
                     continue;
                 }
@@ -366,21 +377,16 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     // (query/ray_octant_stream.hpp); those the wide walk does not take go one by one.
     void occlude_in_octants(std::span<const Ray<float, 3>> rays,
                             std::span<std::uint8_t> occluded) const {
-        const Aabb<float, 3>& bounds = bvh_.root().bounds;
         const auto blocked = [&](std::size_t i, bool b) { occluded[i] = b ? 1 : 0; };
         detail::OctantStreams streams;
+        detail::SlabConstants k;
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray<float, 3>& ray = rays[i];
-            if (!wide_ray_usable(ray)) {
-                occluded[i] = any_hit(ray) ? 1 : 0;
-                continue;
-            }
-            const detail::SlabConstants k(ray);
-            if (!k.meets(bounds, ray.tmin, ray.tmax)) {
-                occluded[i] = 0;
-                continue;
-            }
-            streams.add(wide8_, ray, k, i, blocked);
+            const WideRoute route = route_wide(ray, k);
+            if (route == WideRoute::Walk)
+                streams.add(wide8_, ray, k, i, blocked);
+            else
+                occluded[i] = route == WideRoute::Binary && any_hit(ray) ? 1 : 0;
         }
         streams.finish(wide8_, blocked);
     }

@@ -51,8 +51,6 @@ struct StreamRay {
     bool found = false;  // any hit
     bool live = false;   // walking
     WideStack<8> stack;
-
-    StreamRay() : k(Ray<float, 3>({0, 0, 0}, {1, 0, 0})) {}
 };
 
 /// Walks rays through `tree`, stream_width at a time. start(StreamRay&) -> bool fills a slot with

@@ -247,6 +247,7 @@ struct alignas(16) SlabConstants {
     // meets() can clip four lanes at once; the walks read lanes 0-2.
     float origin[4], inv[4], inv_far[4];
     std::uint32_t near[4], far[4];
+    SlabConstants() = default;  // unset: a place for a ray's constants, written later
     /// For a ray wide_ray_usable accepts: no subnormal direction component, so 1 / d is what
     /// RaySlabData holds (an infinity for a zero of either sign, finite otherwise).
     explicit SlabConstants(const Ray<float, 3>& ray) {
