@@ -136,6 +136,23 @@ TEST(SahBlocks, TriangleBvhPricesLeavesByItsLayout) {
     EXPECT_EQ(flat.bvh().nodes.size(), wide_ones.bvh().nodes.size());
 }
 
+TEST(SahBlocks, TriangleBvhBlocksAreAsWideAsItsGroups) {
+    const TriangleMesh mesh = make_procedural("sphere:subdiv=4");
+    TriangleBvhOptions four;
+    four.ray_layout = RayLayout::Wide4;
+    const TriangleBvh<float> chosen(mesh), wide4(mesh, four);
+    if (!wide4.traces_wide()) GTEST_SKIP() << "no wide ray layout on this CPU";
+    // A node of one block is a leaf (traversal >= intersection), and larger ones still split.
+    ASSERT_EQ(wide4.ray_width(), 4);
+    EXPECT_EQ(inner_nodes_of_at_most(wide4.bvh(), 4), 0u);
+    EXPECT_GT(inner_nodes_of_at_most(wide4.bvh(), 8), 0u);
+    if (chosen.ray_width() == 8) {  // blocks of eight: nodes of five to eight do not split either
+        EXPECT_EQ(inner_nodes_of_at_most(chosen.bvh(), 8), 0u);
+        EXPECT_GT(inner_nodes_of_at_most(chosen.bvh(), 16), 0u);
+        EXPECT_LT(chosen.bvh().nodes.size(), wide4.bvh().nodes.size());
+    }
+}
+
 TEST(SahBlocks, BlocksBeyond64AreRejectedByName) {
     const Input in = input_of(test::random_soup<float>(10, 1));
     BuildOptions o;
