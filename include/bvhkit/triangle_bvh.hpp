@@ -266,9 +266,11 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         // as wide as the walk's groups. Against one triangle a test (bunny and igea, one thread),
         // blocks of four made the build about a quarter faster (nodes of one block are leaves
         // without a search), R1-R3 within noise; for the eight-wide walk, blocks of eight against
-        // four: igea 74-87 -> 66-69 ms, bunny 18.6 -> 17.5-17.8 ms, R2/R3 within noise.
+        // four: igea 74-87 -> 66-69 ms, bunny 18.6 -> 17.5-17.8 ms, R2/R3 within noise. Never
+        // above max_leaf_size: nodes between the two would be split at the object median.
         if (tree_options.costs.leaf_block == 0 && wide_layout())
-            tree_options.costs.leaf_block = eight_wide() ? 8 : 4;
+            tree_options.costs.leaf_block =
+                std::min<std::uint32_t>(eight_wide() ? 8 : 4, tree_options.max_leaf_size);
         if (options.spatial_splits) {
             if (options.builder != Builder::BinnedSah || options.optimize)
                 throw Error(
@@ -331,9 +333,9 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
 
 #if defined(__SSE2__)
-    // Where a wide walk sends `ray`: to the binary tree's one-ray call (the wide walk does not
-    // serve it), nowhere (it misses the tree's bounds: no hit) or down the wide layout, with its
-    // slab constants in `k` (which also served the bounds test).
+    /// Where a wide walk sends `ray`: to the binary tree's one-ray call (the wide walk does not
+    /// serve it), nowhere (it misses the tree's bounds: no hit) or down the wide layout, with its
+    /// slab constants in `k` (which also served the bounds test).
     enum class WideRoute{Binary, Miss, Walk};
     WideRoute route_wide(const Ray<float, 3>& ray, detail::SlabConstants& k) const {
         if (!wide_ray_usable(ray)) return WideRoute::Binary;

@@ -21,7 +21,7 @@ std::vector<std::pair<std::string, BuildOptions>> top_down_configurations() {
         if (!o.optimize && (o.builder == Builder::BinnedSah || o.builder == Builder::SweepSah ||
                             o.builder == Builder::TopDown))
             out.emplace_back(name, o);
-    // Leaves in blocks of four, as TriangleBvh builds for its wide layouts.
+    // Leaves in blocks of four, as TriangleBvh builds for its four-wide layout.
     BuildOptions blocks;
     blocks.costs.leaf_block = 4;
     out.emplace_back("binned-sah, leaf blocks of 4", blocks);

@@ -151,6 +151,15 @@ TEST(SahBlocks, TriangleBvhBlocksAreAsWideAsItsGroups) {
         EXPECT_GT(inner_nodes_of_at_most(chosen.bvh(), 16), 0u);
         EXPECT_LT(chosen.bvh().nodes.size(), wide4.bvh().nodes.size());
     }
+    // Never a block above max_leaf_size: the tree is the one of blocks that size.
+    TriangleBvhOptions small, small_blocks;
+    small.max_leaf_size = small_blocks.max_leaf_size = 3;
+    small_blocks.costs.leaf_block = 3;
+    const TriangleBvh<float> a(mesh, small), b(mesh, small_blocks);
+    EXPECT_EQ(a.bvh().primitive_indices, b.bvh().primitive_indices);
+    ASSERT_EQ(a.bvh().nodes.size(), b.bvh().nodes.size());
+    for (std::size_t i = 0; i < a.bvh().nodes.size(); ++i)
+        ASSERT_TRUE(a.bvh().nodes[i].bounds == b.bvh().nodes[i].bounds) << "node " << i;
 }
 
 TEST(SahBlocks, BlocksBeyond64AreRejectedByName) {
