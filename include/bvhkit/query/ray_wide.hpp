@@ -91,7 +91,9 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
     // bunny 141-143 / 141-143 / 144-146, igea 246 / 241-247 / 244-250; R1 and occlusion within
     // noise on bunny and igea, the sphere's occlusion 517 / 384-407. Once the tree outgrows the
     // caches, a node costs more than the groups of a larger leaf, which lie side by side. Four
-    // wide, 48 was mixed (bunny 5% faster, the sphere 6% slower): it keeps 24.
+    // wide, 48 was mixed (bunny 5% faster, the sphere 6% slower): it keeps 24. With the tree's
+    // leaves priced in blocks of eight (2026-11-27, 500,000 rays), 32 / 48 / 64 on igea R2:
+    // 130-133 / 119-121 / 119-120 ms, bunny and the 5k sphere within noise.
     constexpr std::uint32_t leaf_limit = W == 8 ? 48 : 24;
     const WideBvh<float, W> wide = collapse_to_wide<float, W>(bvh, leaf_limit, true);
     out.nodes.resize(wide.nodes.size());
