@@ -18,6 +18,7 @@
 
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/bvh/statistics.hpp"
+#include "bvhkit/io/byte_codec.hpp"
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/io/winding_number_mesh_file.hpp"
@@ -312,9 +313,9 @@ class Scene {
             for (const auto& t : mesh_.triangles) f.insert(f.end(), {t[0], t[1], t[2]});
             fast = rays_.triangle_test() == TriangleTest::Fast;
             if (spatial_splits_) {
-                // Little-endian, whatever this machine's order.
-                for (const std::uint32_t face : rays_.skipped())
-                    for (int b = 0; b < 4; ++b) tree.push_back(std::uint8_t(face >> (8 * b)));
+                serial_detail::ByteWriter out;  // little-endian, whatever this machine's order
+                for (const std::uint32_t face : rays_.skipped()) out.u32(face);
+                tree = std::move(out.bytes());
             } else {
                 tree = to_bytes(rays_);
             }
@@ -360,10 +361,10 @@ class Scene {
         if (bytes.size() % 4 != 0)
             throw Error("ray tree: the list of faces left out has " + std::to_string(bytes.size()) +
                         " bytes, not a multiple of 4");
+        serial_detail::ByteReader in(bytes, "ray tree");
         std::vector<std::uint32_t> left_out(bytes.size() / 4);
         for (std::size_t k = 0; k < left_out.size(); ++k) {
-            std::uint32_t face = 0;
-            for (int b = 0; b < 4; ++b) face |= std::uint32_t(bytes[4 * k + b]) << (8 * b);
+            const std::uint32_t face = in.u32();
             if (face >= faces || (k > 0 && face <= left_out[k - 1]))
                 throw Error("ray tree: the faces left out are not ascending face indices below " +
                             std::to_string(faces));

@@ -187,22 +187,7 @@ TEST(WideRays, SameAnswersAsTheBinaryWalkOnHardGeometry) {
                             {"tiny sphere", test::placed<float>(make_sphere(3), 1e-6, 0)},
                             {"huge terrain", test::placed<float>(make_terrain(64), 1e6, 0)}};
     // Needles and slivers, duplicates and zero-area triangles.
-    test::Random rng(7);
-    std::vector<Triangle<float>> odd;
-    for (int i = 0; i < 1500; ++i) {
-        Vec3f a, d, s;
-        for (int k = 0; k < 3; ++k) {
-            a[k] = float(rng.uniform(-1, 1));
-            d[k] = float(rng.uniform(-1, 1));
-            s[k] = float(rng.uniform(-1, 1));
-        }
-        const float width = float(std::pow(10.0, rng.uniform(-6, -2)));
-        odd.push_back({a, a + d, a + d * 0.5f + s * width});
-        if (i % 10 == 0) odd.push_back(odd.back());                // a duplicate
-        if (i % 15 == 0) odd.push_back({a, a + d, a + d * 2.0f});  // collinear: zero area
-        if (i % 20 == 0) odd.push_back({a, a, a});                 // a point
-    }
-    cases.push_back({"needles", odd});
+    cases.push_back({"needles", test::random_needles(1500, 7, true)});
     if (const auto spot = test::shared_mesh("spot.obj"); !spot.empty())
         cases.push_back({"spot", test::placed<float>(read_mesh(spot), 1, 0)});
     TriangleBvhOptions binary, four, eight, four_of_eights;
@@ -676,19 +661,7 @@ TEST(BatchRays, LargeOcclusionBatchesEqualTheOneByOneCalls) {
 // boxes, rays aimed at vertices, NaN, subnormal components and empty intervals, short rays; runs
 // of 1 to 1,000 rays (streams left part full), 1 and 2 threads; needles, far and tiny meshes.
 TEST(BatchRays, OctantStreamsEqualTheOneByOneCalls) {
-    test::Random rng(29);
-    std::vector<Triangle<float>> needles;
-    for (int i = 0; i < 3000; ++i) {
-        Vec3f a, d, w;
-        for (int k = 0; k < 3; ++k) {
-            a[k] = float(rng.uniform(-1, 1));
-            d[k] = float(rng.uniform(-1, 1));
-            w[k] = float(rng.uniform(-1, 1));
-        }
-        needles.push_back(
-            {a, a + d, a + d * 0.5f + w * float(std::pow(10.0, rng.uniform(-6, -2)))});
-        if (i % 10 == 0) needles.push_back(needles.back());  // a duplicate
-    }
+    const std::vector<Triangle<float>> needles = test::random_needles(3000, 29);
     const std::vector<std::pair<std::string, std::vector<Triangle<float>>>> meshes{
         {"far sphere", test::placed<float>(make_sphere(4), 1, 1e5)},
         {"tiny torus", test::placed<float>(make_torus(64, 32), 1e-6, 0)},

@@ -1,5 +1,6 @@
 #pragma once
 // Deterministic random geometry for tests: soups of triangles, rays through a box.
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -47,6 +48,29 @@ std::vector<Triangle<T>> random_soup(std::size_t count, std::uint64_t seed) {
         const T size = T(0.2 * std::pow(rng.uniform(), 3.0));
         const Aabb<T, 3> around(c - Vec<T, 3>(size), c + Vec<T, 3>(size));
         tri = {rng.point_in(around), rng.point_in(around), rng.point_in(around)};
+    }
+    return out;
+}
+
+/// `count` needles in [-1, 1]^3: a long edge and a third corner 1e-6 to 1e-2 off its middle, a
+/// duplicate after every tenth; with `degenerate`, also a collinear (zero-area) triangle after
+/// every fifteenth and a point after every twentieth.
+inline std::vector<Triangle<float>> random_needles(int count, std::uint64_t seed,
+                                                   bool degenerate = false) {
+    Random rng(seed);
+    std::vector<Triangle<float>> out;
+    for (int i = 0; i < count; ++i) {
+        Vec<float, 3> a, d, s;
+        for (int k = 0; k < 3; ++k) {
+            a[k] = float(rng.uniform(-1, 1));
+            d[k] = float(rng.uniform(-1, 1));
+            s[k] = float(rng.uniform(-1, 1));
+        }
+        const float width = float(std::pow(10.0, rng.uniform(-6, -2)));
+        out.push_back({a, a + d, a + d * 0.5f + s * width});
+        if (i % 10 == 0) out.push_back(out.back());
+        if (degenerate && i % 15 == 0) out.push_back({a, a + d, a + d * 2.0f});
+        if (degenerate && i % 20 == 0) out.push_back({a, a, a});
     }
     return out;
 }
