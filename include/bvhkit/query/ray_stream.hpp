@@ -50,7 +50,7 @@ struct StreamRay {
     int hit_lane = 0;
     bool found = false;  // any hit
     bool live = false;   // walking
-    WideStack<8> stack;
+    WideStack8 stack;
 };
 
 /// Walks rays through `tree`, stream_width at a time. start(StreamRay&) -> bool fills a slot with
@@ -96,16 +96,17 @@ template <bool AnyHit, class Start, class Finish>
                     inv[a] = _mm256_set1_ps(s.k.inv[a]);
                     inv_far[a] = _mm256_set1_ps(s.k.inv_far[a]);
                 }
-                alignas(32) float entry[8];
-                const unsigned mask =
-                    clip8(node, origin, inv, inv_far, s.k.near, s.k.far, _mm256_set1_ps(s.ray.tmin),
-                          _mm256_set1_ps(s.ray.tmax), entry);
+                __m256 entry = _mm256_set1_ps(s.ray.tmin);
+                const __m256 hit = clip8(node, origin, inv, inv_far, s.k.near, s.k.far, entry,
+                                         _mm256_set1_ps(s.ray.tmax));
+                const unsigned mask = unsigned(_mm256_movemask_ps(hit));
                 if (mask != 0) {
-                    // take_hits asks for the next entry's first three lines; the others here.
+                    // The push asks for the next entry's first three lines; the others here.
                     if constexpr (AnyHit)
-                        take_hits_unordered<8>(mask, entry, node, s.current, s.stack, s.size, line);
+                        push_in_lane_order8(entry, mask, node, s.current, s.stack, s.size, line);
                     else
-                        take_hits<8>(mask, entry, node, s.current, s.stack, s.size, line);
+                        push_nearest_first8(entry, hit, mask, node, s.current, s.stack, s.size,
+                                            line);
                     ask(s.current, 3);
                     continue;
                 }
@@ -126,7 +127,7 @@ template <bool AnyHit, class Start, class Finish>
                     continue;
                 }
             }
-            if (pop(s.stack, s.size, s.ray.tmax, s.current)) {
+            if (pop8(s.stack, s.size, s.ray.tmax, s.current)) {
                 ask(s.current, 0);
                 continue;
             }

@@ -9,7 +9,8 @@
 // planes are chosen once per ray (SlabConstants). For a closest hit the hit children are visited
 // nearest first: the others go on a stack with their entry distances, and an entry farther than
 // the closest hit so far is dropped when popped, without reading its node (an any-hit query
-// pushes them unordered). A leaf child is a run of triangle groups as wide as the walk: four
+// pushes them unordered). The stacks and pushes are in query/ray_wide_stack.hpp, the layouts in
+// query/ray_wide_layout.hpp. A leaf child is a run of triangle groups as wide as the walk: four
 // triangles tested at once in the four-wide walk, eight in the eight-wide one
 // (primitives/triangle_group.hpp), with the answers of the scalar watertight test.
 //
@@ -21,135 +22,16 @@
 #include <type_traits>
 #include <vector>
 
-#include "bvhkit/bvh/huge_page_allocator.hpp"
-#include "bvhkit/bvh/wide_bvh.hpp"
 #include "bvhkit/primitives/triangle_group.hpp"
+#include "bvhkit/query/ray_wide_layout.hpp"
+#include "bvhkit/query/ray_wide_stack.hpp"
 #include "bvhkit/query/stats.hpp"
 
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
-#if defined(__SSE2__) && defined(__x86_64__) && defined(__GNUC__)
-#define BVHKIT_RAY_AVX2 1  // the eight-wide walk is compiled, for CPUs that turn out to have AVX2
-#else
-#define BVHKIT_RAY_AVX2 0
-#endif
 
 namespace bvhkit {
-
-template <int W>
-struct alignas(64) RayNode {
-    float lo[6][W];  // lo[axis][lane] the box's min, +inf in an empty lane; lo[3 + axis][lane] its
-                     // max, -inf in an empty lane (one array, so a ray picks its planes by index)
-    std::uint32_t child[W];   // inner: node index; leaf: first group; empty: invalid_index
-    std::uint32_t groups[W];  // leaf: how many groups (>= 1); inner or empty: 0
-};
-
-template <int W>
-struct WideRayBvh {
-    using Group = TriangleGroup<W == 8 ? 8 : 4>;  // as wide as the walk's registers
-    // On huge pages once large (bvh/huge_page_allocator.hpp): incoherent rays read both at random.
-    std::vector<RayNode<W>, HugePageAllocator<RayNode<W>>> nodes;  // nodes[0] is the root
-    std::vector<Group, HugePageAllocator<Group>> groups;
-
-    bool empty() const { return nodes.empty(); }
-    /// The layout's size: what a walk reads from.
-    std::size_t bytes() const {
-        return nodes.size() * sizeof(RayNode<W>) + groups.size() * sizeof(Group);
-    }
-};
-
-/// Whether this CPU runs the eight-wide walk (AVX2), asked once.
-inline bool cpu_has_avx2() {
-#if BVHKIT_RAY_AVX2
-    static const bool has = [] {
-        __builtin_cpu_init();
-        return __builtin_cpu_supports("avx2") != 0;
-    }();
-    return has;
-#else
-    return false;
-#endif
-}
-
-/// The ray layout of width W of a binary tree whose leaf slot s holds triangle_at_slot(s); its
-/// groups name that triangle index_at_slot(s) (TriangleGroup::slot), which a hit reports.
-template <int W, class TriangleAtSlot, class IndexAtSlot>
-WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&& triangle_at_slot,
-                                IndexAtSlot&& index_at_slot) {
-    WideRayBvh<W> out;
-    // Every node's lanes filled (collapse_to_wide's fill_lanes), and a lane of up to leaf_limit
-    // triangles not opened further is a leaf child. Against leaf limit 8 without filling (3.7
-    // lanes an eight-wide node on igea, 16k nodes, 4.2 MB), 1M random rays, closest hit, against
-    // Embree 3 in the same run: eight wide, igea 0.72-0.81x -> 0.88-0.97x, bunny 0.69x ->
-    // 0.74-0.77x, spot, dragon and teapot +1-4%; four wide, igea 0.67-0.71x -> 0.79-0.80x
-    // (occlusion 0.74-0.78x -> 0.91-1.04x), bunny, spot and dragon within noise. Leaf limits 16-32
-    // measured within noise of 24. (Four wide without filling, leaf limit 2 / 4 / 8 / 16, ms: igea
-    // 861 / 736 / 637 / 583, spot 296 (4) / 268 (8) / 273 (16); the binary walk 853 and 380.)
-    // Eight wide, leaves in blocks of four (2026-11-26, 1M random rays, one thread): leaf limit
-    // 24 / 48 / 64, closest hit, ms: the 1.3M-triangle displaced sphere 586 / 456-489 / 458,
-    // bunny 141-143 / 141-143 / 144-146, igea 246 / 241-247 / 244-250; R1 and occlusion within
-    // noise on bunny and igea, the sphere's occlusion 517 / 384-407. Once the tree outgrows the
-    // caches, a node costs more than the groups of a larger leaf, which lie side by side. Four
-    // wide, 48 was mixed (bunny 5% faster, the sphere 6% slower): it keeps 24. With the tree's
-    // leaves priced in blocks of eight (2026-11-27, 500,000 rays), 32 / 48 / 64 on igea R2:
-    // 130-133 / 119-121 / 119-120 ms, bunny and the 5k sphere within noise.
-    constexpr std::uint32_t leaf_limit = W == 8 ? 48 : 24;
-    const WideBvh<float, W> wide = collapse_to_wide<float, W>(bvh, leaf_limit, true);
-    out.nodes.resize(wide.nodes.size());
-    constexpr float inf = std::numeric_limits<float>::infinity();
-    for (std::size_t i = 0; i < wide.nodes.size(); ++i) {
-        const WideNode<float, W>& w = wide.nodes[i];
-        RayNode<W>& n = out.nodes[i];
-        for (int c = 0; c < W; ++c) {
-            for (int a = 0; a < 3; ++a) {
-                n.lo[a][c] = w.has(c) ? w.lo[a][c] : inf;
-                n.lo[3 + a][c] = w.has(c) ? w.hi[a][c] : -inf;
-            }
-            n.child[c] = w.child[c];
-            n.groups[c] = w.has(c) ? w.groups[c] : 0;
-        }
-    }
-    // collapse_to_wide's groups are of four slots, a leaf child's slots in a run of them padded
-    // at its end only; here each run is cut again into groups of the layout's width, kept in the
-    // runs' order. A group of eight holds the slots of two consecutive groups of four.
-    constexpr std::size_t lanes = WideRayBvh<W>::Group::lanes;
-    // The groups of the layout's width that a run of `run` groups of four fills.
-    const auto cut = [&](std::uint32_t run) {
-        return std::uint32_t((4 * std::size_t(run) + lanes - 1) / lanes);
-    };
-    std::vector<std::uint32_t> run_of(wide.group_count(), 0), first_of(wide.group_count(), 0);
-    for (const WideNode<float, W>& w : wide.nodes)
-        for (int c = 0; c < W; ++c)
-            if (w.has(c) && w.groups[c] > 0) run_of[w.child[c]] = w.groups[c];
-    std::size_t group_count = 0;
-    for (std::size_t g = 0; g < run_of.size(); g += run_of[g]) {
-        if (run_of[g] == 0) throw Error("make_wide_ray_bvh: a group outside every leaf");
-        first_of[g] = std::uint32_t(group_count);
-        group_count += cut(run_of[g]);
-    }
-    out.groups.resize(group_count);
-    for (std::size_t g = 0; g < run_of.size(); g += run_of[g]) {
-        const std::size_t first = first_of[g];
-        const std::size_t slots = 4 * std::size_t(run_of[g]), padded = cut(run_of[g]) * lanes;
-        for (std::size_t k = 0; k < padded; ++k) {
-            const std::uint32_t s = k < slots ? wide.group_slots[4 * g + k] : invalid_index;
-            auto& group = out.groups[first + k / lanes];
-            if (s == invalid_index)
-                group.clear(int(k % lanes));
-            else
-                group.set(int(k % lanes), triangle_at_slot(s), index_at_slot(s));
-        }
-    }
-    for (std::size_t i = 0; i < wide.nodes.size(); ++i)
-        for (int c = 0; c < W; ++c)
-            if (out.nodes[i].groups[c] > 0) {
-                const std::uint32_t g = out.nodes[i].child[c];
-                out.nodes[i].child[c] = first_of[g];
-                out.nodes[i].groups[c] = cut(run_of[g]);
-            }
-    return out;
-}
 
 #if defined(__SSE2__)
 namespace detail {
@@ -158,85 +40,6 @@ template <int L, class Stats>
 void count_lanes(const TriangleGroup<L>& g, Stats& stats) {
     for (std::uint32_t s : g.slot)
         if (s != invalid_index) stats.primitive();
-}
-
-struct WideEntry {
-    std::uint32_t child, groups;  // groups > 0: a leaf
-    float t;
-};
-
-/// Each level pushes at most W - 1 entries, and a wide tree is no deeper than the binary tree it
-/// came from (max_bvh_depth).
-template <int W>
-using WideStack = WideEntry[(W - 1) * max_bvh_depth + 1];
-
-/// After a node's clip: the nearest hit lane of `mask` becomes `current`, the others are pushed,
-/// kept in order of distance so that they pop nearest first. Every entry's first line is asked
-/// for now: most pushed entries are read later, and the walk misses the caches at most nodes.
-template <int W, class Line>
-[[gnu::always_inline]] inline void take_hits(unsigned mask, const float* entry,
-                                             const RayNode<W>& node, WideEntry& current,
-                                             WideEntry* stack, std::uint32_t& size, Line&& line) {
-    const int first = __builtin_ctz(mask);
-    mask &= mask - 1;
-    current = WideEntry{node.child[first], node.groups[first], entry[first]};
-    const std::uint32_t base = size;
-    for (; mask; mask &= mask - 1) {
-        const int c = __builtin_ctz(mask);
-        WideEntry e{node.child[c], node.groups[c], entry[c]};
-        if (e.t < current.t) std::swap(e, current);
-        std::uint32_t i = size++;
-        for (; i > base && stack[i - 1].t < e.t; --i) stack[i] = stack[i - 1];
-        stack[i] = e;
-        _mm_prefetch(line(e), _MM_HINT_T0);
-    }
-    const char* next = line(current);
-    _mm_prefetch(next, _MM_HINT_T0);
-    _mm_prefetch(next + 64, _MM_HINT_T0);
-    _mm_prefetch(next + 128, _MM_HINT_T0);
-}
-
-/// take_hits for any hit, which needs no order: the first hit lane becomes `current`, the others
-/// are pushed as they come. Sorting them cost an occlusion ray 7% of its instructions and 1.2
-/// mispredicted branches (callgrind, random rays on the bunny) and bought nothing: no entry is
-/// ever dropped for being farther than a hit, the walk stops at the first one.
-template <int W, class Line>
-[[gnu::always_inline]] inline void take_hits_unordered(unsigned mask, const float* entry,
-                                                       const RayNode<W>& node, WideEntry& current,
-                                                       WideEntry* stack, std::uint32_t& size,
-                                                       Line&& line) {
-    const int first = __builtin_ctz(mask);
-    mask &= mask - 1;
-    current = WideEntry{node.child[first], node.groups[first], entry[first]};
-    for (; mask; mask &= mask - 1) {
-        const int c = __builtin_ctz(mask);
-        const WideEntry e{node.child[c], node.groups[c], entry[c]};
-        stack[size++] = e;
-        _mm_prefetch(line(e), _MM_HINT_T0);
-    }
-    const char* next = line(current);
-    _mm_prefetch(next, _MM_HINT_T0);
-    _mm_prefetch(next + 64, _MM_HINT_T0);
-    _mm_prefetch(next + 128, _MM_HINT_T0);
-}
-
-/// Where entry `e` starts: its node, or its leaf's first group (both addresses, then a select).
-template <class Node, class Group>
-[[gnu::always_inline]] inline const char* entry_address(const Node* nodes, const Group* groups,
-                                                        const WideEntry& e) {
-    const char* node = reinterpret_cast<const char*>(nodes + e.child);
-    const char* group = reinterpret_cast<const char*>(groups + e.child);
-    return e.groups == 0 ? node : group;
-}
-
-/// Pops the next entry the ray can still reach; false when none is left.
-[[gnu::always_inline]] inline bool pop(WideEntry* stack, std::uint32_t& size, float tmax,
-                                       WideEntry& current) {
-    do {
-        if (size == 0) return false;
-        current = stack[--size];
-    } while (current.t > tmax);
-    return true;
 }
 
 // The ray's constants for the slab test: origin, reciprocal direction, the reciprocal scaled for
@@ -363,18 +166,17 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
     t1 = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, origin), inv_far), t1);
 }
 
-/// An eight-wide node's clip: the hit lanes' mask, their entry distances in `entry`. The ray's
-/// constants come as registers (origin, inv and inv_far per axis) and as the rows of its near and
-/// far planes (SlabConstants::near and far).
-[[gnu::target("avx2"), gnu::always_inline]] inline unsigned clip8(
+/// An eight-wide node's clip: all ones in the lanes the ray meets, whose entry distances `t0` then
+/// holds (t0 comes in as the ray's tmin, t1 as its tmax). The ray's constants come as registers
+/// (origin, inv and inv_far per axis) and as the rows of its near and far planes
+/// (SlabConstants::near and far).
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256 clip8(
     const RayNode<8>& node, const __m256* origin, const __m256* inv, const __m256* inv_far,
-    const std::uint32_t* near_row, const std::uint32_t* far_row, __m256 t0, __m256 t1,
-    float* entry) {
+    const std::uint32_t* near_row, const std::uint32_t* far_row, __m256& t0, __m256 t1) {
     for (int a = 0; a < 3; ++a)
         clip_axis8(_mm256_load_ps(node.lo[near_row[a]]), _mm256_load_ps(node.lo[far_row[a]]),
                    origin[a], inv[a], inv_far[a], t0, t1);
-    _mm256_store_ps(entry, t0);
-    return unsigned(_mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ)));
+    return _mm256_cmp_ps(t0, t1, _CMP_LE_OQ);
 }
 
 // walk4 in AVX registers. It is written out again because its AVX intrinsics must sit in a function
@@ -382,7 +184,7 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
 // helper of the default target), and walk4 must not carry it.
 template <class OnLeaf, class Stats>
 [[gnu::target("avx2")]] void walk8(const WideRayBvh<8>& tree, Ray<float, 3>& ray,
-                                   const SlabConstants& k, WideEntry* stack, OnLeaf& on_leaf,
+                                   const SlabConstants& k, WideStack8& stack, OnLeaf& on_leaf,
                                    Stats& stats) {
     __m256 origin[3], inv[3], inv_far[3];
     for (int a = 0; a < 3; ++a) {
@@ -402,21 +204,21 @@ template <class OnLeaf, class Stats>
             const RayNode<8>& node = nodes[current.child];
             for (std::uint32_t c : node.child)
                 if (c != invalid_index) stats.node();
-            alignas(32) float entry[8];
-            const unsigned mask =
-                clip8(node, origin, inv, inv_far, k.near, k.far, tmin, tmax, entry);
+            __m256 entry = tmin;
+            const __m256 hit = clip8(node, origin, inv, inv_far, k.near, k.far, entry, tmax);
+            const unsigned mask = unsigned(_mm256_movemask_ps(hit));
             if (mask != 0) {
                 if constexpr (OnLeaf::any_hit)
-                    take_hits_unordered<8>(mask, entry, node, current, stack, size, line);
+                    push_in_lane_order8(entry, mask, node, current, stack, size, line);
                 else
-                    take_hits<8>(mask, entry, node, current, stack, size, line);
+                    push_nearest_first8(entry, hit, mask, node, current, stack, size, line);
                 continue;
             }
         } else {
             if (on_leaf.wide8(current.child, current.groups)) return;
             tmax = _mm256_set1_ps(ray.tmax);
         }
-        if (!pop(stack, size, ray.tmax, current)) return;
+        if (!pop8(stack, size, ray.tmax, current)) return;
     }
 }
 #endif
@@ -425,12 +227,13 @@ template <class OnLeaf, class Stats>
 template <int W, class OnLeaf, class Stats>
 void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, const SlabConstants& k,
                        OnLeaf&& on_leaf, Stats& stats) {
-    WideStack<W> stack;
     if constexpr (W == 4) {
+        WideStack<4> stack;
         walk4(tree, ray, k, stack, on_leaf, stats);
     } else {
         static_assert(W == 8);
 #if BVHKIT_RAY_AVX2
+        WideStack8 stack;
         walk8(tree, ray, k, stack, on_leaf, stats);
 #endif
     }
