@@ -394,7 +394,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
 #endif
 
-    // The wide ray layout (query/ray_wide.hpp), derived from the tree and the triangles: made
+    // The wide ray layout (query/ray_wide_layout.hpp), derived from the tree and the triangles: made
     // after a build, a refit or a load.
     void make_ray_layout() {
         wide4_ = {};
