@@ -394,8 +394,8 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
 #endif
 
-    // The wide ray layout (query/ray_wide_layout.hpp), derived from the tree and the triangles: made
-    // after a build, a refit or a load.
+    // The wide ray layout (query/ray_wide_layout.hpp), derived from the tree and the triangles:
+    // made after a build, a refit or a load.
     void make_ray_layout() {
         wide4_ = {};
         wide8_ = {};
