@@ -7,7 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <limits>
+#include <utility>
+#include <vector>
 
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/mesh/procedural.hpp"
@@ -304,6 +309,48 @@ TEST(WideRays, PerRayConstantsAreTheDefinitionsOnes) {
                 ++tested;
             }
     EXPECT_GT(tested, 200u);
+}
+
+// The watertight test's axes against their definition, written here per component: kz the axis
+// of the largest direction magnitude (d0 >= d1 ? (d0 >= d2 ? 0 : 2) : (d1 >= d2 ? 1 : 2), so the
+// first of tied axes, and axis 2 when a comparison meets a NaN), kx and ky the next two in
+// cyclic order, swapped when d[kz] < 0 (the winding kept), and the origin read along them; for
+// float rays (whose comparisons run four lanes at once) and double rays, over every mix of the
+// special values, unusable directions included (the checked constructor still chooses axes).
+template <class T>
+void expect_axes_as_defined() {
+    const T inf = std::numeric_limits<T>::infinity();
+    const T nan = std::numeric_limits<T>::quiet_NaN();
+    const T least = std::numeric_limits<T>::min();
+    const T tiny = std::numeric_limits<T>::denorm_min();
+    const std::vector<T> values{T(0),   -T(0), T(1),    T(-1), T(2), T(-2.5), least,
+                                -least, tiny,  T(3e30), -inf,  inf,  nan};
+    std::size_t tested = 0;
+    for (const T a : values)
+        for (const T b : values)
+            for (const T c : values) {
+                Ray<T, 3> r;
+                r.direction = {a, b, c};
+                r.origin = {T(10), T(20), T(30)};
+                const T m0 = std::fabs(a), m1 = std::fabs(b), m2 = std::fabs(c);
+                const std::uint32_t kz = m0 >= m1 ? (m0 >= m2 ? 0 : 2) : (m1 >= m2 ? 1 : 2);
+                std::uint32_t kx = (kz + 1) % 3, ky = (kz + 2) % 3;
+                if (r.direction[kz] < T(0)) std::swap(kx, ky);
+                const WatertightRay<T> w(r);
+                ASSERT_EQ(w.kz, kz) << a << " " << b << " " << c;
+                ASSERT_EQ(w.kx, kx) << a << " " << b << " " << c;
+                ASSERT_EQ(w.ky, ky) << a << " " << b << " " << c;
+                ASSERT_EQ(w.ox, r.origin[kx]);
+                ASSERT_EQ(w.oy, r.origin[ky]);
+                ASSERT_EQ(w.oz, r.origin[kz]);
+                ++tested;
+            }
+    EXPECT_EQ(tested, values.size() * values.size() * values.size());
+}
+
+TEST(WideRays, WatertightAxesAreTheDefinitionsOnes) {
+    expect_axes_as_defined<float>();
+    expect_axes_as_defined<double>();
 }
 
 // ray_meets_box (the closest-hit early out on the tree's bounds) decides as the scalar slab test
