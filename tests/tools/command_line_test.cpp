@@ -20,17 +20,17 @@ Outcome run(const std::string& args) {
     return bvhkit::test::run_cli(args);
 }
 
-std::filesystem::path temp_file(const std::string& name) {
-    return std::filesystem::temp_directory_path() /
-           ("bvhkit_cli_test_" + std::to_string(::getpid()) + "_" + name);
+bvhkit::test::ScratchFile temp_file(const std::string& name) {
+    return bvhkit::test::ScratchFile("cli_test", name);
 }
 
 // Identity and a far-away pose, 12 float32 each.
-std::filesystem::path write_poses() {
+bvhkit::test::ScratchFile write_poses() {
     const float poses[2][12] = {{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0},
                                 {1, 0, 0, 0, 1, 0, 0, 0, 1, 10, 0, 0}};
-    const auto p = temp_file("poses.bin");
-    std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(poses), sizeof poses);
+    auto p = temp_file("poses.bin");
+    std::ofstream(p.path(), std::ios::binary)
+        .write(reinterpret_cast<const char*>(poses), sizeof poses);
     return p;
 }
 
@@ -101,7 +101,8 @@ TEST(CommandLine, EveryVolumeAnswersAlike) {
                                 {0, -1, 0, 1, 0, 0, 0, 0, 1, 1.5f, 0.3f, 0},
                                 {1, 0, 0, 0, 1, 0, 0, 0, 1, 2.5f, 0, 0}};
     const auto p = temp_file("poses3.bin");
-    std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(poses), sizeof poses);
+    std::ofstream(p.path(), std::ios::binary)
+        .write(reinterpret_cast<const char*>(poses), sizeof poses);
     const std::string meshes = "torus sphere:subdiv=2 --poses " + p.string();
     std::string first_c, first_d;
     for (const char* bv : {"aabb", "obb", "rss", "obbrss", "sphere", "kdop18", "hull"}) {

@@ -9,12 +9,41 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <system_error>
+#include <utility>
 
 namespace bvhkit::test {
 
 struct CliOutcome {
     int status;          // the exit status; -1 when it did not exit normally
     std::string output;  // stdout and stderr together
+};
+
+/// A path in the temporary directory, unique to this process ("bvhkit_<kind>_<pid>_<name>"), whose
+/// file is removed when the object goes (also when a failed assertion leaves the test early): the
+/// tools' tests leave nothing behind.
+class ScratchFile {
+  public:
+    ScratchFile(const std::string& kind, const std::string& name)
+        : path_(std::filesystem::temp_directory_path() /
+                ("bvhkit_" + kind + "_" + std::to_string(::getpid()) + "_" + name)) {}
+    ScratchFile(ScratchFile&& other) noexcept : path_(std::move(other.path_)) {
+        other.path_.clear();
+    }
+    ScratchFile(const ScratchFile&) = delete;
+    ScratchFile& operator=(const ScratchFile&) = delete;
+    ScratchFile& operator=(ScratchFile&&) = delete;
+    ~ScratchFile() {
+        std::error_code ignored;
+        if (!path_.empty()) std::filesystem::remove(path_, ignored);
+    }
+
+    const std::filesystem::path& path() const { return path_; }
+    operator const std::filesystem::path&() const { return path_; }  // NOLINT: a path to pass on
+    std::string string() const { return path_.string(); }
+
+  private:
+    std::filesystem::path path_;
 };
 
 inline CliOutcome run_cli(const std::string& args) {

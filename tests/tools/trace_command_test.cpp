@@ -12,15 +12,15 @@
 #include "bvhkit/io/read_mesh.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "ray_sets.hpp"
+#include "run_cli.hpp"
 #include "test_support.hpp"
 
 using namespace bvhkit;
 
 namespace {
 
-std::filesystem::path temp_path(const std::string& name) {
-    return std::filesystem::temp_directory_path() /
-           ("bvhkit_trace_test_" + std::to_string(::getpid()) + "_" + name);
+test::ScratchFile temp_path(const std::string& name) {
+    return test::ScratchFile("trace_test", name);
 }
 
 int run(const std::string& args, const std::filesystem::path& log) {
@@ -74,7 +74,6 @@ TEST_P(TraceCommand, HitsEqualBruteForceForR1AndR2Rays) {
         }
     }
     EXPECT_GT(hit_count, rays.size() / 20);
-    for (const auto& p : {ray_file, hit_file, log}) std::filesystem::remove(p);
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, TraceCommand,
@@ -84,7 +83,7 @@ INSTANTIATE_TEST_SUITE_P(Meshes, TraceCommand,
 
 TEST(TraceCommandErrors, BadInputGivesAClearErrorAndNonZeroExit) {
     const auto log = temp_path("err.txt"), bad_rays = temp_path("bad.bin");
-    std::ofstream(bad_rays, std::ios::binary) << "0123456789";  // not a multiple of 32 bytes
+    std::ofstream(bad_rays.path(), std::ios::binary) << "0123456789";  // not a multiple of 32 bytes
     EXPECT_NE(run("trace sphere --rays " + bad_rays.string() + " --out /dev/null", log), 0);
     EXPECT_NE(read_text(log).find("not a whole number of ray records"), std::string::npos)
         << read_text(log);
@@ -98,8 +97,6 @@ TEST(TraceCommandErrors, BadInputGivesAClearErrorAndNonZeroExit) {
     EXPECT_EQ(run("trace --help", log), 0);
     EXPECT_EQ(run("render --help", log), 0);
     EXPECT_EQ(run("info --help", log), 0);
-    std::filesystem::remove(log);
-    std::filesystem::remove(bad_rays);
 }
 
 // --threads: one thread and several write the same file, byte for byte, for closest and any hit.
@@ -117,9 +114,8 @@ TEST(TraceCommandThreads, SameFileForEveryThreadCount) {
                           log),
                       0)
                 << read_text(log);
-            std::ifstream in(out, std::ios::binary);
+            std::ifstream in(out.path(), std::ios::binary);
             bytes[k].assign(std::istreambuf_iterator<char>(in), {});
-            std::filesystem::remove(out);
         }
         EXPECT_EQ(bytes[0].size(), rays.size() * 8) << mode;
         EXPECT_TRUE(bytes[0] == bytes[1]) << mode;
@@ -129,5 +125,4 @@ TEST(TraceCommandThreads, SameFileForEveryThreadCount) {
                   log),
               0);
     EXPECT_NE(read_text(log).find("--threads"), std::string::npos) << read_text(log);
-    std::filesystem::remove(ray_file);
 }
