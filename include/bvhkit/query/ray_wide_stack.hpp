@@ -138,7 +138,7 @@ struct WideStack8 {
 /// Asks for the first line of the entry on top of a stack of `size` entries (slot 0 when it is
 /// empty): the one the walk pops next, whose line then arrives while the walk is still below
 /// the current entry. Asked after every push and pop of the one-ray eight-wide walk: random rays
-/// on the bunny 3% faster (closest and any hit), camera rays 4% (docs/rays.md, "Stop 36").
+/// on the bunny 2-3% faster (closest and any hit), camera rays 4% (docs/rays.md, "Stop 36").
 template <class Line>
 [[gnu::always_inline]] inline void ask_for_top8(const WideStack8& stack, std::uint32_t size,
                                                 Line&& line) {
