@@ -131,6 +131,7 @@ struct WideStack8 {
     WideStack8() {
         child[0] = 0;
         groups[0] = 0;
+        t[0] = 0.0f;
     }
     WideEntry entry(std::uint32_t i) const { return WideEntry{child[i], groups[i], t[i]}; }
 };
@@ -138,7 +139,8 @@ struct WideStack8 {
 /// Asks for the first line of the entry on top of a stack of `size` entries (slot 0 when it is
 /// empty): the one the walk pops next, whose line then arrives while the walk is still below
 /// the current entry. Asked after every push and pop of the one-ray eight-wide walk: random rays
-/// on the bunny 2-3% faster (closest and any hit), camera rays 4% (docs/rays.md, "Stop 36").
+/// on the bunny 2-3% faster (closest and any hit), igea 4%; camera rays, which find their lines in
+/// the caches, 1-3% slower (docs/rays.md, "Stop 36").
 template <class Line>
 [[gnu::always_inline]] inline void ask_for_top8(const WideStack8& stack, std::uint32_t size,
                                                 Line&& line) {
