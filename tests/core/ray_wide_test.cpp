@@ -251,13 +251,16 @@ TEST(WideRays, UsableRaysAreTheDefinitionsOnes) {
     for (const float a : values)
         for (const float b : values)
             for (const float c : values)
-                for (int k = 0; k < 4; ++k) {
+                for (int k = 0; k < 7; ++k) {
                     Ray3f r;
                     r.direction = {a, b, c};
                     r.origin = {1.0f, -2.0f, 3.0f};
                     if (k == 1) r.origin = {c, 0.5f, a};  // the special values in the origin
                     if (k == 2) r.tmin = 2.0f, r.tmax = 1.0f;
                     if (k == 3) r.tmin = nan;
+                    if (k == 4) r.tmin = 1.0f;  // tmin other than 0 in a valid window
+                    if (k == 5) r.tmin = -inf;
+                    if (k == 6) r.tmin = 1e-40f;
                     ASSERT_EQ(wide_ray_usable(r), reference(r))
                         << a << " " << b << " " << c << " " << k;
                     usable += reference(r);
@@ -286,6 +289,11 @@ TEST(WideRays, PerRayConstantsAreTheDefinitionsOnes) {
                 r.origin = {1e5f, -2.0f, 3e-3f};
                 if (!wide_ray_usable(r)) continue;
                 const detail::SlabConstants k(r);
+                // The fourth lane restricts nothing: origin 0, direction 1, rows 3 and 6.
+                ASSERT_EQ(k.origin[3], 0.0f);
+                ASSERT_EQ(k.inv[3], 1.0f);
+                ASSERT_EQ(k.near[3], 3u);
+                ASSERT_EQ(k.far[3], 6u);
                 for (std::uint32_t axis = 0; axis < 3; ++axis) {
                     const float inv = 1.0f / r.direction[axis];
                     ASSERT_TRUE(same(k.inv[axis], inv)) << a << " " << b << " " << c;
@@ -313,10 +321,10 @@ TEST(WideRays, PerRayConstantsAreTheDefinitionsOnes) {
 
 // The watertight test's axes against their definition, written here per component: kz the axis
 // of the largest direction magnitude (d0 >= d1 ? (d0 >= d2 ? 0 : 2) : (d1 >= d2 ? 1 : 2), so the
-// first of tied axes, and axis 2 when a comparison meets a NaN), kx and ky the next two in
-// cyclic order, swapped when d[kz] < 0 (the winding kept), and the origin read along them; for
-// float rays (whose comparisons run four lanes at once) and double rays, over every mix of the
-// special values, unusable directions included (the checked constructor still chooses axes).
+// first of tied axes; a NaN compares false), kx and ky the next two in cyclic order, swapped when
+// d[kz] < 0 (the winding kept; -0 is not below 0), and the origin read along them; for float and
+// double rays, over every mix of the special values, unusable directions included (the checked
+// constructor still chooses axes). The wide walks make these once per ray.
 template <class T>
 void expect_axes_as_defined() {
     const T inf = std::numeric_limits<T>::infinity();

@@ -63,11 +63,8 @@ TEST(BspCommand, TraceThroughTheBspEqualsTheBvh) {
     std::vector<Ray3f> rays = camera_rays(mesh.bounds(), 48, 48);
     const auto r2 = random_rays(mesh.bounds(), 48 * 48, 3);
     rays.insert(rays.end(), r2.begin(), r2.end());
-    const auto dir = std::filesystem::temp_directory_path();
-    const std::string tag = std::to_string(::getpid());
-    const auto ray_file = dir / ("bvhkit_bsp_rays_" + tag + ".bin");
-    const auto bvh_file = dir / ("bvhkit_bsp_bvh_" + tag + ".bin");
-    const auto bsp_file = dir / ("bvhkit_bsp_bsp_" + tag + ".bin");
+    const test::ScratchFile ray_file("bsp_test", "rays.bin"), bvh_file("bsp_test", "bvh.bin"),
+        bsp_file("bsp_test", "bsp.bin");
     write_rays(ray_file, rays);
     const std::string common = "trace " + path.string() + " --rays " + ray_file.string();
     const Result a = run_cli(common + " --out " + bvh_file.string());
@@ -96,21 +93,18 @@ TEST(BspCommand, TraceThroughTheBspEqualsTheBvh) {
     EXPECT_LE(differ, rays.size() / 1000) << differ << " of " << rays.size() << " rays differ";
     EXPECT_NE(run_cli(common + " --out /dev/null --structure kd").status, 0);
     EXPECT_NE(run_cli(common + " --out /dev/null --structure bsp --builder lbvh").status, 0);
-    for (const auto& p : {ray_file, bvh_file, bsp_file}) std::filesystem::remove(p);
 }
 
 // `render --structure bsp` draws through the BSP (where the build has libpng; else it says so).
 TEST(BspCommand, RenderThroughTheBsp) {
-    const auto png = std::filesystem::temp_directory_path() /
-                     ("bvhkit_bsp_render_" + std::to_string(::getpid()) + ".png");
+    const bvhkit::test::ScratchFile png("bsp_test", "render.png");
     const Result r =
         run_cli("render torus:u=24,v=12 --structure bsp --size 64x64 -o " + png.string());
     if (r.status != 0 && r.output.find("libpng") != std::string::npos)
         GTEST_SKIP() << "built without libpng";
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("BSP of"), std::string::npos) << r.output;
-    EXPECT_GT(std::filesystem::file_size(png), 100u);
-    std::filesystem::remove(png);
+    EXPECT_GT(std::filesystem::file_size(png.path()), 100u);
     EXPECT_NE(run_cli("render torus --structure octree -o " + png.string()).status, 0);
     EXPECT_NE(run_cli("render torus --structure bsp --builder lbvh -o " + png.string()).status, 0);
 }

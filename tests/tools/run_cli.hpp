@@ -48,15 +48,12 @@ class ScratchFile {
 
 inline CliOutcome run_cli(const std::string& args) {
     static int counter = 0;
-    const auto log =
-        std::filesystem::temp_directory_path() / ("bvhkit_cli_test_" + std::to_string(::getpid()) +
-                                                  "_" + std::to_string(counter++) + ".txt");
+    const ScratchFile log("cli_log", std::to_string(counter++) + ".txt");
     const std::string command =
         std::string(BVHKIT_CLI) + " " + args + " > " + log.string() + " 2>&1";
     const int raw = std::system(command.c_str());
-    std::ifstream in(log);
+    std::ifstream in(log.path());
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::filesystem::remove(log);
     return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, text};
 }
 
