@@ -144,9 +144,9 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
                 alignas(16) float entry[4];
                 _mm_store_ps(entry, t0);
                 if constexpr (OnLeaf::any_hit)
-                    take_hits_unordered<4>(mask, entry, node, current, stack, size, line);
+                    take_hits_unordered(mask, entry, node, current, stack, size, line);
                 else
-                    take_hits<4>(mask, entry, node, current, stack, size, line);
+                    take_hits(mask, entry, node, current, stack, size, line);
                 continue;
             }
         } else {
@@ -233,7 +233,7 @@ template <int W, class OnLeaf, class Stats>
 void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, const SlabConstants& k,
                        OnLeaf&& on_leaf, Stats& stats) {
     if constexpr (W == 4) {
-        WideStack<4> stack;
+        WideStack4 stack;
         walk4(tree, ray, k, stack, on_leaf, stats);
     } else {
         static_assert(W == 8);

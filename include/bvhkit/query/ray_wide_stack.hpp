@@ -34,10 +34,9 @@ struct WideEntry {
     float t;
 };
 
-/// Each level pushes at most W - 1 entries, and a wide tree is no deeper than the binary tree it
-/// came from (max_bvh_depth).
-template <int W>
-using WideStack = WideEntry[(W - 1) * max_bvh_depth + 1];
+/// The four-wide walk's stack: each level pushes at most three entries, and a wide tree is no
+/// deeper than the binary tree it came from (max_bvh_depth).
+using WideStack4 = WideEntry[3 * max_bvh_depth + 1];
 
 /// Where entry `e` starts: its node, or its leaf's first group. Both addresses, then a select
 /// without a branch: a branch on the kind of entry was mispredicted at about one push in four.
@@ -65,9 +64,9 @@ template <class Line>
 /// pushed, kept in order of distance so that they pop nearest first. Every entry's first line is
 /// asked for now: most pushed entries are read later, and the walk misses the caches at most
 /// nodes.
-template <int W, class Line>
+template <class Line>
 [[gnu::always_inline]] inline void take_hits(unsigned mask, const float* entry,
-                                             const RayNode<W>& node, WideEntry& current,
+                                             const RayNode<4>& node, WideEntry& current,
                                              WideEntry* stack, std::uint32_t& size, Line&& line) {
     const int first = __builtin_ctz(mask);
     mask &= mask - 1;
@@ -89,9 +88,9 @@ template <int W, class Line>
 /// are pushed as they come. Sorting them cost an occlusion ray 7% of its instructions and 1.2
 /// mispredicted branches (callgrind, random rays on the bunny) and bought nothing: no entry is
 /// ever dropped for being farther than a hit, the walk stops at the first one.
-template <int W, class Line>
+template <class Line>
 [[gnu::always_inline]] inline void take_hits_unordered(unsigned mask, const float* entry,
-                                                       const RayNode<W>& node, WideEntry& current,
+                                                       const RayNode<4>& node, WideEntry& current,
                                                        WideEntry* stack, std::uint32_t& size,
                                                        Line&& line) {
     const int first = __builtin_ctz(mask);
