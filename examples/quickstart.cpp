@@ -1,11 +1,18 @@
-// The README's tour, compiled so it cannot rot. Run it from the repository's root: it reads the
-// shipped data/spot.obj (or the mesh file or generator spec given as its argument).
+// The README's tour, compiled so it cannot rot. It reads the shipped data/spot.obj (found from any
+// folder: the build records where the repository's data/ is) or the mesh file or generator spec
+// given as its argument.
 #include <bvhkit/bvhkit.hpp>
 #include <cstdio>
 
-int main(int argc, char** argv) {
+#ifndef BVHKIT_EXAMPLE_MESH
+#define BVHKIT_EXAMPLE_MESH "data/spot.obj"
+#endif
+
+namespace {
+
+int tour(const char* mesh_spec) {
     // A file (OBJ, PLY, STL) or a generator spec such as "sphere:subdiv=6".
-    const bvhkit::TriangleMesh mesh = bvhkit::load_mesh(argc > 1 ? argv[1] : "data/spot.obj");
+    const bvhkit::TriangleMesh mesh = bvhkit::load_mesh(mesh_spec);
     const bvhkit::Aabb3f box = mesh.bounds();
     const bvhkit::Vec3f centre = box.centroid();
     const float diagonal = bvhkit::length(box.extent());
@@ -39,4 +46,17 @@ int main(int argc, char** argv) {
     std::printf("%zu triangles, %zu nodes, depth %u, SAH cost %.2f\n", mesh.triangle_count(),
                 s.node_count, s.depth, s.sah_cost);
     return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const char* mesh_spec = argc > 1 ? argv[1] : BVHKIT_EXAMPLE_MESH;
+    // bvhkit reports bad input (a missing or malformed file, say) as bvhkit::Error.
+    try {
+        return tour(mesh_spec);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bvhkit_example_quickstart: %s\n", e.what());
+        return 1;
+    }
 }
