@@ -373,7 +373,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             from distributed import as_completed
 
             with contextlib.ExitStack() as stack:
-                client = _client(args.scheduler, stack)
+                try:
+                    client = _client(args.scheduler, stack)
+                except (OSError, ValueError) as e:  # unreachable or malformed; TimeoutError too
+                    ap.error(f"argument --scheduler: cannot connect to {args.scheduler!r}: {e}")
                 futures = {
                     client.submit(_task, *job(file, name), pure=False): (file, name)
                     for file, name in todo

@@ -274,6 +274,20 @@ def test_numeric_options_are_checked_when_parsed(mesh_dir, tmp_path, capsys, ext
     assert not os.path.exists(tmp_path / "out")
 
 
+def test_a_scheduler_that_cannot_be_reached(mesh_dir, tmp_path, capsys):
+    pytest.importorskip("distributed")
+    import dask
+
+    for address in ("tcp://127.0.0.1:9", "no-port"):
+        with dask.config.set({"distributed.comm.timeouts.connect": "0.2s"}):
+            with pytest.raises(SystemExit) as e:
+                sample_sdf.main([str(mesh_dir), "--out", str(tmp_path), "--points", "10",
+                                 "--scheduler", address])
+        assert e.value.code == 2
+        assert "argument --scheduler: cannot connect" in capsys.readouterr().err
+        assert os.listdir(tmp_path) == []
+
+
 def test_samples_beyond_float32_are_refused(tmp_path, capsys):
     # A sphere of radius 1e38: the box grown by 5% still fits float32, but noise of 0.9
     # diagonal does not, and its distances square past float32's range.
