@@ -1,27 +1,39 @@
 """python -m bvhkit sample-sdf MESH_DIR --out DIR --points N [options]
 
 Signed-distance samples for every mesh file (.obj, .ply, .stl) of MESH_DIR, written as
-DIR/NAME.npz (NAME: the file's name without its extension) with ``points`` float32 (N, 3) and
-``sdf`` float32 (N,), negative inside. The first N // 2 points are uniform in the mesh's bounding
-box grown by 5% of its size on every side (5% of the diagonal along an axis of zero extent); the
-rest lie near the surface: a point of the surface drawn by area, plus gaussian noise of
-SIGMA times the box's diagonal. The sign comes from the generalized winding number
+DIR/NAME.npz (NAME: the file's name without its extension) with ``points`` float32 (N, 3),
+``sdf`` float32 (N,), negative inside, and ``meta``, a JSON string recording what made them: the
+mesh file's name and SHA-256, N, SIGMA and the seed. The first N // 2 points are uniform in the
+mesh's bounding box grown by 5% of its size on every side (5% of the diagonal along an axis of
+zero extent); the rest lie near the surface: a point of the surface drawn by area, plus gaussian
+noise of SIGMA (0 to 1) times the box's diagonal. The sign comes from the generalized winding number
 (``sign="winding_number"``), so meshes with holes get sensible signs.
 
 The samples depend only on the seed, the mesh file's name and its contents: any scheduler and any
 number of workers write the same bytes. With ``--scheduler`` the meshes are spread over Dask
 workers, one task per mesh (``local:K``: a local cluster of K single-threaded worker processes;
 anything else is a scheduler's address; the workers must see MESH_DIR at the same path). Without
-it they are done one by one in this process. A mesh that fails is reported and skipped, the others
-go on, and the exit status is 1 at the end. Meshes whose .npz exists are skipped, so a rerun
-finishes what an interrupted one left.
+it they are done one by one in this process. A mesh that fails (unreadable, no face of positive
+area, samples or distances beyond float32's range, its file cannot be written) is reported and
+skipped, the others go on, and the exit status is 1 at the end; a write that the output folder
+refuses as a whole (full, read-only, over quota) stops the run at once. No partial file is left:
+each is written beside, checked, synced and renamed.
+
+A mesh whose .npz exists with the same record is skipped, so a rerun finishes what an
+interrupted one left, with the same bytes. If an existing .npz was made with other parameters or
+from other mesh contents (or records nothing), the run refuses before sampling anything and names
+those files; --overwrite redoes them.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
+import hashlib
+import json
 import os
+import re
 import sys
 import time
 import zipfile
@@ -31,14 +43,38 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl")
+# Names the sampler itself (margins, the uniform/near split, the record's keys): outputs of
+# another version are refused like outputs of other parameters.
+FORMAT = "bvhkit sample-sdf 1"
+# Write errors that every later file would meet too: the run stops instead of failing each mesh.
+_FOLDER_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.EFBIG}
+_F32_MAX = float(np.finfo(np.float32).max)
+
+
+def file_digest(path: str) -> str:
+    """SHA-256 of the file's bytes, as hex."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def record(file: str, digest: str, points: int, sigma: float, seed: int) -> str:
+    """The ``meta`` of an output: what made it, and no time, so a rerun writes the same bytes."""
+    return json.dumps(
+        {"format": FORMAT, "mesh": file, "mesh_sha256": digest, "points": points,
+         "near_surface": sigma, "seed": seed},
+        sort_keys=True,
+    )
 
 
 def sample(
     path: str, name: str, points: int, sigma: float, seed: int, threads: int = 1
 ) -> tuple[np.ndarray, np.ndarray]:
     """The samples of one mesh file: ``(points float32 (N, 3), sdf float32 (N,))``; ``name``
-    (with ``seed``) seeds the random numbers. ValueError if the mesh cannot be read or has no
-    face of positive area."""
+    (with ``seed``) seeds the random numbers. ValueError if the mesh cannot be read, has no face
+    of positive area, or its samples or distances do not fit float32."""
     import bvhkit
 
     v, f = bvhkit.load_mesh(path)
@@ -52,6 +88,11 @@ def sample(
     diagonal = float(np.linalg.norm(hi - lo))
     extent = hi - lo
     margin = 0.05 * np.where(extent > 0, extent, diagonal)
+    if not np.all(np.abs(np.concatenate([lo - margin, hi + margin])) <= _F32_MAX):
+        raise ValueError(f"{path}: the box grown by 5% does not fit float32 (samples are float32)")
+    scale = sigma * diagonal
+    if not np.isfinite(scale):
+        raise ValueError(f"{path}: --near-surface {sigma} times the diagonal is not finite")
     # zlib.crc32, not hash(): the same number in every process.
     rng = np.random.default_rng([seed, zlib.crc32(name.encode("utf-8"))])
     n_uniform = points // 2
@@ -62,31 +103,89 @@ def sample(
     s = np.sqrt(r1)  # uniform over each triangle
     bary = np.stack([1 - s, s * (1 - r2), s * r2], axis=1)
     surface = np.einsum("ij,ijk->ik", bary, tri[which])
-    near = surface + rng.normal(scale=sigma * diagonal, size=(n_near, 3))
-    p = np.concatenate([uniform, near]).astype(np.float32)
+    near = surface + rng.normal(scale=scale, size=(n_near, 3))
+    with np.errstate(over="ignore"):
+        p = np.concatenate([uniform, near]).astype(np.float32)
+    if not np.isfinite(p).all():
+        raise ValueError(
+            f"{path}: --near-surface {sigma} times the diagonal ({scale:.3g}) puts samples beyond "
+            "float32's range"
+        )
     scene = bvhkit.TriangleMesh(v, f)
     sdf = scene.signed_distance(p, sign="winding_number", threads=threads).astype(np.float32)
+    if not np.isfinite(sdf).all():
+        raise ValueError(f"{path}: signed distances beyond float32's range (the mesh is too large)")
     return p, sdf
 
 
 def _task(path: str, name: str, points: int, sigma: float, seed: int) -> tuple:
-    """One mesh on a worker: the arrays and the seconds taken (the client writes the file)."""
+    """One mesh on a worker: the arrays, the digest of the file they came from, and the seconds
+    taken (the client writes the file)."""
     t = time.perf_counter()
+    before = os.stat(path)
+    digest = file_digest(path)
     p, sdf = sample(path, name, points, sigma, seed)
-    return p, sdf, time.perf_counter() - t
+    after = os.stat(path)
+    if (before.st_size, before.st_mtime_ns, before.st_ino) != (
+        after.st_size, after.st_mtime_ns, after.st_ino
+    ):
+        raise ValueError(f"{path}: the file changed while it was read")
+    return p, sdf, digest, time.perf_counter() - t
 
 
 def write_npz(path: str, arrays: dict[str, np.ndarray]) -> None:
     """An .npz (np.load reads it) with fixed timestamps, so equal arrays give equal bytes
-    (np.savez stamps the time of writing); written beside and renamed, so a file that exists is
-    complete."""
+    (np.savez stamps the time of writing). Written beside, synced and renamed, every step checked:
+    a file that exists is complete, and on an error (OSError) the temporary is removed."""
     tmp = f"{path}.tmp{os.getpid()}"
-    with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED) as z:
-        for key, a in arrays.items():
-            info = zipfile.ZipInfo(f"{key}.npy", date_time=(1980, 1, 1, 0, 0, 0))
-            with z.open(info, "w") as fh:
-                np.lib.format.write_array(fh, np.ascontiguousarray(a), allow_pickle=False)
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as fh:
+            with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_STORED) as z:
+                for key, a in arrays.items():
+                    info = zipfile.ZipInfo(f"{key}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+                    with z.open(info, "w") as out:
+                        np.lib.format.write_array(out, np.asarray(a, order="C"),
+                                                  allow_pickle=False)
+            fh.flush()
+            os.fsync(fh.fileno())  # a rename that outlives a crash names complete contents
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        raise
+
+
+def _mismatch(path: str, expected: dict[str, Any]) -> Optional[str]:
+    """How the output at ``path`` differs from what this run would write; None if it does not."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            meta = str(z["meta"]) if "meta" in z.files else None
+    except Exception as e:  # noqa: BLE001 - any unreadable file is reported, not used
+        return f"unreadable ({type(e).__name__}: {e})"
+    if meta is None:
+        return "records no parameters (made by an older bvhkit)"
+    try:
+        got = json.loads(meta)
+    except ValueError:
+        return "its record is not JSON"
+    if not isinstance(got, dict):
+        return "its record is not a JSON object"
+    options = {"points": "--points", "near_surface": "--near-surface", "seed": "--seed"}
+    diffs, had, has = [], [], []
+    for key, want in expected.items():
+        have = got.get(key)
+        if have == want:
+            continue
+        if key in options:
+            had.append(f"{options[key]} {have}")
+            has.append(f"{options[key]} {want}")
+        elif key == "mesh_sha256":
+            diffs.append("made from other contents of the mesh file")
+        else:
+            diffs.append(f"{key} {have!r}, this run's is {want!r}")
+    if had:
+        diffs.insert(0, f"made with {' '.join(had)}, this run has {' '.join(has)}")
+    return "; ".join(diffs) or None
 
 
 def _client(scheduler: str, stack: contextlib.ExitStack) -> Any:
@@ -109,27 +208,64 @@ def _client(scheduler: str, stack: contextlib.ExitStack) -> Any:
 def _scheduler(value: str) -> str:
     if value.startswith("local:"):
         k = value[len("local:") :]
-        if not k.isdigit() or int(k) < 1:
+        if not re.fullmatch(r"[0-9]+", k) or int(k) < 1:
             raise argparse.ArgumentTypeError(f"local:K needs a worker count K >= 1, not {k!r}")
     return value
 
 
-def _positive_int(value: str) -> int:
-    n = int(value)
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, not {n}")
+def _int(value: str, low: int) -> int:
+    try:
+        n = int(value)
+    except ValueError:
+        msg = f"must be a whole number >= {low}, not {value!r}"
+        raise argparse.ArgumentTypeError(msg) from None
+    if n < low:
+        raise argparse.ArgumentTypeError(f"must be >= {low}, not {n}")
     return n
 
 
+def _positive_int(value: str) -> int:
+    return _int(value, 1)
+
+
+def _seed(value: str) -> int:
+    return _int(value, 0)  # numpy's seed sequences take no negative numbers
+
+
 def _sigma(value: str) -> float:
-    x = float(value)
-    if not x >= 0 or not np.isfinite(x):
-        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, not {value}")
+    try:
+        x = float(value)
+    except ValueError:
+        x = float("nan")
+    # Noise beyond the box's diagonal is no longer near the surface.
+    if not 0 <= x <= 1:
+        raise argparse.ArgumentTypeError(f"must be a number from 0 to 1, not {value!r}")
     return x
 
 
+class _Stop(Exception):
+    """A write that the output folder refuses as a whole."""
+
+
+def _prepare_out(ap: argparse.ArgumentParser, out: str) -> None:
+    """Creates ``out`` and checks that a file can be written there before any mesh is sampled."""
+    try:
+        os.makedirs(out, exist_ok=True)
+        probe = os.path.join(out, f".sample-sdf-probe{os.getpid()}")
+        try:
+            with open(probe, "wb") as fh:
+                fh.write(b"probe")
+                fh.flush()
+                os.fsync(fh.fileno())
+        finally:
+            with contextlib.suppress(OSError):
+                os.remove(probe)
+    except OSError as e:
+        ap.error(f"--out: cannot write to {out!r}: {e.strerror or e}")
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Runs the command; returns the exit status (1 if any mesh failed)."""
+    """Runs the command; returns the exit status (1 if any mesh failed or outputs were refused)."""
     ap = argparse.ArgumentParser(
         prog="python -m bvhkit sample-sdf",
         description=__doc__,
@@ -140,17 +276,23 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--points", required=True, type=_positive_int, metavar="N",
                     help="samples per mesh")
     ap.add_argument("--near-surface", type=_sigma, default=0.01, metavar="SIGMA",
-                    help="noise of the near-surface half, times the box diagonal (0.01)")
+                    help="noise of the near-surface half, times the box diagonal, 0 to 1 (0.01)")
     ap.add_argument("--scheduler", type=_scheduler, default=None,
                     help="local:K (K worker processes) or a Dask scheduler's address")
-    ap.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    ap.add_argument("--seed", type=_seed, default=0, help="random seed, >= 0 (0)")
+    ap.add_argument("--overwrite", action="store_true",
+                    help="redo outputs made with other parameters or mesh contents")
     args = ap.parse_args(argv)
     if not os.path.isdir(args.mesh_dir):
         ap.error(f"MESH_DIR: {args.mesh_dir!r} is not a folder")
-    os.makedirs(args.out, exist_ok=True)
+    _prepare_out(ap, args.out)
+
+    def expected(file: str, digest: str) -> dict[str, Any]:
+        return json.loads(record(file, digest, args.points, args.near_surface, args.seed))
 
     failed = 0
     todo: list[tuple[str, str]] = []
+    refused: list[tuple[str, str]] = []
     seen: dict[str, str] = {}
     for file in sorted(os.listdir(args.mesh_dir)):
         name, ext = os.path.splitext(file)
@@ -162,10 +304,30 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             failed += 1
             continue
         seen[name] = file
-        if os.path.exists(os.path.join(args.out, name + ".npz")):
-            print(f"skip {file}: {name}.npz exists")
-            continue
+        out = os.path.join(args.out, name + ".npz")
+        if os.path.lexists(out):
+            try:
+                digest = file_digest(os.path.join(args.mesh_dir, file))
+            except OSError as e:
+                print(f"FAILED {file}: {e}", file=sys.stderr)
+                failed += 1
+                continue
+            why = _mismatch(out, expected(file, digest))
+            if why is None:
+                print(f"skip {file}: {name}.npz exists")
+                continue
+            if not args.overwrite:
+                refused.append((name, why))
+                continue
+            print(f"redo {file}: {name}.npz {why}")
         todo.append((file, name))
+    if refused:
+        for name, why in refused:
+            print(f"REFUSED {name}.npz: {why}", file=sys.stderr)
+        print(f"sample-sdf: {len(refused)} existing output(s) in {args.out} do not match this "
+              "run; nothing written. Rerun with --overwrite to redo them, or use another --out.",
+              file=sys.stderr)
+        return 1
     total = len(todo)
     done = written = 0
 
@@ -177,8 +339,18 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             print(f"[{done}/{total}] FAILED {file}: {type(error).__name__}: {error}",
                   file=sys.stderr, flush=True)
             return
-        p, sdf, seconds = result
-        write_npz(os.path.join(args.out, name + ".npz"), {"points": p, "sdf": sdf})
+        p, sdf, digest, seconds = result
+        meta = record(file, digest, args.points, args.near_surface, args.seed)
+        try:
+            write_npz(os.path.join(args.out, name + ".npz"),
+                      {"points": p, "sdf": sdf, "meta": np.array(meta)})
+        except OSError as e:
+            failed += 1
+            print(f"[{done}/{total}] FAILED {file}: cannot write {name}.npz: "
+                  f"{e.strerror or e}", file=sys.stderr, flush=True)
+            if e.errno in _FOLDER_ERRORS:
+                raise _Stop(e) from None
+            return
         written += 1
         inside = float(np.mean(np.signbit(sdf)))
         print(f"[{done}/{total}] {file}: {len(p)} samples in {seconds:.2f} s, "
@@ -189,30 +361,38 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return (path, name, args.points, args.near_surface, args.seed)
 
     start = time.perf_counter()
-    if args.scheduler is None:
-        for file, name in todo:
-            try:
-                result, error = _task(*job(file, name)), None
-            except Exception as e:  # noqa: BLE001 - reported, and the others go on
-                result, error = None, e
-            finish(file, name, result, error)
-    elif todo:
-        from distributed import as_completed
-
-        with contextlib.ExitStack() as stack:
-            client = _client(args.scheduler, stack)
-            futures = {
-                client.submit(_task, *job(file, name), pure=False): (file, name)
-                for file, name in todo
-            }
-            for future in as_completed(futures):
-                file, name = futures[future]
+    try:
+        if args.scheduler is None:
+            for file, name in todo:
                 try:
-                    result, error = future.result(), None
-                except Exception as e:  # noqa: BLE001
+                    result, error = _task(*job(file, name)), None
+                except Exception as e:  # noqa: BLE001 - reported, and the others go on
                     result, error = None, e
                 finish(file, name, result, error)
-                future.release()
+        elif todo:
+            from distributed import as_completed
+
+            with contextlib.ExitStack() as stack:
+                try:
+                    client = _client(args.scheduler, stack)
+                except (OSError, ValueError) as e:  # unreachable or malformed; TimeoutError too
+                    ap.error(f"argument --scheduler: cannot connect to {args.scheduler!r}: {e}")
+                futures = {
+                    client.submit(_task, *job(file, name), pure=False): (file, name)
+                    for file, name in todo
+                }
+                for future in as_completed(futures):
+                    file, name = futures[future]
+                    try:
+                        result, error = future.result(), None
+                    except Exception as e:  # noqa: BLE001
+                        result, error = None, e
+                    future.release()
+                    finish(file, name, result, error)
+    except _Stop as e:
+        print(f"sample-sdf: stopped: {args.out} takes no more files ({e}); {total - done} "
+              "mesh(es) not done. Free space (or fix the folder) and rerun to finish.",
+              file=sys.stderr)
     elapsed = time.perf_counter() - start
     print(f"sample-sdf: {written} of {total} meshes written in "
           f"{elapsed:.2f} s" + (f"; {failed} failed" if failed else ""))
