@@ -32,6 +32,8 @@ fi
 "$venv/bin/python" -m pip install -q "scikit-build-core>=0.10" "nanobind>=2.0" numpy pytest
 # Optional for the package; the tests of bvhkit.dask and sample-sdf need it.
 "$venv/bin/python" -m pip install -q "dask[distributed]"
+# Optional too: tests/python/test_arguments.py checks the package's annotations with mypy.
+"$venv/bin/python" -m pip install -q mypy
 "$venv/bin/python" -m pip install -q --no-build-isolation \
   --config-settings=build-dir=build/python .
 cd tests/python  # import the installed package, not python/bvhkit

@@ -13,11 +13,13 @@ runs on ``threads`` threads (0 = every core), with the same answers for every th
 Objects may be queried from several Python threads at once.
 """
 
-from __future__ import annotations
+# Everything but the API is imported under a private name (and without `from __future__ import
+# annotations`, which would bind `annotations`), so that dir(bvhkit) shows the API alone.
+import os as _os
+import typing as _typing
 
-from typing import Any, NamedTuple
-
-import numpy as np
+import numpy as _np
+import numpy.typing as _npt
 
 from . import _arrays as _a
 from . import _bvhkit
@@ -40,7 +42,9 @@ __all__ = [
 ]
 
 
-def load_mesh(path_or_spec: str) -> tuple[np.ndarray, np.ndarray]:
+def load_mesh(
+    path_or_spec: _typing.Union[str, "_os.PathLike[str]"],
+) -> tuple[_np.ndarray, _np.ndarray]:
     """Reads a mesh file (.obj, .ply including triangle strips, .stl ascii or binary) or generates
     one from a spec such as ``"sphere:subdiv=4"``, ``"torus"`` or ``"terrain:n=64"``.
 
@@ -48,39 +52,35 @@ def load_mesh(path_or_spec: str) -> tuple[np.ndarray, np.ndarray]:
     Raises ValueError naming the file and line for a malformed file, or when the argument is
     neither an existing file nor a valid spec.
     """
-    if not isinstance(path_or_spec, (str,)) and not hasattr(path_or_spec, "__fspath__"):
+    p = _a.path("path_or_spec", path_or_spec)
+    if not isinstance(p, str):
         raise TypeError(f"path_or_spec: must be a str or path, not {type(path_or_spec).__name__}")
-    import os
-
-    return _bvhkit.load_mesh(os.fspath(path_or_spec))
+    return _bvhkit.load_mesh(p)
 
 
-class RayHits(NamedTuple):
+class RayHits(_typing.NamedTuple):
     """What :meth:`TriangleMesh.intersect` returns, one entry per ray."""
 
-    t: np.ndarray
+    t: _np.ndarray
     """(k,) distance along the ray in units of its direction's length; inf on a miss."""
-    face: np.ndarray
+    face: _np.ndarray
     """(k,) int64 index of the face hit; -1 on a miss."""
-    barycentric: np.ndarray
+    barycentric: _np.ndarray
     """(k, 3) weights of the face's three vertices at the hit point; zeros on a miss."""
 
 
-class ClosestPoints(NamedTuple):
+class ClosestPoints(_typing.NamedTuple):
     """What :meth:`TriangleMesh.closest_point` returns, one entry per point."""
 
-    distance: np.ndarray
+    distance: _np.ndarray
     """(k,) distance to the mesh; inf where nothing is within max_distance (or the point is not
     finite, or the mesh is empty)."""
-    closest: np.ndarray
+    closest: _np.ndarray
     """(k, 3) closest point on the mesh; NaN where there is none."""
-    face: np.ndarray
+    face: _np.ndarray
     """(k,) int64 index of the face the closest point lies on; -1 where there is none."""
-    barycentric: np.ndarray
+    barycentric: _np.ndarray
     """(k, 3) weights of that face's three vertices at the closest point."""
-
-
-_SIGNS = ("pseudonormal", "winding_number")
 
 
 class TriangleMesh:
@@ -98,139 +98,140 @@ class TriangleMesh:
     on even scans it buys nothing). The same hits, but that among faces hit at the same t up to
     rounding another may be named; docs/python.md has the figures.
 
-    Faces with a NaN or infinite coordinate are left out of every query (see :meth:`skipped`);
-    zero-area faces are never hit by rays. The ray tree is built at once; the closest point and
-    winding number structures on first use.
+    Faces with a NaN or infinite coordinate at the build are left out of every query (see
+    :meth:`skipped`), and stay out after a :meth:`refit`; zero-area faces are never hit by rays.
+    The ray tree is built at once; the closest point and winding number structures on first use.
     """
 
     def __init__(
         self,
-        vertices: Any,
-        faces: Any,
-        builder: str = "binned_sah",
-        dtype: Any = np.float32,
-        ray_test: str = "watertight",
+        vertices: _npt.ArrayLike,
+        faces: _npt.ArrayLike,
+        builder: _a.Builder = "binned_sah",
+        dtype: _npt.DTypeLike = _np.float32,
+        ray_test: _a.RayTest = "watertight",
         threads: int = 0,
         spatial_splits: bool = False,
     ) -> None:
-        self.dtype: np.dtype = _a.scalar_type(dtype)
-        if not isinstance(builder, str):
-            raise TypeError(f"builder: must be a str, not {type(builder).__name__}")
-        if not isinstance(ray_test, str):
-            raise TypeError(f"ray_test: must be a str, not {type(ray_test).__name__}")
-        if not isinstance(spatial_splits, (bool, np.bool_)):
-            raise TypeError(
-                f"spatial_splits: must be a bool, not {type(spatial_splits).__name__}"
-            )
-        if spatial_splits and builder.replace("-", "_") != "binned_sah":
+        self.dtype: _np.dtype = _a.scalar_type(dtype)
+        _a.text("builder", builder)
+        _a.option("ray_test", ray_test, _a.RAY_TESTS)
+        splits = _a.flag("spatial_splits", spatial_splits)
+        n = _a.threads(threads)
+        if splits and builder.replace("-", "_") != "binned_sah":
             raise ValueError(f"spatial_splits: needs builder='binned_sah', not {builder!r}")
         v = _a.vertices("vertices", vertices, self.dtype)
         f = _a.faces(faces, len(v))
-        impl = _bvhkit.Scene32 if self.dtype == np.float32 else _bvhkit.Scene64
+        impl = _bvhkit.Scene32 if self.dtype == _np.float32 else _bvhkit.Scene64
         try:
-            self._impl = impl(
-                v, f, builder.replace("_", "-"), ray_test, _a.threads(threads), bool(spatial_splits)
-            )
+            self._impl = impl(v, f, builder.replace("_", "-"), ray_test, n, splits)
         except ValueError as e:
-            raise ValueError(f"builder or ray_test: {e}") from None
+            if "builder" not in str(e):
+                raise
+            raise ValueError(f"builder: {e}") from None
         self._vertex_count = len(v)
         self._builder = builder.replace("_", "-")
 
     # ------------------------------------------------------------------ rays
 
-    def _rays(self, origins: Any, directions: Any, tmin: Any, tmax: Any):
+    def _rays(self, origins: object, directions: object, tmin: object, tmax: object,
+              threads: object) -> tuple:
         o = _a.rows("origins", origins, 3, self.dtype)
         d = _a.rows("directions", directions, 3, self.dtype)
         if d.shape[0] != o.shape[0]:
             raise ValueError(f"directions: {d.shape[0]} rows, origins has {o.shape[0]}")
         t0 = _a.column("tmin", tmin, len(o), self.dtype)
-        t1 = _a.column("tmax", tmax, len(o), self.dtype)
-        return o, d, t0, t1
+        t1 = _a.column("tmax", tmax, len(o), self.dtype, none=_np.inf)
+        return o, d, t0, t1, _a.threads(threads)
 
     def intersect(
         self,
-        origins: Any,
-        directions: Any,
-        tmin: Any = 0.0,
-        tmax: Any = np.inf,
+        origins: _npt.ArrayLike,
+        directions: _npt.ArrayLike,
+        tmin: _npt.ArrayLike = 0.0,
+        tmax: _typing.Optional[_npt.ArrayLike] = _np.inf,
         threads: int = 0,
     ) -> RayHits:
         """The closest hit of each ray ``origin + t * direction``, t in [tmin, tmax].
 
-        ``origins`` and ``directions``: (k, 3); ``tmin``/``tmax``: scalars or (k,) arrays.
+        ``origins`` and ``directions``: (k, 3); ``tmin``/``tmax``: numbers or (k,) arrays
+        (``tmax=None``: no limit, as inf).
         Returns :class:`RayHits` ``(t, face, barycentric)``: t = inf and face = -1 on a miss.
         Directions need not be unit length (t is in units of the direction given).
         """
-        o, d, t0, t1 = self._rays(origins, directions, tmin, tmax)
+        o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
         k = len(o)
-        t = np.empty(k, self.dtype)
-        face = np.empty(k, np.int64)
-        bary = np.empty((k, 3), self.dtype)
-        self._impl.intersect(o, d, t0, t1, t, face, bary, _a.threads(threads))
+        t = _np.empty(k, self.dtype)
+        face = _np.empty(k, _np.int64)
+        bary = _np.empty((k, 3), self.dtype)
+        self._impl.intersect(o, d, t0, t1, t, face, bary, n)
         return RayHits(t, face, bary)
 
     def occluded(
         self,
-        origins: Any,
-        directions: Any,
-        tmin: Any = 0.0,
-        tmax: Any = np.inf,
+        origins: _npt.ArrayLike,
+        directions: _npt.ArrayLike,
+        tmin: _npt.ArrayLike = 0.0,
+        tmax: _typing.Optional[_npt.ArrayLike] = _np.inf,
         threads: int = 0,
-    ) -> np.ndarray:
+    ) -> _np.ndarray:
         """Whether each ray hits any face within [tmin, tmax]: (k,) bool (any-hit, shadow rays)."""
-        o, d, t0, t1 = self._rays(origins, directions, tmin, tmax)
-        out = np.empty(len(o), np.bool_)
-        self._impl.occluded(o, d, t0, t1, out, _a.threads(threads))
+        o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
+        out = _np.empty(len(o), _np.bool_)
+        self._impl.occluded(o, d, t0, t1, out, n)
         return out
 
     def count_intersections(
         self,
-        origins: Any,
-        directions: Any,
-        tmin: Any = 0.0,
-        tmax: Any = np.inf,
+        origins: _npt.ArrayLike,
+        directions: _npt.ArrayLike,
+        tmin: _npt.ArrayLike = 0.0,
+        tmax: _typing.Optional[_npt.ArrayLike] = _np.inf,
         threads: int = 0,
-    ) -> np.ndarray:
+    ) -> _np.ndarray:
         """How many faces each ray hits within [tmin, tmax]: (k,) int64.
 
         With the default watertight test a ray through an edge or vertex shared by several faces
         counts each face whose closed triangle it meets; ``ray_test="fast"`` may miss or double
         count there.
         """
-        o, d, t0, t1 = self._rays(origins, directions, tmin, tmax)
-        out = np.empty(len(o), np.int64)
-        self._impl.count_intersections(o, d, t0, t1, out, _a.threads(threads))
+        o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
+        out = _np.empty(len(o), _np.int64)
+        self._impl.count_intersections(o, d, t0, t1, out, n)
         return out
 
     # ------------------------------------------------------------------ proximity
 
-    def _points(self, points: Any) -> np.ndarray:
+    def _points(self, points: _typing.Any) -> _np.ndarray:
         return _a.rows("points", points, 3, self.dtype)
 
     def closest_point(
-        self, points: Any, max_distance: float = np.inf, threads: int = 0
+        self,
+        points: _npt.ArrayLike,
+        max_distance: _typing.Optional[float] = _np.inf,
+        threads: int = 0,
     ) -> ClosestPoints:
         """The closest point of the mesh to each point, within ``max_distance``.
 
-        ``points``: (k, 3). Returns :class:`ClosestPoints` ``(distance, closest, face,
-        barycentric)``; where no face is within max_distance (or the point has a NaN or
-        infinite coordinate): distance = inf, closest = NaN, face = -1.
+        ``points``: (k, 3); ``max_distance``: a number >= 0, inf or None for no limit. Returns
+        :class:`ClosestPoints` ``(distance, closest, face, barycentric)``; where no face is within
+        max_distance (or the point has a NaN or infinite coordinate): distance = inf, closest =
+        NaN, face = -1.
         """
         p = self._points(points)
-        md = float(max_distance)
-        if not md >= 0:
-            raise ValueError(f"max_distance: must be >= 0 (inf for no limit), not {max_distance}")
+        md = _a.limit("max_distance", max_distance)
+        n = _a.threads(threads)
         k = len(p)
-        dist = np.empty(k, self.dtype)
-        closest = np.empty((k, 3), self.dtype)
-        face = np.empty(k, np.int64)
-        bary = np.empty((k, 3), self.dtype)
-        self._impl.closest_point(p, md, dist, closest, face, bary, _a.threads(threads))
+        dist = _np.empty(k, self.dtype)
+        closest = _np.empty((k, 3), self.dtype)
+        face = _np.empty(k, _np.int64)
+        bary = _np.empty((k, 3), self.dtype)
+        self._impl.closest_point(p, md, dist, closest, face, bary, n)
         return ClosestPoints(dist, closest, face, bary)
 
     def signed_distance(
-        self, points: Any, sign: str = "pseudonormal", threads: int = 0
-    ) -> np.ndarray:
+        self, points: _npt.ArrayLike, sign: _a.Sign = "pseudonormal", threads: int = 0
+    ) -> _np.ndarray:
         """Distance to the mesh, negative inside: (k,).
 
         ``sign="pseudonormal"`` takes the sign from the angle-weighted pseudonormal at the
@@ -239,16 +240,16 @@ class TriangleMesh:
         (inside where it exceeds 1/2; Jacobson et al. 2013): robust for meshes with holes or
         self-intersections. Points with a non-finite coordinate, or an empty mesh, give inf.
         """
-        if sign not in _SIGNS:
-            raise ValueError(f"sign: {sign!r} is not one of {', '.join(map(repr, _SIGNS))}")
+        _a.option("sign", sign, _a.SIGNS)
         p = self._points(points)
-        out = np.empty(len(p), self.dtype)
-        self._impl.signed_distance(p, sign, out, _a.threads(threads))
+        n = _a.threads(threads)
+        out = _np.empty(len(p), self.dtype)
+        self._impl.signed_distance(p, sign, out, n)
         return out
 
     def winding_number(
-        self, points: Any, exact: bool = False, beta: float = 2.0, threads: int = 0
-    ) -> np.ndarray:
+        self, points: _npt.ArrayLike, exact: bool = False, beta: float = 2.0, threads: int = 0
+    ) -> _np.ndarray:
         """The generalized winding number of the mesh at each point: (k,).
 
         About 1 inside a closed outward-oriented mesh, 0 outside. ``exact=True`` sums every
@@ -257,22 +258,28 @@ class TriangleMesh:
         radius away.
         """
         p = self._points(points)
-        b = float(beta)
-        if not b > 0 or not np.isfinite(b):
+        e = _a.flag("exact", exact)
+        b = _a.number("beta", beta)
+        if not 0 < b < _a.INF:
             raise ValueError(f"beta: must be a positive finite number, not {beta}")
-        out = np.empty(len(p), self.dtype)
-        self._impl.winding_number(p, bool(exact), b, out, _a.threads(threads))
+        n = _a.threads(threads)
+        out = _np.empty(len(p), self.dtype)
+        self._impl.winding_number(p, e, b, out, n)
         return out
 
-    def contains(self, points: Any, threads: int = 0) -> np.ndarray:
+    def contains(self, points: _npt.ArrayLike, threads: int = 0) -> _np.ndarray:
         """Whether each point is inside the mesh (winding number above 1/2): (k,) bool."""
         return self.winding_number(points, threads=threads) > 0.5
 
     # ------------------------------------------------------------------ changes and measures
 
-    def refit(self, vertices: Any) -> None:
+    def refit(self, vertices: _npt.ArrayLike) -> None:
         """New positions for the same vertices (same faces): the trees are refitted, not rebuilt
-        (fast, for deforming meshes; their quality degrades if the motion is large)."""
+        (fast, for deforming meshes; their quality degrades if the motion is large).
+
+        The faces left out at the build (:meth:`skipped`) stay out of every query even where the
+        new vertices make them finite; a NaN or infinite coordinate in any other face is a
+        ValueError naming ``vertices``, and the scene is left as it was."""
         v = _a.vertices("vertices", vertices, self.dtype)
         if len(v) != self._vertex_count:
             raise ValueError(f"vertices: {len(v)} rows, the mesh has {self._vertex_count}")
@@ -284,7 +291,7 @@ class TriangleMesh:
         in the tree, or more where spatial splits cut some)."""
         return dict(self._impl.stats())
 
-    def skipped(self) -> np.ndarray:
+    def skipped(self) -> _np.ndarray:
         """Indices (int64) of faces left out for a NaN or infinite coordinate."""
         return self._impl.skipped()
 
@@ -309,38 +316,37 @@ class TriangleMesh:
         return _scene_file.encode(self.dtype, self._builder, self._impl.state())
 
     @classmethod
-    def from_bytes(cls, data: Any, threads: int = 0) -> "TriangleMesh":
+    def from_bytes(cls, data: _typing.Union[bytes, bytearray, memoryview], threads: int = 0
+                   ) -> "TriangleMesh":
         """A scene from :meth:`to_bytes`'s bytes. Everything is checked (a checksum over the whole,
         the sizes, and each tree as the library's loaders check it); damaged or foreign data
         raises ValueError. ``threads`` is for the trees built later, if any."""
         return cls._from_bytes(data, "data", _a.threads(threads))
 
-    def save(self, path: Any) -> None:
+    def save(self, path: _typing.Union[str, "_os.PathLike[str]"]) -> None:
         """Writes :meth:`to_bytes` to the file ``path``."""
-        import os
-
-        with open(os.fspath(path), "wb") as f:
+        with open(_a.path("path", path), "wb") as f:
             f.write(self.to_bytes())
 
     @classmethod
-    def load(cls, path: Any, threads: int = 0) -> "TriangleMesh":
+    def load(cls, path: _typing.Union[str, "_os.PathLike[str]"], threads: int = 0
+             ) -> "TriangleMesh":
         """A scene from a file written by :meth:`save` (ValueError naming the file if damaged)."""
-        import os
-
-        p = os.fspath(path)
+        p = _a.path("path", path)
+        n = _a.threads(threads)
         with open(p, "rb") as f:
             data = f.read()
-        return cls._from_bytes(data, p, _a.threads(threads))
+        return cls._from_bytes(data, p, n)
 
     @classmethod
-    def _from_bytes(cls, data: Any, what: str, threads: int) -> "TriangleMesh":
+    def _from_bytes(cls, data: _typing.Any, what: str, threads: int) -> "TriangleMesh":
         self = cls.__new__(cls)
         self._load(data, what, threads)
         return self
 
-    def _load(self, data: Any, what: str, threads: int) -> None:
+    def _load(self, data: _typing.Any, what: str, threads: int) -> None:
         d = _scene_file.decode(data, what)
-        impl = _bvhkit.Scene32 if d.dtype == np.float32 else _bvhkit.Scene64
+        impl = _bvhkit.Scene32 if d.dtype == _np.float32 else _bvhkit.Scene64
         try:
             self._impl = impl(
                 d.vertices,

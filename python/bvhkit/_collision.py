@@ -2,16 +2,18 @@
 
 from __future__ import annotations
 
+import os
 import struct
-from typing import Any, List, NamedTuple, Union
+from typing import Any, List, Literal, NamedTuple, Optional, Union, overload
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _arrays as _a
 from . import _bvhkit
 from ._scene_file import _checksum, _join_sections, _split_sections  # the scenes' framing
 
-VOLUMES = ("obb", "rss", "obbrss", "aabb", "sphere", "kdop18", "hull")
+VOLUMES = _a.VOLUMES
 
 # ---------------------------------------------------------------- the container (docs/python.md)
 # Header: magic, version, scalar (1 float32, 2 float64), volume (the C++ file's volume code),
@@ -100,20 +102,19 @@ class CollisionModel:
 
     def __init__(
         self,
-        vertices: Any,
-        faces: Any,
-        volume: str = "obb",
-        dtype: Any = np.float32,
+        vertices: npt.ArrayLike,
+        faces: npt.ArrayLike,
+        volume: _a.Volume = "obb",
+        dtype: npt.DTypeLike = np.float32,
         threads: int = 0,
     ) -> None:
-        if volume not in VOLUMES:
-            raise ValueError(f"volume: {volume!r} is not one of {', '.join(map(repr, VOLUMES))}")
-        self.volume: str = volume
+        self.volume: str = _a.option("volume", volume, VOLUMES)
         self.dtype: np.dtype = _a.scalar_type(dtype)
+        n = _a.threads(threads)
         v = _a.vertices("vertices", vertices, self.dtype)
         f = _a.faces(faces, len(v))
         suffix = "f32" if self.dtype == np.float32 else "f64"
-        self._impl = getattr(_bvhkit, f"Model_{volume}_{suffix}")(v, f, _a.threads(threads))
+        self._impl = getattr(_bvhkit, f"Model_{volume}_{suffix}")(v, f, n)
         self._vertex_count = len(v)
 
     # ------------------------------------------------------------------ saving and loading
@@ -125,25 +126,21 @@ class CollisionModel:
         return _encode(self.dtype, self.volume, self._impl.state())
 
     @classmethod
-    def from_bytes(cls, data: Any) -> "CollisionModel":
+    def from_bytes(cls, data: Union[bytes, bytearray, memoryview]) -> "CollisionModel":
         """A model from :meth:`to_bytes`'s bytes. Everything is checked (a checksum over the
         whole, the sizes, the tree as the library's loader checks it, and that it is the model of
         the mesh stored beside it); damaged or foreign data raises ValueError."""
         return cls._from_bytes(data, "data")
 
-    def save(self, path: Any) -> None:
+    def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
         """Writes :meth:`to_bytes` to the file ``path``."""
-        import os
-
-        with open(os.fspath(path), "wb") as f:
+        with open(_a.path("path", path), "wb") as f:
             f.write(self.to_bytes())
 
     @classmethod
-    def load(cls, path: Any) -> "CollisionModel":
+    def load(cls, path: Union[str, "os.PathLike[str]"]) -> "CollisionModel":
         """A model from a file written by :meth:`save` (ValueError naming the file if damaged)."""
-        import os
-
-        p = os.fspath(path)
+        p = _a.path("path", path)
         with open(p, "rb") as f:
             data = f.read()
         return cls._from_bytes(data, p)
@@ -177,7 +174,7 @@ class CollisionModel:
             raise ValueError("state: not a pickled bvhkit.CollisionModel")
         self._load(state["bvhkit.CollisionModel"], "pickled CollisionModel")
 
-    def refit(self, vertices: Any) -> None:
+    def refit(self, vertices: npt.ArrayLike) -> None:
         """New positions for the same vertices (same faces): every volume is refitted, the tree's
         shape kept."""
         v = _a.vertices("vertices", vertices, self.dtype)
@@ -195,7 +192,7 @@ class CollisionModel:
         return f"CollisionModel(faces={self.face_count}, volume={self.volume!r}, dtype={self.dtype})"
 
 
-def _poses(a: CollisionModel, b: CollisionModel, rotations: Any, translations: Any):
+def _poses(a: Any, b: Any, rotations: Any, translations: Any):
     for name, m in (("a", a), ("b", b)):
         if not isinstance(m, CollisionModel):
             raise TypeError(f"{name}: must be a CollisionModel, not {type(m).__name__}")
@@ -214,11 +211,38 @@ def _poses(a: CollisionModel, b: CollisionModel, rotations: Any, translations: A
     return r, t
 
 
+@overload
 def collide(
     a: CollisionModel,
     b: CollisionModel,
-    rotations: Any,
-    translations: Any,
+    rotations: Optional[npt.ArrayLike],
+    translations: npt.ArrayLike,
+    contacts: Literal[False] = ...,
+    threads: int = ...,
+) -> np.ndarray: ...
+@overload
+def collide(
+    a: CollisionModel,
+    b: CollisionModel,
+    rotations: Optional[npt.ArrayLike],
+    translations: npt.ArrayLike,
+    contacts: Literal[True],
+    threads: int = ...,
+) -> List[np.ndarray]: ...
+@overload
+def collide(
+    a: CollisionModel,
+    b: CollisionModel,
+    rotations: Optional[npt.ArrayLike],
+    translations: npt.ArrayLike,
+    contacts: bool = ...,
+    threads: int = ...,
+) -> Union[np.ndarray, List[np.ndarray]]: ...
+def collide(
+    a: CollisionModel,
+    b: CollisionModel,
+    rotations: Optional[npt.ArrayLike],
+    translations: npt.ArrayLike,
     contacts: bool = False,
     threads: int = 0,
 ) -> Union[np.ndarray, List[np.ndarray]]:
@@ -232,9 +256,10 @@ def collide(
     the intersecting (face of a, face of b) pairs at each pose, sorted. Faces that only touch
     count as intersecting.
     """
-    r, t = _poses(a, b, rotations, translations)
+    want_contacts = _a.flag("contacts", contacts)
     n = _a.threads(threads)
-    if not contacts:
+    r, t = _poses(a, b, rotations, translations)
+    if not want_contacts:
         out = np.empty(len(r), np.bool_)
         a._impl.collides(b._impl, r, t, out, n)
         return out
@@ -260,8 +285,8 @@ class Distances(NamedTuple):
 def distance(
     a: CollisionModel,
     b: CollisionModel,
-    rotations: Any,
-    translations: Any,
+    rotations: Optional[npt.ArrayLike],
+    translations: npt.ArrayLike,
     absolute_tolerance: float = 0.0,
     relative_tolerance: float = 0.0,
     threads: int = 0,
@@ -277,17 +302,18 @@ def distance(
     tol = []
     for name, value in (("absolute_tolerance", absolute_tolerance),
                         ("relative_tolerance", relative_tolerance)):
-        x = float(value)
-        if not (x >= 0 and np.isfinite(x)):
+        x = _a.number(name, value)
+        if not 0 <= x < _a.INF:
             raise ValueError(f"{name}: must be a finite number >= 0, not {value}")
         tol.append(x)
+    n = _a.threads(threads)
     k = len(r)
     d = np.empty(k, a.dtype)
     pa = np.empty((k, 3), a.dtype)
     pb = np.empty((k, 3), a.dtype)
     fa = np.empty(k, np.int64)
     fb = np.empty(k, np.int64)
-    a._impl.distance(b._impl, r, t, tol[0], tol[1], d, pa, pb, fa, fb, _a.threads(threads))
+    a._impl.distance(b._impl, r, t, tol[0], tol[1], d, pa, pb, fa, fb, n)
     return Distances(d, pa, pb, fa, fb)
 
 

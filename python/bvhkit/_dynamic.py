@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any, Optional
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _arrays as _a
 from . import _bvhkit
@@ -31,13 +32,13 @@ class _DynamicTree:
         margin: float = 0.1,
         margin_relative: float = 0.0,
         displacement_multiplier: float = 4.0,
-        dtype: Any = np.float32,
+        dtype: npt.DTypeLike = np.float32,
     ) -> None:
         self.dtype: np.dtype = _a.scalar_type(dtype)
         for name, value in (("margin", margin), ("margin_relative", margin_relative),
                             ("displacement_multiplier", displacement_multiplier)):
-            x = float(value)
-            if not (x >= 0 and np.isfinite(x)):
+            x = _a.number(name, value)
+            if not 0 <= x < _a.INF:
                 raise ValueError(f"{name}: must be a finite number >= 0, not {value}")
         suffix = "f32" if self.dtype == np.float32 else "f64"
         cls = getattr(_bvhkit, f"Tree{self._dim}_{suffix}")
@@ -53,7 +54,7 @@ class _DynamicTree:
             raise ValueError(f"{lo_name}: row {int(bad[0])} has min > max on some axis")
         return lo_, hi_
 
-    def create(self, lo: Any, hi: Any) -> np.ndarray:
+    def create(self, lo: npt.ArrayLike, hi: npt.ArrayLike) -> np.ndarray:
         """Adds one proxy per box (``lo``, ``hi``: (k, D) corners) and returns their ids, (k,)
         int32. Ids of destroyed proxies are reused."""
         lo_, hi_ = self._boxes(lo, hi)
@@ -61,7 +62,13 @@ class _DynamicTree:
         self._impl.create(lo_, hi_, ids)
         return ids
 
-    def move(self, ids: Any, lo: Any, hi: Any, displacement: Optional[Any] = None) -> np.ndarray:
+    def move(
+        self,
+        ids: npt.ArrayLike,
+        lo: npt.ArrayLike,
+        hi: npt.ArrayLike,
+        displacement: Optional[npt.ArrayLike] = None,
+    ) -> np.ndarray:
         """Gives the proxies ``ids`` new boxes. ``displacement`` (k, D), optional, is each box's
         predicted motion until its next move (its fat box is stretched along it). Returns (k,)
         bool: whether the tree was restructured for that proxy (its box left its fat box).
@@ -78,7 +85,7 @@ class _DynamicTree:
         self._impl.move(i, lo_, hi_, disp, out)
         return out
 
-    def destroy(self, ids: Any) -> None:
+    def destroy(self, ids: npt.ArrayLike) -> None:
         """Removes the proxies ``ids`` (each live, none twice; else nothing changes)."""
         self._impl.destroy(_ids(ids))
 
@@ -87,14 +94,18 @@ class _DynamicTree:
         call, each once: (p, 2) int32, rows (a, b) with a < b, sorted."""
         return self._impl.find_pairs()
 
-    def query(self, lo: Any, hi: Any, threads: int = 0) -> np.ndarray:
+    def query(self, lo: npt.ArrayLike, hi: npt.ArrayLike, threads: int = 0) -> np.ndarray:
         """Every proxy whose box overlaps each query box (touching counts): (p, 2) int64 rows
         (query index, proxy id), grouped by query in order."""
         lo_, hi_ = self._boxes(lo, hi)
         return self._impl.query(lo_, hi_, _a.threads(threads))
 
     def ray_cast(
-        self, origins: Any, directions: Any, max_fraction: Any = 1.0, threads: int = 0
+        self,
+        origins: npt.ArrayLike,
+        directions: npt.ArrayLike,
+        max_fraction: npt.ArrayLike = 1.0,
+        threads: int = 0,
     ) -> np.ndarray:
         """Every proxy whose box the segment ``origin + s * direction``, s in [0, max_fraction],
         crosses: (p, 2) int64 rows (ray index, proxy id), grouped by ray in order."""
@@ -107,7 +118,7 @@ class _DynamicTree:
             raise ValueError("max_fraction: must be finite and >= 0")
         return self._impl.ray_cast(o, d, f, _a.threads(threads))
 
-    def boxes(self, ids: Any) -> tuple[np.ndarray, np.ndarray]:
+    def boxes(self, ids: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """The tight boxes of the proxies ``ids``: (lo, hi), each (k, D)."""
         return self._impl.boxes(_ids(ids))
 

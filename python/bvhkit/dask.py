@@ -20,9 +20,10 @@ dask is optional for bvhkit; this module needs it (``pip install "dask[distribut
 from __future__ import annotations
 
 import uuid
-from typing import Any, Callable, Optional, Sequence
+from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
+import numpy.typing as npt
 
 try:
     import dask
@@ -47,8 +48,6 @@ __all__ = [
     "count_intersections",
 ]
 
-_SIGNS = ("pseudonormal", "winding_number")
-
 
 class SharedScene:
     """A scene shipped to the workers once (see :func:`share`); pass it to the functions of this
@@ -63,6 +62,9 @@ class SharedScene:
         return f"SharedScene({self.ref!r})"
 
 
+_Scene = Union[TriangleMesh, SharedScene]
+
+
 def _active_client() -> Any:
     try:
         from distributed import default_client
@@ -74,7 +76,7 @@ def _active_client() -> Any:
         return None
 
 
-def share(scene: TriangleMesh, client: Any = None) -> SharedScene:
+def share(scene: _Scene, client: Any = None) -> SharedScene:
     """Ships ``scene`` once for any number of later calls: scattered to every worker of
     ``client`` (default: the active distributed Client), or, with none, wrapped as one graph key.
     The scene is copied as it is now; a later ``refit`` of it is not seen by the shared copy."""
@@ -133,12 +135,10 @@ def _dtype(scene: Any) -> np.dtype:
 
 
 def closest_point(
-    scene: Any, points: Any, max_distance: float = np.inf, threads: int = 1
+    scene: _Scene, points: npt.ArrayLike, max_distance: Optional[float] = np.inf, threads: int = 1
 ) -> ClosestPoints:
     """:meth:`TriangleMesh.closest_point` on each partition: ClosestPoints of dask arrays."""
-    t, md = _a.threads(threads), float(max_distance)
-    if not md >= 0:
-        raise ValueError(f"max_distance: must be >= 0 (inf for no limit), not {max_distance}")
+    t, md = _a.threads(threads), _a.limit("max_distance", max_distance)
     dt = _dtype(scene)
     p = _rows("points", points)
 
@@ -150,12 +150,11 @@ def closest_point(
 
 
 def signed_distance(
-    scene: Any, points: Any, sign: str = "pseudonormal", threads: int = 1
+    scene: _Scene, points: npt.ArrayLike, sign: _a.Sign = "pseudonormal", threads: int = 1
 ) -> da.Array:
     """:meth:`TriangleMesh.signed_distance` on each partition."""
     t = _a.threads(threads)
-    if sign not in _SIGNS:
-        raise ValueError(f"sign: {sign!r} is not one of {', '.join(map(repr, _SIGNS))}")
+    _a.option("sign", sign, _a.SIGNS)
     p = _rows("points", points)
 
     def block(s: TriangleMesh, b: np.ndarray) -> tuple:
@@ -165,21 +164,21 @@ def signed_distance(
 
 
 def winding_number(
-    scene: Any, points: Any, exact: bool = False, beta: float = 2.0, threads: int = 1
+    scene: _Scene, points: npt.ArrayLike, exact: bool = False, beta: float = 2.0, threads: int = 1
 ) -> da.Array:
     """:meth:`TriangleMesh.winding_number` on each partition."""
-    t, b_ = _a.threads(threads), float(beta)
-    if not b_ > 0 or not np.isfinite(b_):
+    t, e, b_ = _a.threads(threads), _a.flag("exact", exact), _a.number("beta", beta)
+    if not 0 < b_ < _a.INF:
         raise ValueError(f"beta: must be a positive finite number, not {beta}")
     p = _rows("points", points)
 
     def block(s: TriangleMesh, b: np.ndarray) -> tuple:
-        return (s.winding_number(b, exact=bool(exact), beta=b_, threads=t),)
+        return (s.winding_number(b, exact=e, beta=b_, threads=t),)
 
     return _map(scene, [p], block, [((), _dtype(scene))])[0]
 
 
-def contains(scene: Any, points: Any, threads: int = 1) -> da.Array:
+def contains(scene: _Scene, points: npt.ArrayLike, threads: int = 1) -> da.Array:
     """:meth:`TriangleMesh.contains` on each partition: (n,) bool."""
     return winding_number(scene, points, threads=threads) > 0.5
 
@@ -188,18 +187,16 @@ def _ray_args(scene: Any, origins: Any, directions: Any, tmin: Any, tmax: Any):
     _dtype(scene)
     o = _rows("origins", origins)
     d = _rows("directions", directions, like=o)
-    for name, v in (("tmin", tmin), ("tmax", tmax)):
-        if not np.isscalar(v):
-            raise TypeError(f"{name}: must be a scalar here, not {type(v).__name__}")
-    return o, d, float(tmin), float(tmax)
+    t1 = _a.INF if tmax is None else _a.number("tmax", tmax)  # None: no limit
+    return o, d, _a.number("tmin", tmin), t1
 
 
 def intersect(
-    scene: Any,
-    origins: Any,
-    directions: Any,
+    scene: _Scene,
+    origins: npt.ArrayLike,
+    directions: npt.ArrayLike,
     tmin: float = 0.0,
-    tmax: float = np.inf,
+    tmax: Optional[float] = np.inf,
     threads: int = 1,
 ) -> RayHits:
     """:meth:`TriangleMesh.intersect` on each partition (``tmin``, ``tmax``: scalars): RayHits of
@@ -215,11 +212,11 @@ def intersect(
 
 
 def occluded(
-    scene: Any,
-    origins: Any,
-    directions: Any,
+    scene: _Scene,
+    origins: npt.ArrayLike,
+    directions: npt.ArrayLike,
     tmin: float = 0.0,
-    tmax: float = np.inf,
+    tmax: Optional[float] = np.inf,
     threads: int = 1,
 ) -> da.Array:
     """:meth:`TriangleMesh.occluded` on each partition: (n,) bool."""
@@ -227,11 +224,11 @@ def occluded(
 
 
 def count_intersections(
-    scene: Any,
-    origins: Any,
-    directions: Any,
+    scene: _Scene,
+    origins: npt.ArrayLike,
+    directions: npt.ArrayLike,
     tmin: float = 0.0,
-    tmax: float = np.inf,
+    tmax: Optional[float] = np.inf,
     threads: int = 1,
 ) -> da.Array:
     """:meth:`TriangleMesh.count_intersections` on each partition: (n,) int64."""

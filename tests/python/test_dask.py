@@ -104,7 +104,7 @@ def test_bad_arguments(data):
         bd.signed_distance(scene, points, sign="nope")
     with pytest.raises(ValueError, match="directions: 3 rows"):
         bd.intersect(scene, points, points[:3])
-    with pytest.raises(TypeError, match="tmax: must be a scalar"):
+    with pytest.raises(TypeError, match="tmax: must be a real number"):
         bd.occluded(scene, points, points, tmax=np.ones(len(points)))
     with pytest.raises(TypeError, match="threads"):
         bd.winding_number(scene, points, threads=1.5)
