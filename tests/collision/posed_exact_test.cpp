@@ -186,7 +186,7 @@ TEST(PosedExact, IdentityAndSignedPermutationsAreExactInDouble) {
 
 TEST(PosedExact, DoubleModelsAcceptRotationsReadFromFloatData) {
     // A rotation rounded to float is ~6e-8 from orthonormal: a double model takes it as given and
-    // decides exactly for it; a shear of 1e-3 is still refused.
+    // decides exactly for it; a scale of 1e-3 is still refused.
     const auto c = near_touching<double, float>(scaled(24, 4), 1.0, 10.0, 11);
     const Transform<double> pose = c.pose;
     const auto ma = mesh_of(c.a), mb = mesh_of(c.b);
@@ -195,9 +195,9 @@ TEST(PosedExact, DoubleModelsAcceptRotationsReadFromFloatData) {
     EXPECT_FALSE(want.empty());
     EXPECT_EQ(collide_pairs(a, b, pose, true), want);
     EXPECT_NO_THROW((void)distance(a, b, pose));
-    Transform<double> sheared = pose;
-    sheared.rotation[0][1] += 1e-3;
-    EXPECT_THROW((void)collides(a, b, sheared), Error);
+    Transform<double> scaled_pose = pose;
+    for (auto& row : scaled_pose.rotation.row) row = row * 1.001;  // det R = 1.003
+    EXPECT_THROW((void)collides(a, b, scaled_pose), Error);
 }
 
 }  // namespace

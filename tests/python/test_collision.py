@@ -98,7 +98,7 @@ def test_float64_models_take_rotations_read_from_float32():
     assert list(bvhkit.collide(a, a, r32.astype(np.float64), t)) == [True, False, True, False]
     assert np.all(np.isfinite(bvhkit.distance(a, a, r32, t).distance))
     bad = r32.astype(np.float64)
-    bad[1, 0, 0] *= 1 + 1e-3
+    bad[1] *= 1 + 1e-3  # a scale: det R = 1.003
     with pytest.raises(ValueError, match="rotations"):
         bvhkit.collide(a, a, bad, t)
 
