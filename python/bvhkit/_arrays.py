@@ -210,8 +210,9 @@ def path(name: str, value: Any) -> Any:
 
 
 def rotations(value: Any, dtype: np.dtype) -> np.ndarray:
-    """Rotations: (k, 3, 3) (a single (3, 3) becomes (1, 3, 3)), finite and orthonormal with
-    determinant +1 to 1e-4 (the collision queries assume rigid motion)."""
+    """Rotations: (k, 3, 3) (a single (3, 3) becomes (1, 3, 3)), finite, with max |R^T R - I| and
+    |det R - 1| at most 1e-4 for float32 and float64 alike (the C++ check_rigid_pose's rule: a
+    rotation read from float32 data serves a float64 model; the pose is used as given)."""
     a = _as_array("rotations", value)
     if a.dtype.kind not in "fiu" or a.dtype == np.bool_:
         raise TypeError(f"rotations: dtype must be a real number type, not {a.dtype}")
@@ -227,7 +228,7 @@ def rotations(value: Any, dtype: np.dtype) -> np.ndarray:
         r = a.astype(np.float64)
         err = np.abs(np.einsum("kji,kjl->kil", r, r) - np.eye(3)).max(axis=(1, 2))
         det = np.linalg.det(r)
-        bad = np.flatnonzero((err > 1e-4) | (det < 0))
+        bad = np.flatnonzero(~((err <= 1e-4) & (np.abs(det - 1) <= 1e-4)))
         if len(bad):
             raise ValueError(
                 f"rotations: rotation {int(bad[0])} is not a rotation matrix "

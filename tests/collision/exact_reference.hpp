@@ -49,10 +49,9 @@ int exact_orient3d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, c
     return idot(icross(isub(p[1], p[0]), isub(p[2], p[0])), isub(p[3], p[0])).sign();
 }
 
-/// Whether closed triangles a and b (of any shape, zero area included) meet, exactly.
-template <class T>
-bool exact_triangles_meet(const Triangle<T>& a, const Triangle<T>& b) {
-    const auto q = to_integers<T>({a.p0, a.p1, a.p2, b.p0, b.p1, b.p2});
+/// Whether closed triangles a and b (of any shape, zero area included) meet, exactly, given as
+/// integer corners q[0..2] (a) and q[3..5] (b) at one scale.
+inline bool exact_integer_triangles_meet(const std::vector<IVec>& q) {
     IVec p[9];
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) p[3 * i + j] = isub(q[i], q[3 + j]);
@@ -102,6 +101,12 @@ bool exact_triangles_meet(const Triangle<T>& a, const Triangle<T>& b) {
         for (int j = i + 1; j < 9; ++j)
             if (izero(icross(p[i], p[j])) && idot(p[i], p[j]).sign() <= 0) return true;
     return false;
+}
+
+/// Whether closed triangles a and b (of any shape, zero area included) meet, exactly.
+template <class T>
+bool exact_triangles_meet(const Triangle<T>& a, const Triangle<T>& b) {
+    return exact_integer_triangles_meet(to_integers<T>({a.p0, a.p1, a.p2, b.p0, b.p1, b.p2}));
 }
 
 }  // namespace bvhkit::test

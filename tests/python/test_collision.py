@@ -87,6 +87,22 @@ def test_float32_models_and_identity_pose():
     assert d == pytest.approx(1.0, rel=1e-3)
 
 
+def test_float64_models_take_rotations_read_from_float32():
+    # A rotation rounded to float32 is ~6e-8 from orthonormal: float64 models use it as given (the
+    # same 1e-4 rule as float32 models); a 1e-3 scale is refused naming the argument.
+    rng = np.random.default_rng(38)
+    v, f = bvhkit.load_mesh("sphere:subdiv=2")
+    a = bvhkit.CollisionModel(v, f, dtype=np.float64)
+    r32 = random_rotations(rng, 4).astype(np.float32)
+    t = [[1.5, 0, 0], [0, 2.5, 0], [0, 0, 1.9], [3, 3, 3]]
+    assert list(bvhkit.collide(a, a, r32.astype(np.float64), t)) == [True, False, True, False]
+    assert np.all(np.isfinite(bvhkit.distance(a, a, r32, t).distance))
+    bad = r32.astype(np.float64)
+    bad[1] *= 1 + 1e-3  # a scale: det R = 1.003
+    with pytest.raises(ValueError, match="rotations"):
+        bvhkit.collide(a, a, bad, t)
+
+
 def test_self_intersections():
     # Faces 0 and 1 cross; face 2 shares a vertex with face 0 and touches it there (left out);
     # face 3 is far away.

@@ -96,13 +96,30 @@ Mat3<T> rotation_from_quaternion(T w, T x, T y, T z) {
     return r;
 }
 
-/// How far R may be from a rotation and still count as one: max |(R^T R - I)_ij| and |det R - 1|.
-/// A rotation rounded to float is within ~1e-7 of one, and a few dozen float compositions stay
-/// well under 1e-5; a scale or shear of 1e-4 would already move a point 1 unit away by 1e-4,
-/// which no caller means by "rigid". Double: rounding is ~1e-16, so 1e-9 leaves the same room.
+/// How far R may be from a rotation and still count as one: max |(R^T R - I)_ij| and |det R - 1|,
+/// for float and double poses alike. A rotation rounded to float is within ~1e-7 of one, and a few
+/// dozen float compositions stay well under 1e-5; a double model takes such a rotation (read from
+/// float data, say) as it is. A scale or shear of 1e-4 would already move a point 1 unit away by
+/// 1e-4, which no caller means by "rigid". The pose is used as given: the queries decide for
+/// R x + t with the caller's R (exactly, for collide), and widen their volume tests by what R's
+/// distance from a rotation can move (pose_slack, query/pose_slack.hpp).
 template <class T>
 constexpr double rigid_tolerance() {
-    return sizeof(T) <= 4 ? 1e-4 : 1e-9;
+    return 1e-4;
+}
+
+/// max(max |(R^T R - I)_ij|, |det R - 1|), computed in double (NaN for a non-finite R).
+template <class T>
+double rigid_deviation(const Mat3<T>& rotation) {
+    const Mat3<double> r(rotation);
+    double worst = 0;
+    for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) {
+            const double d = dot(r.column(i), r.column(j)) - (i == j ? 1.0 : 0.0);
+            worst = std::max(worst, std::fabs(d));
+        }
+    const double det = dot(r.row[0], cross(r.row[1], r.row[2]));
+    return std::max(worst, std::fabs(det - 1.0));
 }
 
 /// Throws Error unless `pose` is finite and rigid (R^T R = I and det R = +1 within

@@ -99,10 +99,13 @@ inline Vec<double, 3> nearest_on_triangle(const Vec<double, 3>& p, const Vec<dou
 /// Distance between triangles a and b (zero-area ones are their segment or point), computed in
 /// double on the input coordinates; the points are rounded to T.
 template <class T>
-TriangleDistanceResult<T> triangle_distance(const Triangle<T>& a, const Triangle<T>& b) {
+TriangleDistanceResult<T> triangle_distance(const Triangle<T>& a, const Triangle<T>& b);
+
+/// triangle_distance() for triangles already known not to meet (the least of the feature
+/// distances; 0 only where rounding makes it so).
+template <class T>
+TriangleDistanceResult<T> triangle_distance_apart(const Triangle<T>& a, const Triangle<T>& b) {
     using V = Vec<double, 3>;
-    const TriangleIntersection<T> x = intersect_triangles(a, b);
-    if (x.hit) return {0.0, x.p, x.p};
     const V u[3] = {V(a.p0), V(a.p1), V(a.p2)}, v[3] = {V(b.p0), V(b.p1), V(b.p2)};
     double best2 = std::numeric_limits<double>::infinity();
     V bp{}, bq{};
@@ -120,6 +123,13 @@ TriangleDistanceResult<T> triangle_distance(const Triangle<T>& a, const Triangle
         take(detail::nearest_on_triangle(v[i], u), v[i]);
     }
     return {best2, Vec<T, 3>(bp), Vec<T, 3>(bq)};
+}
+
+template <class T>
+TriangleDistanceResult<T> triangle_distance(const Triangle<T>& a, const Triangle<T>& b) {
+    const TriangleIntersection<T> x = intersect_triangles(a, b);
+    if (x.hit) return {0.0, x.p, x.p};
+    return triangle_distance_apart(a, b);
 }
 
 }  // namespace bvhkit

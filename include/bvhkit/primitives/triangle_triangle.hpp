@@ -44,6 +44,10 @@ T orient3d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, const Vec
 
 namespace detail {
 
+// The decision below is written for any corner type P with orient3d_sign, orient3d_signs,
+// orient2d_in and coordinate comparison (p[k] < q[k]): Vec<T, 3> here, and corners held as exact
+// integers where a pose's rounding must be undone (primitives/posed_triangles.hpp).
+
 /// The two axes kept when axis `drop` is dropped.
 inline void kept_axes(std::size_t drop, std::size_t& x, std::size_t& y) {
     x = drop == 0 ? 1 : 0;
@@ -60,16 +64,16 @@ int orient2d_in(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, std:
 
 /// An axis whose dropping keeps triangle t's area (its normal's component on it is non-zero),
 /// or 3 when t has zero area. Exact.
-template <class T>
-std::size_t projection_axis(const Vec<T, 3>* t) {
+template <class P>
+std::size_t projection_axis(const P* t) {
     for (std::size_t k = 0; k < 3; ++k)
         if (orient2d_in(t[0], t[1], t[2], k) != 0) return k;
     return 3;
 }
 
 /// p within the box of a and b in the plane that drops `drop` (for collinear points: on [a, b]).
-template <class T>
-bool in_box_2d(const Vec<T, 3>& p, const Vec<T, 3>& a, const Vec<T, 3>& b, std::size_t drop) {
+template <class P>
+bool in_box_2d(const P& p, const P& a, const P& b, std::size_t drop) {
     for (std::size_t k = 0; k < 3; ++k)
         if (k != drop && (p[k] < std::min(a[k], b[k]) || p[k] > std::max(a[k], b[k]))) return false;
     return true;
@@ -77,9 +81,8 @@ bool in_box_2d(const Vec<T, 3>& p, const Vec<T, 3>& a, const Vec<T, 3>& b, std::
 
 /// Whether closed segments [a, b] and [c, d] (either may be a point) meet in the plane dropping
 /// axis `drop`.
-template <class T>
-bool segments_meet_2d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c,
-                      const Vec<T, 3>& d, std::size_t drop) {
+template <class P>
+bool segments_meet_2d(const P& a, const P& b, const P& c, const P& d, std::size_t drop) {
     const int o1 = orient2d_in(a, b, c, drop), o2 = orient2d_in(a, b, d, drop);
     const int o3 = orient2d_in(c, d, a, drop), o4 = orient2d_in(c, d, b, drop);
     if (o1 * o2 < 0 && o3 * o4 < 0) return true;
@@ -90,9 +93,8 @@ bool segments_meet_2d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c
 /// Whether closed segments [a, b] and [c, d] (either may be a point) meet in space: they must be
 /// coplanar, and then they meet exactly when they meet in all three coordinate projections (one
 /// of them is one-to-one on a plane holding all four points).
-template <class T>
-bool segments_meet_3d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c,
-                      const Vec<T, 3>& d) {
+template <class P>
+bool segments_meet_3d(const P& a, const P& b, const P& c, const P& d) {
     if (orient3d_sign(a, b, c, d) != 0) return false;
     for (std::size_t k = 0; k < 3; ++k)
         if (!segments_meet_2d(a, b, c, d, k)) return false;
@@ -100,8 +102,8 @@ bool segments_meet_3d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c
 }
 
 /// p in closed triangle t, in the plane dropping `drop`, where t has non-zero area.
-template <class T>
-bool point_in_triangle_2d(const Vec<T, 3>* t, const Vec<T, 3>& p, std::size_t drop) {
+template <class P>
+bool point_in_triangle_2d(const P* t, const P& p, std::size_t drop) {
     const int a = orient2d_in(t[0], t[1], p, drop), b = orient2d_in(t[1], t[2], p, drop),
               c = orient2d_in(t[2], t[0], p, drop);
     return (a >= 0 && b >= 0 && c >= 0) || (a <= 0 && b <= 0 && c <= 0);
@@ -109,9 +111,8 @@ bool point_in_triangle_2d(const Vec<T, 3>* t, const Vec<T, 3>& p, std::size_t dr
 
 /// Whether closed segment [s, e] (maybe a point) meets closed triangle t (maybe of zero area;
 /// `axis` is projection_axis(t)).
-template <class T>
-bool segment_meets_triangle(const Vec<T, 3>& s, const Vec<T, 3>& e, const Vec<T, 3>* t,
-                            std::size_t axis) {
+template <class P>
+bool segment_meets_triangle(const P& s, const P& e, const P* t, std::size_t axis) {
     if (axis == 3) {  // t is its corners' hull: the union of its edges
         for (int i = 0; i < 3; ++i)
             if (segments_meet_3d(s, e, t[i], t[(i + 1) % 3])) return true;
@@ -133,8 +134,8 @@ bool segment_meets_triangle(const Vec<T, 3>& s, const Vec<T, 3>& e, const Vec<T,
 }
 
 /// The general rule: an edge of one triangle meets the other.
-template <class T>
-bool edges_meet(const Vec<T, 3>* u, const Vec<T, 3>* v) {
+template <class P>
+bool edges_meet(const P* u, const P* v) {
     const std::size_t au = projection_axis(u), av = projection_axis(v);
     for (int i = 0; i < 3; ++i)
         if (segment_meets_triangle(u[i], u[(i + 1) % 3], v, av)) return true;
@@ -169,8 +170,8 @@ enum class Meet { None, Crossing, General };
 /// The exact decision. On Crossing, a[0..2] and b[0..2] are the triangles reordered so that
 /// a[0] is alone on the positive side of b's plane and b[0] on the positive side of a's (see
 /// apex()), for the segment construction.
-template <class T>
-Meet decide(const Vec<T, 3>* u, const Vec<T, 3>* v, Vec<T, 3>* a, Vec<T, 3>* b) {
+template <class P>
+Meet decide(const P* u, const P* v, P* a, P* b) {
     int dv[3], du[3];
     orient3d_signs(u[0], u[1], u[2], v, dv);
     if (dv[0] == dv[1] && dv[1] == dv[2]) return dv[0] == 0 ? Meet::General : Meet::None;

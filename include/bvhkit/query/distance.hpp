@@ -11,8 +11,10 @@
 // distance. Both are 0 by default: the exact minimum (up to rounding).
 //
 // A zero-area triangle counts as the segment or point it is (triangle_triangle.hpp's rule).
-// Models that intersect are at distance 0 (the points then lie on an intersection segment). An
-// empty model gives +infinity.
+// B's corners are carried into A's frame in double; triangle pairs that meet for the pose as given
+// (exactly, as collide() decides: primitives/posed_triangles.hpp) are at distance 0 (the points
+// then lie on an intersection segment), the others are measured in double. An empty model gives
+// +infinity.
 #include <algorithm>
 #include <limits>
 #include <vector>
@@ -80,6 +82,7 @@ DistanceResult<typename V::Scalar> distance(
     const auto ta = a.slot_triangles();
     const auto tb = b.slot_triangles();
     const T slack = pose_slack(a.scale(), b.scale(), pose_of_b_in_a);
+    const PosedTriangles<T> posed(pose_of_b_in_a, b.scale());
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
     const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
     // The best squared distance is kept in double (finite for any finite float input: a float
@@ -139,24 +142,30 @@ DistanceResult<typename V::Scalar> distance(
         const auto& na = na_[e.a];
         const auto& nb = nb_[e.b];
         if (na.is_leaf() && nb.is_leaf()) {
-            // B's triangle outside: carried into A's frame once for all of A's.
+            // B's triangle outside: carried into A's frame (in double) once for all of A's.
             for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
-                const Triangle<T> tri_b = transformed(tb[sb], pose_of_b_in_a);
-                const T rb = std::sqrt(std::max(length_squared(tri_b.p1 - tri_b.p0),
-                                                length_squared(tri_b.p2 - tri_b.p0)));
+                using D = Vec<double, 3>;
+                const D vb[3] = {posed.apply(tb[sb].p0), posed.apply(tb[sb].p1),
+                                 posed.apply(tb[sb].p2)};
+                const Triangle<double> tri_b{vb[0], vb[1], vb[2]};
+                const double rb = std::sqrt(
+                    std::max(length_squared(vb[1] - vb[0]), length_squared(vb[2] - vb[0])));
                 for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
+                    const Triangle<double> tri_a{D(ta[sa].p0), D(ta[sa].p1), D(ta[sa].p2)};
                     // Cheap rejection by the triangles' spheres about their first corners.
-                    const T ra = std::sqrt(std::max(length_squared(ta[sa].p1 - ta[sa].p0),
-                                                    length_squared(ta[sa].p2 - ta[sa].p0)));
-                    const T reach = best + ra + rb;
-                    if (length_squared(ta[sa].p0 - tri_b.p0) > reach * reach) continue;
+                    const double ra = std::sqrt(std::max(length_squared(tri_a.p1 - tri_a.p0),
+                                                         length_squared(tri_a.p2 - tri_a.p0)));
+                    const double reach = double(best) + ra + rb;
+                    if (length_squared(tri_a.p0 - tri_b.p0) > reach * reach) continue;
                     // Then by either triangle's plane: the other wholly at least `best` beyond
                     // it (facing triangles of two surfaces, which the spheres keep).
-                    if (detail::beyond_plane(ta[sa], tri_b, best) ||
-                        detail::beyond_plane(tri_b, ta[sa], best))
+                    if (detail::beyond_plane(tri_a, tri_b, double(best)) ||
+                        detail::beyond_plane(tri_b, tri_a, double(best)))
                         continue;
                     result.stats.primitive();
-                    const auto d = triangle_distance(ta[sa], tri_b);
+                    const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
+                    const auto d = x.hit ? TriangleDistanceResult<double>{0.0, D(x.p), D(x.p)}
+                                         : triangle_distance_apart(tri_a, tri_b);
                     if (d.distance_squared < best2) {
                         best2 = d.distance_squared;
                         // Above T's range only for float corners near 3e38: +inf, not UB.
@@ -165,8 +174,8 @@ DistanceResult<typename V::Scalar> distance(
                                    ? T(root)
                                    : std::numeric_limits<T>::infinity();
                         result.distance = best;
-                        result.point_a = d.p;
-                        result.point_b = d.q;
+                        result.point_a = Vec<T, 3>(d.p);
+                        result.point_b = Vec<T, 3>(d.q);
                         result.triangle_a = a.triangle_id(sa);
                         result.triangle_b = b.triangle_id(sb);
                     }

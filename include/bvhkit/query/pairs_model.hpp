@@ -2,10 +2,12 @@
 // collide(A, B, pose_of_b_in_a, ...) reports the intersecting triangle pairs of two
 // CollisionModels (query/collision_model.hpp), or only whether one exists, with the intersection
 // segment in A's frame. B's triangles are carried into A's frame one at a time, at the leaf pairs
-// the traversal reaches; neither mesh is copied per query.
+// the traversal reaches (primitives/posed_triangles.hpp, exactly for the pose as given); neither
+// mesh is copied per query.
 #include <cstdint>
 #include <vector>
 
+#include "bvhkit/primitives/posed_triangles.hpp"
 #include "bvhkit/primitives/triangle_triangle.hpp"
 #include "bvhkit/query/collision_model.hpp"
 #include "bvhkit/query/pairs.hpp"
@@ -45,9 +47,9 @@ struct CollideResult {
 
 /// Whether A and B (B placed in A's frame by pose_of_b_in_a) intersect, and where. The pose must
 /// be finite and rigid (check_rigid_pose, math/transform.hpp: Error otherwise). What is decided:
-/// each of B's corners is carried into A's frame in T (R x + t, each product and sum rounded to
-/// T, transformed() below), and the triangle pairs are then decided exactly on those rounded
-/// coordinates (triangle_triangle.hpp).
+/// whether A's triangles meet B's carried by the pose as given, R x + t in exact arithmetic (no
+/// rounding of B's corners, primitives/posed_triangles.hpp). The segments are computed in double
+/// and rounded to T.
 template <BoundingVolume V>
 bool collide(const CollisionModel<V>& a, const CollisionModel<V>& b,
              const Transform<typename V::Scalar>& pose_of_b_in_a, const CollideOptions& options,
@@ -60,18 +62,18 @@ bool collide(const CollisionModel<V>& a, const CollisionModel<V>& b,
     const auto ta = a.slot_triangles();
     const auto tb = b.slot_triangles();
     const bool first = options.mode == CollideMode::FirstContact;
+    const PosedTriangles<T> posed(pose_of_b_in_a, b.scale());
     for_each_overlapping_pair(
         a.bvh(), b.bvh(), pose_of_b_in_a,
         [&](std::uint32_t sa, std::uint32_t sb) {
-            const Triangle<T> tri_b = transformed(tb[sb], pose_of_b_in_a);
             Contact<T> c{a.triangle_id(sa), b.triangle_id(sb)};
             if (options.segments) {
-                const TriangleIntersection<T> x = intersect_triangles(ta[sa], tri_b);
+                const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb]);
                 if (!x.hit) return true;
                 c.p = x.p;
                 c.q = x.q;
                 c.coplanar = x.coplanar;
-            } else if (!triangles_intersect(ta[sa], tri_b)) {
+            } else if (!posed.intersects(ta[sa], tb[sb])) {
                 return true;
             }
             result.colliding = true;
@@ -90,12 +92,11 @@ bool collides(const CollisionModel<V>& a, const CollisionModel<V>& b,
     check_rigid_pose(pose_of_b_in_a, "collides", "pose_of_b_in_a");
     const auto ta = a.slot_triangles();
     const auto tb = b.slot_triangles();
+    const PosedTriangles<typename V::Scalar> posed(pose_of_b_in_a, b.scale());
     return !for_each_overlapping_pair(
         a.bvh(), b.bvh(), pose_of_b_in_a,
-        [&](std::uint32_t sa, std::uint32_t sb) {
-            return !triangles_intersect(ta[sa], transformed(tb[sb], pose_of_b_in_a));
-        },
-        rule, NoStats{}, pose_slack(a.scale(), b.scale(), pose_of_b_in_a));
+        [&](std::uint32_t sa, std::uint32_t sb) { return !posed.intersects(ta[sa], tb[sb]); }, rule,
+        NoStats{}, pose_slack(a.scale(), b.scale(), pose_of_b_in_a));
 }
 
 }  // namespace bvhkit
