@@ -328,8 +328,7 @@ class TriangleMesh:
         import os
 
         p = os.fspath(path)
-        with open(p, "rb") as f:
-            data = f.read()
+        data = _bvhkit.read_file(p)  # refuses devices and FIFOs, which may never end
         return cls._from_bytes(data, p, _a.threads(threads))
 
     @classmethod
