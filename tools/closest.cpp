@@ -4,10 +4,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 
 #include "args.hpp"
+#include "bvhkit/io/file_access.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/query/closest_point_mesh.hpp"
 #include "commands.hpp"
@@ -26,10 +25,7 @@ output is the same for any number of threads.
 )";
 
 std::vector<Vec3f> read_points(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error("cannot open points file '" + path + "'");
-    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
-                                  std::istreambuf_iterator<char>());
+    const auto bytes = file_detail::read_regular_file<std::vector<char>>(path, "points file");
     if (bytes.size() % 12 != 0)
         throw Error("points file '" + path + "' has " + std::to_string(bytes.size()) +
                     " bytes, not a multiple of 12 (3 float32 per point)");
@@ -69,9 +65,7 @@ int closest_command(int argc, char** argv) {
         std::memcpy(o + 16, &found[i].triangle, 4);
     }
     const std::string out_path = args.value("--out");
-    std::ofstream f(out_path, std::ios::binary);
-    if (!f || !f.write(out.data(), std::streamsize(out.size())))
-        throw Error("cannot write '" + out_path + "'");
+    file_detail::write_file_bytes_of(out_path, out, "output file");
     const auto ms = [](auto a, auto b) {
         return std::chrono::duration<double, std::milli>(b - a).count();
     };

@@ -3,6 +3,7 @@
 // coloured by depth, fat boxes dashed, the proxies' own boxes filled.
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -13,11 +14,31 @@
 #include "args.hpp"
 #include "bvhkit/dynamic/dynamic_tree.hpp"
 #include "bvhkit/error.hpp"
+#include "bvhkit/io/file_access.hpp"
 #include "commands.hpp"
 
 namespace bvhkit::tools {
 
 namespace {
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+void append(std::string& out, const char* format, ...) {
+    std::va_list args;
+    va_start(args, format);
+    std::va_list again;
+    va_copy(again, args);
+    const int n = std::vsnprintf(nullptr, 0, format, args);
+    va_end(args);
+    if (n > 0) {
+        const std::size_t at = out.size();
+        out.resize(at + std::size_t(n) + 1);
+        std::vsnprintf(out.data() + at, std::size_t(n) + 1, format, again);
+        out.resize(at + std::size_t(n));
+    }
+    va_end(again);
+}
 
 void usage(std::FILE* out) {
     std::fprintf(
@@ -110,18 +131,17 @@ int draw_tree_command(int argc, char** argv) {
     const Vec2f e = world.extent();
     const float margin = 10, scale = 800.0f / std::max({e[0], e[1], 1e-6f});
     const float width = e[0] * scale + 2 * margin, height = e[1] * scale + 2 * margin;
-    std::FILE* f = std::fopen(out.c_str(), "w");
-    if (!f) throw Error("cannot write '" + out + "'");
+    std::string svg;  // written whole at the end, so a failed write leaves no partial picture
     const auto rect = [&](const Aabb2f& b, const char* style) {
-        std::fprintf(f, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" %s/>\n",
-                     margin + (b.min[0] - world.min[0]) * scale,
-                     margin + (world.max[1] - b.max[1]) * scale,
-                     std::max(0.5f, (b.max[0] - b.min[0]) * scale),
-                     std::max(0.5f, (b.max[1] - b.min[1]) * scale), style);
+        append(svg, "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" %s/>\n",
+               margin + (b.min[0] - world.min[0]) * scale,
+               margin + (world.max[1] - b.max[1]) * scale,
+               std::max(0.5f, (b.max[0] - b.min[0]) * scale),
+               std::max(0.5f, (b.max[1] - b.min[1]) * scale), style);
     };
-    std::fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\">\n",
-                 width, height);
-    std::fprintf(f, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
+    append(svg, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\">\n",
+           width, height);
+    append(svg, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
     // Internal nodes first (shallow ones under deep ones), then the leaves on top.
     for (int want = 0; want <= max_depth; ++want)
         tree.for_each_node([&](const Aabb2f& b, int depth, bool leaf, ProxyId) {
@@ -140,12 +160,11 @@ int draw_tree_command(int argc, char** argv) {
              "fill=\"#888\" fill-opacity=\"0.45\" stroke=\"#222\" stroke-width=\"0.6\"");
     });
     const auto st = tree.stats();
-    std::fprintf(
-        f,
-        "<text x=\"%.0f\" y=\"%.0f\" font-family=\"sans-serif\" font-size=\"12\">%zu proxies, "
-        "height %d, area ratio %.2f</text>\n</svg>\n",
-        margin, height - 2, st.proxies, st.height, st.area_ratio);
-    std::fclose(f);
+    append(svg,
+           "<text x=\"%.0f\" y=\"%.0f\" font-family=\"sans-serif\" font-size=\"12\">%zu proxies, "
+           "height %d, area ratio %.2f</text>\n</svg>\n",
+           margin, height - 2, st.proxies, st.height, st.area_ratio);
+    file_detail::write_file_bytes_of(out, svg, "output file");
     std::printf("wrote %s: %zu proxies, height %d, SAH cost %.1f, area ratio %.3f\n", out.c_str(),
                 st.proxies, st.height, st.sah_cost, st.area_ratio);
     return 0;

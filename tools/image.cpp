@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "bvhkit/error.hpp"
+#include "bvhkit/io/file_access.hpp"
 
 #if BVHKIT_HAVE_PNG
 #include <png.h>
@@ -68,18 +70,28 @@ Rgb heat_colour(double t) {
     return c;
 }
 
+namespace {
+#if BVHKIT_HAVE_PNG
+void append_png_bytes(png_structp png, png_bytep data, png_size_t size) {
+    auto* out = static_cast<std::vector<unsigned char>*>(png_get_io_ptr(png));
+    out->insert(out->end(), data, data + size);
+}
+void flush_nothing(png_structp) {}
+#endif
+}  // namespace
+
 void write_png(const std::filesystem::path& path, const Image& image) {
 #if BVHKIT_HAVE_PNG
-    std::FILE* f = std::fopen(path.string().c_str(), "wb");
-    if (!f) throw Error(path.string() + ": cannot open for writing");
+    // Encoded in memory and written whole (file_access.hpp), so a failed write leaves no partial
+    // picture and is reported.
+    std::vector<unsigned char> bytes;
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
     png_infop info = png ? png_create_info_struct(png) : nullptr;
     if (!png || !info || setjmp(png_jmpbuf(png))) {
         png_destroy_write_struct(&png, &info);
-        std::fclose(f);
-        throw Error(path.string() + ": writing the PNG failed");
+        throw Error(path.string() + ": encoding the PNG failed");
     }
-    png_init_io(png, f);
+    png_set_write_fn(png, &bytes, append_png_bytes, flush_nothing);
     png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
@@ -88,7 +100,7 @@ void write_png(const std::filesystem::path& path, const Image& image) {
             png, reinterpret_cast<png_const_bytep>(&image.pixels[std::size_t(y) * image.width]));
     png_write_end(png, nullptr);
     png_destroy_write_struct(&png, &info);
-    if (std::fclose(f) != 0) throw Error(path.string() + ": writing the PNG failed");
+    file_detail::write_file(path, bytes, "output file");
 #else
     (void)image;
     throw Error(path.string() + ": bvhkit was built without libpng (apt-get install libpng-dev)");

@@ -1,22 +1,19 @@
 #pragma once
 // Pose files (docs/workloads.md): 12 float32 per pose, a row-major 3x3 rotation R then a
-// translation t; and the little-endian byte writer the result files share.
+// translation t; and the writer the result files share (file_access.hpp: beside and renamed, every
+// step checked).
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
 #include "bvhkit/error.hpp"
+#include "bvhkit/io/file_access.hpp"
 #include "bvhkit/math/transform.hpp"
 
 namespace bvhkit::tools {
 
 inline std::vector<Transform<float>> read_pose_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error("cannot open pose file " + path);
-    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
-                                  std::istreambuf_iterator<char>());
+    const auto bytes = file_detail::read_regular_file<std::vector<char>>(path, "pose file");
     if (bytes.size() % 48 != 0)
         throw Error("pose file " + path + ": " + std::to_string(bytes.size()) +
                     " bytes is not a whole number of 48-byte poses");
@@ -35,9 +32,7 @@ inline std::vector<Transform<float>> read_pose_file(const std::string& path) {
 }
 
 inline void write_bytes(const std::string& path, const std::vector<unsigned char>& bytes) {
-    std::ofstream out(path, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-    if (!out) throw Error("cannot write " + path);
+    file_detail::write_file(path, bytes, "output file");
 }
 
 }  // namespace bvhkit::tools

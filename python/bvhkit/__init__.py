@@ -39,7 +39,11 @@ __all__ = [
     "self_intersections",
     "DynamicTree2D",
     "DynamicTree3D",
+    "MissingFileError",
 ]
+
+#: Raised for a file named as input that does not exist: a FileNotFoundError and a ValueError.
+MissingFileError = _bvhkit.MissingFileError
 
 
 def load_mesh(
@@ -325,8 +329,8 @@ class TriangleMesh:
 
     def save(self, path: _typing.Union[str, "_os.PathLike[str]"]) -> None:
         """Writes :meth:`to_bytes` to the file ``path``."""
-        with open(_a.path("path", path), "wb") as f:
-            f.write(self.to_bytes())
+        # Written beside and renamed: a failed write (a full disk) leaves no partial file.
+        _bvhkit.write_file(_a.path("path", path), self.to_bytes())
 
     @classmethod
     def load(cls, path: _typing.Union[str, "_os.PathLike[str]"], threads: int = 0
@@ -334,8 +338,7 @@ class TriangleMesh:
         """A scene from a file written by :meth:`save` (ValueError naming the file if damaged)."""
         p = _a.path("path", path)
         n = _a.threads(threads)
-        with open(p, "rb") as f:
-            data = f.read()
+        data = _bvhkit.read_file(p)  # refuses devices and FIFOs, which may never end
         return cls._from_bytes(data, p, n)
 
     @classmethod

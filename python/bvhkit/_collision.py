@@ -134,15 +134,14 @@ class CollisionModel:
 
     def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
         """Writes :meth:`to_bytes` to the file ``path``."""
-        with open(_a.path("path", path), "wb") as f:
-            f.write(self.to_bytes())
+        # Written beside and renamed: a failed write (a full disk) leaves no partial file.
+        _bvhkit.write_file(_a.path("path", path), self.to_bytes())
 
     @classmethod
     def load(cls, path: Union[str, "os.PathLike[str]"]) -> "CollisionModel":
         """A model from a file written by :meth:`save` (ValueError naming the file if damaged)."""
         p = _a.path("path", path)
-        with open(p, "rb") as f:
-            data = f.read()
+        data = _bvhkit.read_file(p)  # refuses devices and FIFOs, which may never end
         return cls._from_bytes(data, p)
 
     @classmethod

@@ -1,8 +1,10 @@
-// The extension module bvhkit._bvhkit: bvhkit::Error becomes ValueError, load_mesh, and the scene,
+// The extension module bvhkit._bvhkit: bvhkit::Error becomes ValueError (FileNotFoundError becomes
+// MissingFileError, a FileNotFoundError and a ValueError), load_mesh, read_file, and the scene,
 // collision and dynamic tree classes (scene.cpp, collision.cpp, dynamic.cpp). The public API with
 // argument checks and defaults is the Python package around it (python/bvhkit/).
 #include <string>
 
+#include "bvhkit/io/file_access.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/version.hpp"
 #include "common.hpp"
@@ -12,13 +14,49 @@ using namespace bvhkit::python;
 
 NB_MODULE(_bvhkit, m) {
     m.doc() = "bvhkit's compiled core; use the bvhkit package, which checks arguments.";
-    nb::register_exception_translator([](const std::exception_ptr& p, void*) {
-        try {
-            std::rethrow_exception(p);
-        } catch (const bvhkit::Error& e) {
-            PyErr_SetString(PyExc_ValueError, e.what());
-        }
-    });
+    // A missing file is both FileNotFoundError (what Python users catch for a missing file) and
+    // ValueError (what every other bad input is).
+    nb::object missing_file = nb::steal(PyErr_NewExceptionWithDoc(
+        "bvhkit.MissingFileError", "A file named as input does not exist.",
+        nb::make_tuple(nb::handle(PyExc_FileNotFoundError), nb::handle(PyExc_ValueError)).ptr(),
+        nullptr));
+    m.attr("MissingFileError") = missing_file;
+    nb::register_exception_translator(
+        [](const std::exception_ptr& p, void* missing) {
+            try {
+                std::rethrow_exception(p);
+            } catch (const bvhkit::FileNotFoundError& e) {
+                PyErr_SetString(static_cast<PyObject*>(missing), e.what());
+            } catch (const bvhkit::Error& e) {
+                PyErr_SetString(PyExc_ValueError, e.what());
+            }
+        },
+        missing_file.ptr());
+    m.def(
+        "read_file",
+        [](const std::string& path) {
+            std::string bytes;
+            {
+                nb::gil_scoped_release release;
+                bytes = bvhkit::file_detail::read_regular_file<std::string>(path, "file");
+            }
+            return nb::bytes(bytes.data(), bytes.size());
+        },
+        nb::arg("path"),
+        "The bytes of a regular file; ValueError for a device, FIFO or directory (which may never "
+        "end or never deliver), MissingFileError for a missing file.");
+    m.def(
+        "write_file",
+        [](const std::string& path, nb::bytes data) {
+            const auto* first = static_cast<const unsigned char*>(data.data());
+            const std::span<const unsigned char> bytes(first, data.size());
+            nb::gil_scoped_release release;
+            bvhkit::file_detail::write_file(path, bytes, "file");
+        },
+        nb::arg("path"), nb::arg("data"),
+        "Writes `data` to `path` beside it and renamed into place (in place for a device or FIFO), "
+        "every write, flush and close checked; ValueError naming the path on failure, and no "
+        "partial file left.");
     m.def(
         "load_mesh",
         [](const std::string& file_or_spec) {

@@ -1,28 +1,17 @@
 #include "io_detail.hpp"
 
+#include "bvhkit/io/file_access.hpp"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 
 namespace bvhkit::io_detail {
 
 std::string read_file_bytes(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        throw Error("cannot read mesh file '" + path.string() + "': it is a directory");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error("cannot open mesh file '" + path.string() + "': " + std::strerror(errno));
-    in.seekg(0, std::ios::end);
-    const std::streamoff size = in.tellg();
-    if (size < 0) throw Error("cannot read mesh file '" + path.string() + "': size unknown");
-    in.seekg(0, std::ios::beg);
-    std::string bytes(static_cast<std::size_t>(size), '\0');
-    if (!in.read(bytes.data(), size))
-        throw Error("cannot read mesh file '" + path.string() + "': read failed");
-    return bytes;
+    return file_detail::read_regular_file<std::string>(path, "mesh file");
 }
 
 std::string quote_token(std::string_view token) {

@@ -132,8 +132,9 @@ class ObjParser {
         if (index == 0) fail_at_line(name_, line_, "face index 0 (OBJ indices start at 1)");
         if (index < 0) {
             // Relative: -1 is the last vertex read so far.
+            // Compared as index < -count: negating the index would overflow at INT64_MIN.
             const auto count = static_cast<std::int64_t>(mesh_.vertices.size());
-            if (-index > count)
+            if (index < -count)
                 fail_at_line(name_, line_,
                              "relative face index " + std::to_string(index) +
                                  " reaches before the first vertex (" + std::to_string(count) +

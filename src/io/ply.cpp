@@ -180,7 +180,14 @@ Header parse_header(std::string_view bytes, std::string_view name) {
             h.elements.push_back(parse_element(tokens, h.elements, name, line));
         } else if (keyword == "property") {
             if (h.elements.empty()) fail_at_line(name, line, "property before any element");
-            h.elements.back().properties.push_back(parse_property(tokens, name, line));
+            Property p = parse_property(tokens, name, line);
+            // A repeated name would make "which x?" depend on the reader (last or first wins).
+            for (const Property& other : h.elements.back().properties)
+                if (other.name == p.name)
+                    fail_at_line(name, line,
+                                 "property " + quote_token(p.name) + " of element " +
+                                     quote_token(h.elements.back().name) + " appears twice");
+            h.elements.back().properties.push_back(std::move(p));
         } else {
             fail_at_line(name, line, "unknown header statement " + quote_token(keyword));
         }

@@ -2,9 +2,9 @@
 
 #include <bit>
 #include <cstring>
-#include <fstream>
 
 #include "bvhkit/error.hpp"
+#include "bvhkit/io/file_access.hpp"
 
 namespace bvhkit {
 namespace {
@@ -14,9 +14,8 @@ static_assert(std::endian::native == std::endian::little,
 
 std::vector<char> read_all(const std::filesystem::path& path, std::size_t record,
                            const char* what) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path.string() + ": cannot open " + what + " file");
-    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::vector<char> bytes =
+        file_detail::read_regular_file<std::vector<char>>(path, std::string(what) + " file");
     if (bytes.size() % record != 0)
         throw Error(path.string() + ": " + std::to_string(bytes.size()) +
                     " bytes is not a whole number of " + what + " records (" +
@@ -25,10 +24,7 @@ std::vector<char> read_all(const std::filesystem::path& path, std::size_t record
 }
 
 void write_all(const std::filesystem::path& path, const void* data, std::size_t size) {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw Error(path.string() + ": cannot open for writing");
-    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
-    if (!out) throw Error(path.string() + ": write failed");
+    file_detail::write_file(path, {static_cast<const unsigned char*>(data), size});
 }
 
 }  // namespace

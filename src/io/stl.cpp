@@ -140,7 +140,19 @@ TriangleMesh read_stl(std::string_view bytes, std::string_view name) {
         binary_size = binary_header_size + binary_triangle_size * count;
         if (binary_size == bytes.size()) return read_binary(bytes, count, name);
     }
-    if (starts_with_solid(bytes)) return AsciiStl(bytes, name).parse();
+    if (starts_with_solid(bytes)) {
+        // Binary headers often begin with "solid" too, and some writers pad the file after the
+        // triangles: when the binary layout fits (trailing bytes allowed), a file that is not
+        // valid ASCII STL is read as binary. ASCII STL is text, so its bytes 80..83 read as a
+        // count of at least 0x09090909 triangles: only a file of over 7 GB could be misread.
+        const bool binary_fits = bytes.size() >= binary_header_size && binary_size <= bytes.size();
+        if (!binary_fits) return AsciiStl(bytes, name).parse();
+        try {
+            return AsciiStl(bytes, name).parse();
+        } catch (const Error&) {
+            return read_binary(bytes, count, name);
+        }
+    }
     if (bytes.size() < binary_header_size)
         fail(name, "not an ascii STL (no 'solid') and too short (" + std::to_string(bytes.size()) +
                        " bytes) for a binary STL's 84-byte header");

@@ -19,7 +19,7 @@ TriangleMesh load_mesh(std::string_view file_or_spec) {
     if (is_procedural_kind(file_or_spec)) return make_procedural(file_or_spec);
     const std::string arg(file_or_spec);
     if (is_mesh_file_extension(path.extension().string()))
-        throw Error("mesh file '" + arg + "' does not exist");
+        throw FileNotFoundError("mesh file '" + arg + "' does not exist");
     throw Error("'" + arg +
                 "' is neither an existing mesh file (.obj, .ply, .stl) nor a generator spec "
                 "kind[:key=value,...] with one of these kinds:\n" +

@@ -46,11 +46,12 @@ class ScratchFile {
     std::filesystem::path path_;
 };
 
-inline CliOutcome run_cli(const std::string& args) {
+/// `shell_prefix` goes before the command in the same shell ("ulimit -f 8;", "timeout 20").
+inline CliOutcome run_cli(const std::string& args, const std::string& shell_prefix = "") {
     static int counter = 0;
     const ScratchFile log("cli_log", std::to_string(counter++) + ".txt");
     const std::string command =
-        std::string(BVHKIT_CLI) + " " + args + " > " + log.string() + " 2>&1";
+        shell_prefix + " " + std::string(BVHKIT_CLI) + " " + args + " > " + log.string() + " 2>&1";
     const int raw = std::system(command.c_str());
     std::ifstream in(log.path());
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -5,11 +5,8 @@
 // single count is used: the size the header claims against the bytes there are, and the checksum
 // over header and payload, so a truncated or corrupted file is an Error before any allocation.
 #include <array>
-#include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <span>
 #include <string>
@@ -17,6 +14,7 @@
 
 #include "bvhkit/error.hpp"
 #include "bvhkit/io/byte_codec.hpp"
+#include "bvhkit/io/file_access.hpp"
 
 namespace bvhkit {
 
@@ -165,15 +163,7 @@ inline std::uint64_t section_bytes(std::uint64_t count, std::uint64_t record_byt
 }
 
 inline std::vector<std::uint8_t> read_file_bytes(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary | std::ios::ate);
-    if (!in) throw Error("cannot open " + path.string());
-    const std::streamoff size = in.tellg();
-    if (size < 0) throw Error("cannot read " + path.string());
-    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-    in.seekg(0);
-    if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size))
-        throw Error("cannot read " + path.string());
-    return bytes;
+    return file_detail::read_regular_file<std::vector<std::uint8_t>>(path, "tree file");
 }
 
 /// The structure from_bytes(bytes) makes of the file at `path`; an Error names the file.
@@ -187,32 +177,12 @@ auto load_file(const std::filesystem::path& path, FromBytes&& from_bytes) {
     }
 }
 
-/// Writes a new file next to `path` and renames it over `path`: the old file is never rewritten in
-/// place, so a process that has it mapped (map_triangle_bvh) keeps reading the bytes it checked,
-/// and a failed write leaves the old file whole.
+/// Writes a new file next to `path` and renames it over `path` (file_access.hpp): the old file is
+/// never rewritten in place, so a process that has it mapped (map_triangle_bvh) keeps reading the
+/// bytes it checked, and a failed write leaves the old file whole and no partial file.
 inline void write_file_bytes(const std::filesystem::path& path,
                              std::span<const std::uint8_t> bytes) {
-    static std::atomic<std::uint64_t> counter{0};
-    std::filesystem::path temp = path;
-    temp += ".tmp-" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) +
-            "-" + std::to_string(counter++);
-    std::error_code ec;
-    {
-        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-        if (!out) throw Error("cannot create " + path.string());
-        out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
-        out.close();
-        if (!out) {
-            std::filesystem::remove(temp, ec);
-            throw Error("cannot write " + path.string());
-        }
-    }
-    std::filesystem::rename(temp, path, ec);
-    if (ec) {
-        std::error_code ignored;
-        std::filesystem::remove(temp, ignored);
-        throw Error("cannot write " + path.string() + ": " + ec.message());
-    }
+    file_detail::write_file(path, bytes, "tree file");
 }
 
 }  // namespace serial_detail
