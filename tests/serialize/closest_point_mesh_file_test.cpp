@@ -147,8 +147,10 @@ TEST(ClosestPointMeshFile, LongestEdgeIsChecked) {
     ASSERT_GT(stored, 0.1f);
     ASSERT_LT(stored, 1.0f);
     EXPECT_NO_THROW((void)closest_point_mesh_from_bytes<float>(with(stored * 2)));
-    for (const float bad :
-         {std::numeric_limits<float>::quiet_NaN(), -1.0f, std::numeric_limits<float>::infinity()})
+    // inf is what a build stores for an edge past FLT_MAX: longer only costs time.
+    EXPECT_NO_THROW(
+        (void)closest_point_mesh_from_bytes<float>(with(std::numeric_limits<float>::infinity())));
+    for (const float bad : {std::numeric_limits<float>::quiet_NaN(), -1.0f})
         for (const bool validate : {true, false})
             EXPECT_THROW((void)closest_point_mesh_from_bytes<float>(with(bad), {validate}), Error);
     EXPECT_THROW((void)closest_point_mesh_from_bytes<float>(with(stored / 2)), Error);

@@ -7,8 +7,9 @@
 // loaded mesh answers bit for bit as the saved one.
 //
 // Loading checks what a TriangleBvh load checks (envelope, counts before allocation, structure and
-// indices always, validate() unless opted out), and that the longest edge is finite and not below
-// the longest edge of the triangles in the tree.
+// indices always, validate() unless opted out), and that the longest edge is not negative or NaN
+// (inf is what a build stores for an edge past T's largest finite value) and not below the
+// longest edge of the triangles in the tree.
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -92,21 +93,19 @@ struct ClosestPointMeshAccess {
 
         check_tree_structure(bvh, triangle_count, what);
         check_skipped(skipped, triangle_count, what);
-        if (!(std::isfinite(mesh.longest_edge_) && mesh.longest_edge_ >= T(0)))
-            fail("the longest edge is negative or not finite");
+        // +inf is what a build stores for an edge longer than T's largest finite value.
+        if (!(mesh.longest_edge_ >= T(0))) fail("the longest edge is negative or NaN");
         if (options.validate) {
             validate_loaded(
                 bvh_view(bvh), std::size_t(triangle_count), skipped,
                 [&](std::uint32_t s, const auto&) { return mesh.tris_[s].bounds(); }, what);
-            // As build() computes it, over the tree's triangles only: the file's may be longer.
-            double longest2 = 0;
-            for (const Triangle<T>& t : mesh.tris_) {
-                const Vec<double, 3> a(t.p0), b(t.p1), c(t.p2);
-                const double e2 =
-                    std::max({length_squared(b - a), length_squared(c - b), length_squared(a - c)});
-                if (std::isfinite(e2)) longest2 = std::max(longest2, e2);
-            }
-            if (!(mesh.longest_edge_ >= T(std::sqrt(longest2) * (1 + 1e-6))))
+            // As build() measures edges (longest_edge_of, which cannot overflow), over the
+            // tree's triangles only: the file's may be longer. The build rounds up by a relative
+            // 1e-6, so the stored value is at least the edge itself, whatever the rounding.
+            double longest = 0;
+            for (const Triangle<T>& t : mesh.tris_)
+                longest = std::max(longest, ClosestPointMesh<T>::longest_edge_of(t));
+            if (!(double(mesh.longest_edge_) >= longest))
                 fail("the longest edge is shorter than an edge in the tree");
         }
         mesh.tris_.push_back(Triangle<T>{});  // the padding the SSE box test reads past

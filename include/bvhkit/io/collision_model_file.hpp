@@ -8,14 +8,15 @@
 //
 // Loading trusts nothing: the envelope (size, checksum), every count against the bytes there are
 // before anything is allocated, the tree's shape and every index (check_tree_structure), the
-// skipped list, the scale's sign and the triangles' coordinates (finite, |x| <= 2^300, what the
-// exact triangle tests need), always; then, unless LoadOptions::validate is false, what the
-// builder guarantees: each triangle once (in the tree or skipped), volumes
-// that are well formed (finite, sizes >= 0, orthonormal axes) and contain every vertex of the
-// triangles under their node (to a tolerance of a few units in the last place of the model's
-// scale: the fits pad for their own rounding, so a fitted volume passes on any machine), and the
-// scale the triangles give. A volume that a corruption shrank fails; one it grew only costs time.
-// Any failure is a bvhkit::Error.
+// skipped list, the scale's sign and the triangles' coordinates (finite, what the exact triangle
+// tests need), always; then, unless LoadOptions::validate is false, what the builder guarantees:
+// each triangle once (in the tree or skipped), volumes that are well formed (no NaN, finite
+// centres, sizes >= 0, orthonormal axes) and contain every vertex of the triangles under their
+// node (to a tolerance of a few units in the last place of the model's scale: the fits pad for
+// their own rounding, so a fitted volume passes on any machine), and the scale the triangles give.
+// A volume that a corruption shrank fails; one it grew only costs time. Whatever a build makes
+// loads, at any finite scale: a size past T's largest finite value is stored as inf by the build
+// and accepted here. Any failure is a bvhkit::Error.
 //
 // Thread safety: saving reads the model only; loading touches only its input and the model it
 // returns.
@@ -33,6 +34,7 @@
 #include "bvhkit/io/tree_file.hpp"
 #include "bvhkit/io/tree_sections.hpp"
 #include "bvhkit/io/tree_structure.hpp"
+#include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/query/collision_model.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/convex_hull.hpp"
@@ -60,6 +62,19 @@ bool finite_all(std::initializer_list<T> values) {
 template <class T>
 bool finite_vec(const Vec<T, 3>& v) {
     return finite_all({v[0], v[1], v[2]});
+}
+// What a build produces at the edges of T's range: a size (radius, extent, reach) or a slab's
+// bound whose true value lies beyond T's largest finite value is stored as infinite, which still
+// bounds everything (a float model at 3e38 has a box diagonal, and k-DOP projections, past
+// FLT_MAX). Accepted as the builder makes it; NaN, negative sizes and inverted slabs are not.
+template <class T>
+bool size_ok(T size) {
+    return size >= T(0);  // false for NaN
+}
+template <class T>
+bool bound_ok(T lo, T hi) {
+    return lo <= hi && lo < std::numeric_limits<T>::infinity() &&
+           hi > -std::numeric_limits<T>::infinity();  // false for NaN
 }
 /// Rows of unit length, orthogonal to each other, within a few hundred units in the last place.
 template <class T>
@@ -120,11 +135,9 @@ struct VolumeCodec<Sphere<T>> {
         v.radius = r.scalar<T>();
         return v;
     }
-    static bool well_formed(const V& v) {
-        return finite_vec(v.center) && std::isfinite(v.radius) && v.radius >= T(0);
-    }
+    static bool well_formed(const V& v) { return finite_vec(v.center) && size_ok(v.radius); }
     static bool contains(const V& v, const Vec3d& p, double tol) {
-        return length(p - Vec3d(v.center)) <= double(v.radius) + tol;
+        return wide_length(p - Vec3d(v.center)) <= double(v.radius) + tol;
     }
 };
 
@@ -144,8 +157,8 @@ struct VolumeCodec<Obb<T>> {
         return v;
     }
     static bool well_formed(const V& v) {
-        return finite_vec(v.center) && finite_vec(v.extents) && orthonormal(v.axes) &&
-               v.extents[0] >= T(0) && v.extents[1] >= T(0) && v.extents[2] >= T(0);
+        return finite_vec(v.center) && orthonormal(v.axes) && size_ok(v.extents[0]) &&
+               size_ok(v.extents[1]) && size_ok(v.extents[2]);
     }
     static bool contains(const V& v, const Vec3d& p, double tol) {
         const Vec3d q = Mat3<double>(v.axes) * (p - Vec3d(v.center));
@@ -174,16 +187,14 @@ struct VolumeCodec<Rss<T>> {
         return v;
     }
     static bool well_formed(const V& v) {
-        return finite_vec(v.center) && orthonormal(v.axes) &&
-               finite_all({v.half[0], v.half[1], v.radius}) && v.half[0] >= T(0) &&
-               v.half[1] >= T(0) && v.radius >= T(0);
+        return finite_vec(v.center) && orthonormal(v.axes) && size_ok(v.half[0]) &&
+               size_ok(v.half[1]) && size_ok(v.radius);
     }
     static bool contains(const V& v, const Vec3d& p, double tol) {
         const Vec3d q = Mat3<double>(v.axes) * (p - Vec3d(v.center));
         const double dx = std::max(std::fabs(q[0]) - double(v.half[0]), 0.0);
         const double dy = std::max(std::fabs(q[1]) - double(v.half[1]), 0.0);
-        const double r = double(v.radius) + tol;
-        return dx * dx + dy * dy + q[2] * q[2] <= r * r;
+        return wide_length(Vec3d(dx, dy, q[2])) <= double(v.radius) + tol;
     }
 };
 
@@ -227,7 +238,7 @@ requires(K == 14 || K == 18 || K == 26) struct VolumeCodec<Kdop<T, K>> {
     }
     static bool well_formed(const V& v) {
         for (std::size_t d = 0; d < V::slabs; ++d)
-            if (!(finite_all({v.lo[d], v.hi[d]}) && v.lo[d] <= v.hi[d])) return false;
+            if (!(bound_ok(v.lo[d], v.hi[d]))) return false;
         return true;
     }
     // The directions' lengths are at most sqrt(3): the tolerance along each is scaled by 2.
@@ -269,21 +280,28 @@ struct VolumeCodec<ConvexHull<T, 16>> {
     /// bounding-sphere test relies on it), to the rounding of this check.
     static bool well_formed(const V& v) {
         if (v.count < 1 || v.count > 16) return false;
-        if (!finite_vec(v.center) || !finite_all({v.margin, v.reach}) || !(v.margin >= T(0)))
-            return false;
+        if (!finite_vec(v.center) || !size_ok(v.margin) || !size_ok(v.reach)) return false;
         const double slack = 1 - 4 * double(std::numeric_limits<T>::epsilon());
         for (std::uint32_t i = 0; i < 16; ++i) {
             if (!finite_vec(v.points[i])) return false;
-            if (i < v.count && !(length(Vec3d(v.points[i]) - Vec3d(v.center)) + double(v.margin) <=
-                                 double(v.reach) / slack))
+            if (i < v.count &&
+                !(wide_length(Vec3d(v.points[i]) - Vec3d(v.center)) + double(v.margin) <=
+                  double(v.reach) / slack))
                 return false;
         }
         return true;
     }
+    /// Around the centre and scaled by a power of two to about 1: the distance's squares would
+    /// overflow double for a model at 1e155 (and sink at 1e-155).
     static bool contains(const V& v, const Vec3d& p, double tol) {
+        const Vec3d c(v.center);
+        double m = max_component(abs(p - c));
+        for (const auto& q : v.vertices()) m = std::max(m, max_component(abs(Vec3d(q) - c)));
+        const double unit = m > 0 && std::isfinite(m) ? std::ldexp(1.0, -std::ilogb(m)) : 1.0;
         std::vector<Vec3d> points;
-        for (const auto& q : v.vertices()) points.push_back(Vec3d(q));
-        return hull_detail::distance_to_hull<double>(p, points) <= double(v.margin) + tol;
+        for (const auto& q : v.vertices()) points.push_back((Vec3d(q) - c) * unit);
+        return hull_detail::distance_to_hull<double>((p - c) * unit, points) <=
+               (double(v.margin) + tol) * unit;
     }
 };
 
@@ -406,20 +424,29 @@ struct CollisionModelAccess {
 
         check_tree_structure(bvh, triangle_count, what);
         check_skipped(skipped, triangle_count, what);
-        if (!(std::isfinite(model.scale_) && model.scale_ >= T(0)))
-            fail("the scale is negative or not finite");
-        // The exact triangle tests of collide() need finite coordinates whose products cannot
-        // overflow (a NaN there breaks the expansions' bounds): checked always, like an index.
-        constexpr double coordinate_limit = 0x1p300;
+        // +inf is what scale_of() gives a model whose extent passes T's largest finite value.
+        if (!(model.scale_ >= T(0))) fail("the scale is negative or NaN");
+        // The exact triangle tests of collide() need finite coordinates (a NaN or an infinity
+        // breaks the expansions' bounds): checked always, like an index. Any finite coordinate
+        // is what a build keeps, and the predicates answer 0 where their products overflow
+        // (math/predicates.hpp), so no tighter limit.
         for (std::size_t s = 0; s < model.slot_triangles_.size(); ++s)
             for (const Vec<T, 3>& p : {model.slot_triangles_[s].p0, model.slot_triangles_[s].p1,
                                        model.slot_triangles_[s].p2})
-                for (std::size_t a = 0; a < 3; ++a)
-                    if (!(std::fabs(double(p[a])) <= coordinate_limit))
-                        fail("the triangle in slot " + std::to_string(s) +
-                             " is not finite or beyond 2^300");
+                if (!finite_vec(p))
+                    fail("the triangle in slot " + std::to_string(s) + " is not finite");
         if (options.validate) validate_model(model, fail);
         return model;
+    }
+
+    /// scale() computed in double: largest |coordinate| plus the box's diagonal.
+    template <class T>
+    static double wide_scale(std::span<const Triangle<T>> tris) {
+        Aabb<T, 3> box;
+        for (const Triangle<T>& t : tris) box.grow(t.p0).grow(t.p1).grow(t.p2);
+        if (box.is_empty()) return 0;
+        return double(max_component(bvhkit::max(box.max, -box.min))) +
+               wide_length(Vec3d(box.max) - Vec3d(box.min));
     }
 
     /// What the builder guarantees of a model (the structure was checked already).
@@ -440,7 +467,10 @@ struct CollisionModelAccess {
             fail("the scale is not the one the triangles give");
         // Each node's volume around every vertex under it: the run of slots below a node, from
         // the leaves up (children after parents, as check_tree_structure made sure).
-        const double tol = double(std::numeric_limits<T>::epsilon()) * 16 * double(scale);
+        // The scale in double (finite for every float model) and an absolute floor for the
+        // rounding of coordinates in denormals, where the fits' relative pads vanish.
+        const double tol = double(std::numeric_limits<T>::epsilon()) * 16 * wide_scale<T>(tris) +
+                           64 * double(std::numeric_limits<T>::denorm_min());
         const auto runs = node_slot_runs(bvh);
         std::vector<std::uint32_t> below(bvh.nodes.size(), 0);  // slots under each node
         for (std::size_t n = bvh.nodes.size(); n-- > 0;) {

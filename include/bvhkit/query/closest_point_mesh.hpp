@@ -26,6 +26,7 @@
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/math/select.hpp"
+#include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/primitives/triangle_pack.hpp"
@@ -274,16 +275,19 @@ class ClosestPointMesh {
 
         // The longest edge, rounded up, for widened(); triangles with a NaN or infinite
         // coordinate are left out of the tree and of this.
-        double longest2 = 0;
-        for (const Triangle<T>& t : tris) {
-            const Triangle<double> d{Vec<double, 3>(t.p0), Vec<double, 3>(t.p1),
-                                     Vec<double, 3>(t.p2)};
-            const double e2 = std::max({length_squared(d.p1 - d.p0), length_squared(d.p2 - d.p1),
-                                        length_squared(d.p0 - d.p2)});
-            if (std::isfinite(e2)) longest2 = std::max(longest2, e2);
-        }
-        longest_edge_ = T(std::sqrt(longest2) * (1 + 1e-6));
+        double longest = 0;
+        for (const Triangle<T>& t : tris) longest = std::max(longest, longest_edge_of(t));
+        longest_edge_ = narrow_or_inf<T>(longest * (1 + 1e-6));
         derive_walk_data();
+    }
+    /// The longest edge of a triangle with finite corners (0 for one with a NaN or an infinity),
+    /// in double without squaring (wide_length): the squares of a double mesh's edges overflow
+    /// at 1e155 and sink at 1e-155. Inf only for an edge longer than double holds; a float mesh's
+    /// longest edge past FLT_MAX makes longest_edge_ inf (widened() then prunes nothing).
+    static double longest_edge_of(const Triangle<T>& t) {
+        if (!t.bounds().is_finite()) return 0;
+        const Vec<double, 3> a(t.p0), b(t.p1), c(t.p2);
+        return std::max({wide_length(b - a), wide_length(c - b), wide_length(a - c)});
     }
     // The wide tree and the packs, from bvh_ and tris_ alone (a loaded file rebuilds them so).
     void derive_walk_data() {

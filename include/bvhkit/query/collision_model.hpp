@@ -5,7 +5,9 @@
 // kept in leaf-slot order, so a leaf's triangles are contiguous. The queries on two models are in
 // query/pairs_model.hpp (collide, collides) and query/distance.hpp.
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -13,6 +15,7 @@
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/fit_volumes.hpp"
 #include "bvhkit/error.hpp"
+#include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 
 namespace bvhkit {
@@ -86,12 +89,20 @@ class CollisionModel {
     /// Largest |coordinate| of the model plus its box diagonal: the scale of its rounding errors.
     T scale() const { return scale_; }
     /// scale() of a model with these slot triangles.
+    /// The diagonal's length is taken without squaring through T's range (a float model at 1e19
+    /// would get an infinite scale, at 1e-25 lose the diagonal); the sum is inf only beyond T's
+    /// largest finite value. Where the squares stay normal it is the sum in T, as it always was.
     static T scale_of(std::span<const Triangle<T>> triangles) {
         Aabb<T, 3> box;
         for (const Triangle<T>& t : triangles) box.grow(t.p0).grow(t.p1).grow(t.p2);
-        return box.is_empty()
-                   ? T(0)
-                   : max_component(bvhkit::max(box.max, -box.min)) + length(box.max - box.min);
+        if (box.is_empty()) return T(0);
+        const T largest = max_component(bvhkit::max(box.max, -box.min));
+        const Vec<T, 3> diagonal = box.max - box.min;
+        const T d2 = length_squared(diagonal);
+        if (std::isfinite(d2) && (d2 >= std::numeric_limits<T>::min() || box.max == box.min))
+            return largest + std::sqrt(d2);
+        return narrow_or_inf<T>(double(largest) +
+                                wide_length(Vec<double, 3>(box.max) - Vec<double, 3>(box.min)));
     }
 
   private:

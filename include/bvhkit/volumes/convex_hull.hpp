@@ -28,6 +28,7 @@
 #include <span>
 #include <vector>
 
+#include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/volumes/bounding_volume.hpp"
 #include "bvhkit/volumes/gjk.hpp"
 #include "bvhkit/volumes/quickhull.hpp"
@@ -126,9 +127,7 @@ double distance_to_hull(const Vec<T, 3>& p, std::span<const Vec<T, 3>> s) {
 /// Rounds a non-negative double up to T.
 template <class T>
 T round_up(double x) {
-    T y = T(x);
-    if (double(y) < x) y = std::nextafter(y, std::numeric_limits<T>::infinity());
-    return y;
+    return round_up_to<T>(x);
 }
 
 /// `cap` of the hull vertices `hull`: the extremes along the axes, then greedily the vertex
@@ -215,13 +214,14 @@ ConvexHull<T, Cap> hull_of(std::span<const Vec<T, 3>> points, double margin,
         box.grow(points[i]);
     }
     v.margin = margin > 0 ? round_up<T>(margin) : T(0);
-    v.center = box.centroid();
+    for (std::size_t a = 0; a < 3; ++a) v.center[a] = midpoint_of(box.min[a], box.max[a]);
     // The box's half diagonal, which never shrinks when volumes merge (so size() grows from child
     // to parent), or, when the centre's rounding (far from the origin) leaves a vertex farther,
     // that vertex's distance: the sphere holds every kept vertex.
-    double half = length(Vec<double, 3>(box.max) - Vec<double, 3>(box.min)) * 0.5;
+    // Lengths without squaring (wide_length): squares overflow double for a model at 1e155.
+    double half = wide_length(Vec<double, 3>(box.max) - Vec<double, 3>(box.min)) * 0.5;
     for (std::uint32_t i = 0; i < v.count; ++i)
-        half = std::max(half, length(Vec<double, 3>(v.points[i]) - Vec<double, 3>(v.center)));
+        half = std::max(half, wide_length(Vec<double, 3>(v.points[i]) - Vec<double, 3>(v.center)));
     v.reach = round_up<T>((half + double(v.margin)) * (1 + 1e-12)) * (T(1) + detail::fit_pad<T>);
     return v;
 }

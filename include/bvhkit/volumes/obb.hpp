@@ -61,18 +61,21 @@ inline Mat3<double> symmetric_eigenvectors(Mat3<double> a) {
 /// The box with the given axes around some points (in double, then padded and rounded out).
 template <class T, class ForEachPoint>
 Obb<T> obb_around(const Mat3<double>& axes, ForEachPoint&& for_each_point) {
+    // Projections of the halved points: a double model's projections onto a skew axis may pass
+    // DBL_MAX (their sum of three products) where the halves' cannot. Halving is exact outside
+    // denormals, so this is the box of the points themselves, bit for bit.
     Vec3d lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
     for_each_point([&](const Vec3d& p) {
-        const Vec3d q = axes * p;
+        const Vec3d q = axes * (p * 0.5);
         lo = min(lo, q);
         hi = max(hi, q);
     });
     Obb<T> o;
     if (!(lo[0] <= hi[0])) return o;
     const Vec3d mid = (lo + hi) * 0.5;
-    const Vec3d c = axes.transpose_times(mid);
-    const double scale = max_component(max(hi, -lo)) + max_component(max(c, -c));
-    const Vec3d e = (hi - lo) * 0.5 + Vec3d(scale * double(fit_pad<T>));
+    const Vec3d c = axes.transpose_times(mid) * 2.0;
+    const double scale = max_component(max(hi, -lo)) * 2.0 + max_component(max(c, -c));
+    const Vec3d e = (hi - lo) + Vec3d(scale * double(fit_pad<T>));
     o.center = Vec<T, 3>(c);
     o.axes = Mat3<T>(axes);
     o.extents = Vec<T, 3>(e);
@@ -127,13 +130,26 @@ struct VolumeTraits<Obb<T>> {
 
     static V fit(std::span<const Triangle<T>> tris) {
         if (tris.empty()) return {};
-        // Centre on the first vertex so the sums do not lose the small spread to a large offset.
-        const Vec3d o(tris[0].p0);
+        // Centre on the first vertex so the sums do not lose the small spread to a large offset,
+        // and scale by a power of two that brings the spread to about 1: the sums hold fourth
+        // powers of it, which overflow double for a model at 1e77 and sink at 1e-77. The scaling
+        // is exact and leaves the eigenvectors as they are (bit for bit, where nothing over- or
+        // underflowed without it).
+        // Differences of halves, which cannot overflow (a double model may span more than
+        // DBL_MAX), are the differences halved exactly outside denormals.
+        const Vec3d half_o = Vec3d(tris[0].p0) * 0.5;
+        const auto half_diff = [&](const Vec<T, 3>& p) { return Vec3d(p) * 0.5 - half_o; };
+        double spread = 0;
+        for (const auto& t : tris)
+            for (const Vec<T, 3>& p : {t.p0, t.p1, t.p2})
+                spread = std::max(spread, max_component(bvhkit::abs(half_diff(p))));
+        const double unit = spread > 0 ? std::ldexp(1.0, -std::ilogb(spread)) : 2.0;
+        const auto local = [&](const Vec<T, 3>& p) { return half_diff(p) * unit; };
         double area = 0;
         Vec3d mean{};
         double m[3][3] = {};
         for (const auto& t : tris) {
-            const Vec3d p = Vec3d(t.p0) - o, q = Vec3d(t.p1) - o, r = Vec3d(t.p2) - o;
+            const Vec3d p = local(t.p0), q = local(t.p1), r = local(t.p2);
             const double a = 0.5 * length(cross(q - p, r - p));
             const Vec3d c = (p + q + r) * (1.0 / 3.0);
             area += a;
@@ -153,7 +169,7 @@ struct VolumeTraits<Obb<T>> {
             Vec3d s{};
             double s2[3][3] = {};
             for (const auto& t : tris)
-                for (const Vec3d& p : {Vec3d(t.p0) - o, Vec3d(t.p1) - o, Vec3d(t.p2) - o}) {
+                for (const Vec3d& p : {local(t.p0), local(t.p1), local(t.p2)}) {
                     n += 1;
                     s += p;
                     for (int i = 0; i < 3; ++i)

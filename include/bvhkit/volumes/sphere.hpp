@@ -2,6 +2,7 @@
 // Sphere<T>: centre and radius. Fitted around the centre of the triangles' box (not the minimal
 // sphere, but cheap and within a factor sqrt(3) of it). Under a pose the test is exact (the centre
 // moves, the radius does not); the distance lower bound is |ca - cb| - ra - rb.
+#include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/volumes/bounding_volume.hpp"
 
 namespace bvhkit {
@@ -19,17 +20,22 @@ struct VolumeTraits<Sphere<T>> {
     using Prepared = PreparedPose<T>;
     static constexpr bool merge_is_tight = false;
 
+    /// The radius in double without squaring (wide_length), rounded up: squares in T overflow
+    /// for a float model at 1e19 (an infinite radius) and sink at 1e-20 (a radius too small to
+    /// hold the triangles); the centre is a midpoint that cannot overflow.
     static V fit(std::span<const Triangle<T>> tris) {
         if (tris.empty()) return {};
         Aabb<T, 3> box;
         for (const auto& t : tris) box.grow(t.p0).grow(t.p1).grow(t.p2);
-        const Vec<T, 3> c = box.centroid();
-        T r2 = 0;
+        Vec<T, 3> c;
+        for (std::size_t a = 0; a < 3; ++a) c[a] = midpoint_of(box.min[a], box.max[a]);
+        const Vec3d cd(c);
+        double r = 0;
         for (const auto& t : tris)
-            r2 = std::max(
-                {r2, length_squared(t.p0 - c), length_squared(t.p1 - c), length_squared(t.p2 - c)});
-        const T r = std::sqrt(r2);
-        return {c, r + (r + max_component(bvhkit::max(c, -c))) * detail::fit_pad<T>};
+            for (const Vec<T, 3>& p : {t.p0, t.p1, t.p2})
+                r = std::max(r, wide_length(Vec3d(p) - cd));
+        const double pad = (r + max_component(bvhkit::max(cd, -cd))) * double(detail::fit_pad<T>);
+        return {c, round_up_to<T>(r + pad)};
     }
     static V merge(const V& a, const V& b) {
         if (a.radius < 0) return b;
