@@ -52,8 +52,9 @@ RunResult run_bvhkit(const Motion& m, InsertionStrategy strategy) {
     tree.find_pairs(pairs);
     r.build_ms = ms_since(t0);
     const auto summarize = [&] {
-        PairSummary s;  // ids are the indices: a fresh tree hands out 0, 1, 2, ...
-        for (const ProxyPair& p : pairs) s.add(std::uint32_t(p.a), std::uint32_t(p.b));
+        PairSummary s;  // slots are the indices: a fresh tree hands out 0, 1, 2, ...
+        for (const ProxyPair& p : pairs)
+            s.add(std::uint32_t(p.a.index()), std::uint32_t(p.b.index()));
         r.per_step.push_back(s);
     };
     summarize();
@@ -63,7 +64,7 @@ RunResult run_bvhkit(const Motion& m, InsertionStrategy strategy) {
         for (const auto& mv : moves) {
             V d;
             for (std::size_t a = 0; a < N; ++a) d[a] = mv.v[a];
-            r.touched += tree.move(mv.id, box_at(mv.p), d);
+            r.touched += tree.move(ProxyId(mv.id, 0), box_at(mv.p), d);  // never destroyed
         }
         moving += ms_since(t0);
         tree.find_pairs(pairs);

@@ -55,9 +55,9 @@ RunResult run_bvhkit_events(const Motion& m) {
     std::unordered_set<std::uint64_t> current;
     const auto apply = [&] {
         for (const ProxyPair& p : ends)
-            current.erase(pair_key(std::uint32_t(p.a), std::uint32_t(p.b)));
+            current.erase(pair_key(std::uint32_t(p.a.index()), std::uint32_t(p.b.index())));
         for (const ProxyPair& p : begins)
-            current.insert(pair_key(std::uint32_t(p.a), std::uint32_t(p.b)));
+            current.insert(pair_key(std::uint32_t(p.a.index()), std::uint32_t(p.b.index())));
         r.per_step.push_back(summarize(current));
         r.reported += (long long)begins.size();
         begins.clear(), ends.clear();
@@ -71,7 +71,7 @@ RunResult run_bvhkit_events(const Motion& m) {
     for (const auto& moves : m.steps) {
         t0 = Clock::now();
         for (const auto& mv : moves)
-            r.touched += tree.move(mv.id, box_at(mv.p), Vec2f(mv.v[0], mv.v[1]));
+            r.touched += tree.move(ProxyId(mv.id, 0), box_at(mv.p), Vec2f(mv.v[0], mv.v[1]));
         moving += ms_since(t0);
         tree.update_pairs(on_begin, on_end);
         total += ms_since(t0);

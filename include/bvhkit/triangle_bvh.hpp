@@ -22,6 +22,14 @@
 // reports each triangle once). refit() keeps such a tree correct, with each leaf's box grown to
 // its triangles' whole boxes; a tree with spatial splits cannot be saved
 // (io/triangle_bvh_file.hpp).
+//
+// Threads: the const queries may run on many threads at once. refit() needs the tree to itself: it
+// rewrites (and may reallocate) what the queries read. Debug builds (!NDEBUG) catch the misuse, as
+// the dynamic tree's walk counter does: refit() throws bvhkit::Error while a query runs, and a
+// query that starts during a refit() throws. Release builds check nothing (an atomic count per
+// query would cost the many-thread case its scaling): a query overlapping refit() is undefined
+// behaviour (wrong hits, or a crash on freed memory).
+#include <atomic>
 #include <span>
 #include <unordered_set>
 
@@ -41,6 +49,76 @@ namespace bvhkit {
 namespace serial_detail {
 struct TriangleBvhAccess;  // io/triangle_bvh_file.hpp: saves and loads the private arrays
 }
+
+namespace detail {
+
+/// Debug builds: who uses a tree now, queries (counted) or refit() (a flag), so that refit() and
+/// the queries can refuse to overlap instead of corrupting memory. Release builds never touch it;
+/// the member is there in both, so that code built with and without NDEBUG agrees on the layout.
+/// A copied or moved tree starts unused.
+class QueryExclusion {
+  public:
+    QueryExclusion() = default;
+    QueryExclusion(const QueryExclusion&) noexcept {}
+    QueryExclusion& operator=(const QueryExclusion&) noexcept { return *this; }
+
+    /// Held by a query for its duration (nested queries count again).
+    class Reading {
+      public:
+#if !defined(NDEBUG)
+        explicit Reading(const QueryExclusion& e) : e_(e) {
+            if (e_.state_.fetch_add(1, std::memory_order_acquire) & kRefitting) {
+                e_.state_.fetch_sub(1, std::memory_order_relaxed);
+                throw Error(
+                    "TriangleBvh: a query started while refit() runs on the same tree (refit "
+                    "needs the tree to itself; in a release build this is undefined behaviour)");
+            }
+        }
+        ~Reading() {
+            e_.state_.fetch_sub(1, std::memory_order_release);
+        }
+        Reading(const Reading&) = delete;
+        Reading& operator=(const Reading&) = delete;
+
+      private:
+        const QueryExclusion& e_;
+#else
+        explicit Reading(const QueryExclusion&) {}
+#endif
+    };
+
+    /// Held by refit() for its duration.
+    class Writing {
+      public:
+#if !defined(NDEBUG)
+        Writing(QueryExclusion& e, const char* where) : e_(e) {
+            std::uint32_t idle = 0;
+            if (!e_.state_.compare_exchange_strong(idle, kRefitting, std::memory_order_acquire))
+                throw Error(std::string(where) + ": called while " +
+                            ((idle & kRefitting) ? std::string("another refit()")
+                                                 : std::to_string(idle) + " queries") +
+                            " run on the same tree (refit needs the tree to itself; in a release "
+                            "build this is undefined behaviour)");
+        }
+        ~Writing() {
+            e_.state_.fetch_sub(kRefitting, std::memory_order_release);
+        }
+        Writing(const Writing&) = delete;
+        Writing& operator=(const Writing&) = delete;
+
+      private:
+        QueryExclusion& e_;
+#else
+        Writing(QueryExclusion&, const char*) {}
+#endif
+    };
+
+  private:
+    static constexpr std::uint32_t kRefitting = 0x80000000u;
+    mutable std::atomic<std::uint32_t> state_{0};
+};
+
+}  // namespace detail
 
 /// Which tree rays walk. The wide layouts serve float trees with the watertight test, on x86
 /// (query/ray_wide.hpp); anything else walks the binary tree.
@@ -89,6 +167,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     Hit<T> closest_hit(const Ray<T, 3>& ray) const { return closest_hit(ray, NoStats{}); }
     template <class Stats>
     Hit<T> closest_hit(const Ray<T, 3>& ray, Stats&& stats) const {
+        const Reading reading(exclusion_);
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>) {
             detail::SlabConstants k;
@@ -118,6 +197,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
     template <class Stats>
     bool any_hit(const Ray<T, 3>& ray, Stats&& stats) const {
+        const Reading reading(exclusion_);
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>)
             if (traces_wide() && wide_ray_usable(ray)) {
@@ -132,6 +212,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     /// on_hit(const Hit<T>&) -> bool (true to go on); hits come in no particular order.
     template <class OnHit, class Stats = NoStats>
     void all_hits(const Ray<T, 3>& ray, OnHit&& on_hit, Stats&& stats = {}) const {
+        const Reading reading(exclusion_);
         if (!split_references_) {
             binary_rays().all_hits(ray, on_hit, stats);
             return;
@@ -152,6 +233,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     /// hits[i] = closest_hit(rays[i]) for every ray, on the calling thread (an Error when the
     /// spans differ in length).
     void trace_stream(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
+        const Reading reading(exclusion_);
 #if BVHKIT_RAY_AVX2
         if constexpr (std::is_same_v<T, float>)
             if (streams_rays()) {
@@ -170,6 +252,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
     /// occluded[i] = any_hit(rays[i]) (1 or 0) for every ray, on the calling thread.
     void occluded_stream(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded) const {
+        const Reading reading(exclusion_);
 #if BVHKIT_RAY_AVX2
         if constexpr (std::is_same_v<T, float>) {
             if (!wide8_.empty()) {
@@ -217,9 +300,11 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
     /// A triangle of the tree with a NaN or infinite coordinate is an Error, and the tree is left
     /// as it was (its boxes would be NaN, and rays would miss it without a word); triangles left
-    /// out at the build stay out.
+    /// out at the build stay out. No query may run on the tree meanwhile (debug builds throw
+    /// bvhkit::Error on either side; see the top of this file).
     template <IndexedTriangleMesh M>
     void refit(const M& mesh) {
+        const detail::QueryExclusion::Writing writing(exclusion_, "TriangleBvh::refit");
         if (mesh.triangle_count() != triangle_count_)
             throw Error("TriangleBvh::refit: the mesh has " +
                         std::to_string(mesh.triangle_count()) +
@@ -251,6 +336,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
 
   private:
     friend struct serial_detail::TriangleBvhAccess;
+    using Reading = detail::QueryExclusion::Reading;
 
     // The binary walk over this tree's own arrays.
     TriangleRays<T> binary_rays() const {
@@ -422,6 +508,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     RayLayout ray_layout_ = RayLayout::Auto;
     WideRayBvh<4> wide4_;  // at most one of the two is filled (float, watertight, x86 only)
     WideRayBvh<8> wide8_;
+    detail::QueryExclusion exclusion_;  // debug builds: refit() and queries never overlap
 };
 
 }  // namespace bvhkit

@@ -19,9 +19,9 @@ def _ids(value: Any) -> np.ndarray:
         raise TypeError(f"ids: dtype must be an integer type, not {a.dtype}")
     if a.ndim != 1:
         raise ValueError(f"ids: shape must be (k,), not {a.shape}")
-    if a.size and (a.min() < 0 or a.max() > np.iinfo(np.int32).max):
-        raise ValueError("ids: every id must be one create() returned (0 <= id < 2^31)")
-    return np.ascontiguousarray(a, dtype=np.int32)
+    if a.size and (a.min() < 0 or a.max() > np.iinfo(np.int64).max):
+        raise ValueError("ids: every id must be one create() returned (0 <= id < 2^63)")
+    return np.ascontiguousarray(a, dtype=np.int64)
 
 
 class _DynamicTree:
@@ -56,9 +56,11 @@ class _DynamicTree:
 
     def create(self, lo: npt.ArrayLike, hi: npt.ArrayLike) -> np.ndarray:
         """Adds one proxy per box (``lo``, ``hi``: (k, D) corners) and returns their ids, (k,)
-        int32. Ids of destroyed proxies are reused."""
+        int64. An id is the proxy's slot plus 2^32 times the slot's generation: a slot freed by
+        destroy() is reused with a new generation, so an id kept past its proxy's destroy() is
+        never the id of another proxy (passing it is a ValueError)."""
         lo_, hi_ = self._boxes(lo, hi)
-        ids = np.empty(len(lo_), np.int32)
+        ids = np.empty(len(lo_), np.int64)
         self._impl.create(lo_, hi_, ids)
         return ids
 
@@ -91,7 +93,7 @@ class _DynamicTree:
 
     def find_pairs(self) -> np.ndarray:
         """The pairs of overlapping boxes that involve a proxy created or moved since the last
-        call, each once: (p, 2) int32, rows (a, b) with a < b, sorted."""
+        call, each once: (p, 2) int64, rows (a, b) with a < b, sorted."""
         return self._impl.find_pairs()
 
     def query(self, lo: npt.ArrayLike, hi: npt.ArrayLike, threads: int = 0) -> np.ndarray:

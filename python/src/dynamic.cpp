@@ -1,6 +1,9 @@
 // Tree<T, N>: the dynamic AABB tree for Python, changed and asked in batches. A batch of changes
 // checks every box and id before it changes anything, so a bad row leaves the tree as it was.
 // Queries hold a shared lock and run over threads without the GIL; changes hold an exclusive one.
+// Ids are int64: ProxyId::bits() (generation << 32 | slot), so a kept id of a destroyed proxy never
+// names the proxy that reuses its slot.
+#include <algorithm>
 #include <mutex>
 #include <shared_mutex>
 
@@ -37,22 +40,26 @@ class Tree {
             dynamic_detail::check_box(Box(at(lo.data(), i), at(hi.data(), i)), w.c_str());
         }
     }
-    void check_ids(const Column<std::int32_t>& ids, const char* where) const {
-        for (std::size_t i = 0; i < ids.shape(0); ++i)
-            if (!tree_.contains(ids.data()[i]))
-                throw Error(std::string(where) + ": ids[" + std::to_string(i) + "] = " +
-                            std::to_string(ids.data()[i]) + " is not a live proxy");
+    static ProxyId id_at(const Column<std::int64_t>& ids, std::size_t i) {
+        return ProxyId::from_bits(std::uint64_t(ids.data()[i]));
     }
-
-    void create(const Rows<T, N>& lo, const Rows<T, N>& hi, OutColumn<std::int32_t> ids) {
+    void check_ids(const Column<std::int64_t>& ids, const char* where) const {
+        for (std::size_t i = 0; i < ids.shape(0); ++i)
+            if (!tree_.contains(id_at(ids, i)))
+                throw Error(std::string(where) + ": ids[" + std::to_string(i) +
+                            "] = " + std::to_string(ids.data()[i]) +
+                            " is not a live proxy (destroyed, or never created by this tree)");
+    }
+    void create(const Rows<T, N>& lo, const Rows<T, N>& hi, OutColumn<std::int64_t> ids) {
         check_boxes(lo, hi, "create");
         expect_rows(ids, lo.shape(0), "ids");
         nb::gil_scoped_release release;
         const std::unique_lock<std::shared_mutex> lock(mutex_);
         for (std::size_t i = 0; i < lo.shape(0); ++i)
-            ids.data()[i] = tree_.create(Box(at(lo.data(), i), at(hi.data(), i)));
+            ids.data()[i] =
+                std::int64_t(tree_.create(Box(at(lo.data(), i), at(hi.data(), i))).bits());
     }
-    void move(const Column<std::int32_t>& ids, const Rows<T, N>& lo, const Rows<T, N>& hi,
+    void move(const Column<std::int64_t>& ids, const Rows<T, N>& lo, const Rows<T, N>& hi,
               const Rows<T, N>& displacement, OutColumn<bool> restructured) {
         check_boxes(lo, hi, "move");
         expect_rows(ids, lo.shape(0), "ids");
@@ -64,30 +71,40 @@ class Tree {
         const std::unique_lock<std::shared_mutex> lock(mutex_);
         check_ids(ids, "move");
         for (std::size_t i = 0; i < lo.shape(0); ++i)
-            restructured.data()[i] =
-                tree_.move(ids.data()[i], Box(at(lo.data(), i), at(hi.data(), i)),
-                           at(displacement.data(), i));
+            restructured.data()[i] = tree_.move(
+                id_at(ids, i), Box(at(lo.data(), i), at(hi.data(), i)), at(displacement.data(), i));
     }
-    void destroy(const Column<std::int32_t>& ids) {
+    void destroy(const Column<std::int64_t>& ids) {
         nb::gil_scoped_release release;
         const std::unique_lock<std::shared_mutex> lock(mutex_);
         check_ids(ids, "destroy");
-        for (std::size_t i = 0; i < ids.shape(0); ++i)
-            for (std::size_t j = 0; j < i; ++j)
-                if (ids.data()[j] == ids.data()[i])
-                    throw Error("destroy: ids[" + std::to_string(i) + "] repeats ids[" +
-                                std::to_string(j) + "]");
-        for (std::size_t i = 0; i < ids.shape(0); ++i) tree_.destroy(ids.data()[i]);
+        check_unique(ids, "destroy");
+        for (std::size_t i = 0; i < ids.shape(0); ++i) tree_.destroy(id_at(ids, i));
+    }
+    /// Throws naming the first id that repeats an earlier one: a sort of (id, position), so a
+    /// batch of k ids costs O(k log k) under the exclusive lock, whatever the tree's size.
+    static void check_unique(const Column<std::int64_t>& ids, const char* where) {
+        std::vector<std::pair<std::int64_t, std::size_t>> order(ids.shape(0));
+        for (std::size_t i = 0; i < order.size(); ++i) order[i] = {ids.data()[i], i};
+        std::sort(order.begin(), order.end());
+        std::size_t first = order.size(), earlier = 0;
+        for (std::size_t k = 1; k < order.size(); ++k)
+            if (order[k].first == order[k - 1].first && order[k].second < first)
+                first = order[k].second, earlier = order[k - 1].second;
+        if (first < order.size())
+            throw Error(std::string(where) + ": ids[" + std::to_string(first) + "] repeats ids[" +
+                        std::to_string(earlier) + "] (" + std::to_string(ids.data()[first]) + ")");
     }
 
-    nb::ndarray<nb::numpy, std::int32_t> find_pairs() {
-        std::vector<std::int32_t> flat;
+    nb::ndarray<nb::numpy, std::int64_t> find_pairs() {
+        std::vector<std::int64_t> flat;
         {
             nb::gil_scoped_release release;
             const std::unique_lock<std::shared_mutex> lock(mutex_);
             tree_.find_pairs(pairs_);
             flat.reserve(2 * pairs_.size());
-            for (const ProxyPair& p : pairs_) flat.insert(flat.end(), {p.a, p.b});
+            for (const ProxyPair& p : pairs_)
+                flat.insert(flat.end(), {std::int64_t(p.a.bits()), std::int64_t(p.b.bits())});
         }
         const std::size_t n = flat.size() / 2;
         return owned_array(std::move(flat), n, 2);
@@ -118,7 +135,7 @@ class Tree {
         check_boxes(lo, hi, "query");
         return gather(lo.shape(0), threads, [&](std::size_t i, std::vector<std::int64_t>& out) {
             tree_.query(Box(at(lo.data(), i), at(hi.data(), i)), [&](ProxyId id) {
-                out.insert(out.end(), {std::int64_t(i), std::int64_t(id)});
+                out.insert(out.end(), {std::int64_t(i), std::int64_t(id.bits())});
                 return true;
             });
         });
@@ -135,19 +152,19 @@ class Tree {
             // A negative answer means "go on without clipping": every box on the segment.
             tree_.ray_cast(at(origins.data(), i), at(directions.data(), i), limit,
                            [&](ProxyId id, T) {
-                               out.insert(out.end(), {std::int64_t(i), std::int64_t(id)});
+                               out.insert(out.end(), {std::int64_t(i), std::int64_t(id.bits())});
                                return T(-1);
                            });
         });
     }
 
-    nb::tuple boxes(const Column<std::int32_t>& ids) const {
+    nb::tuple boxes(const Column<std::int64_t>& ids) const {
         const std::shared_lock<std::shared_mutex> lock(mutex_);
         check_ids(ids, "boxes");
         const std::size_t k = ids.shape(0);
         std::vector<T> lo(N * k), hi(N * k);
         for (std::size_t i = 0; i < k; ++i) {
-            const Box& b = tree_.box(ids.data()[i]);
+            const Box& b = tree_.box(id_at(ids, i));
             for (std::size_t a = 0; a < N; ++a) {
                 lo[N * i + a] = b.min[a];
                 hi[N * i + a] = b.max[a];

@@ -7,6 +7,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -77,9 +78,11 @@ TEST(DynamicTreeEvents, UpdatePairsMatchesBruteForce) {
         }
         while (w.live.size() < 300) w.create();
         if (s % 25 == 24) {
-            // Destroy the largest ids so that shrink_to_fit() drops them (their pairs must end).
+            // Destroy the largest slots so that shrink_to_fit() drops them (their pairs must end).
             for (int k = 0; k < 20; ++k) {
-                const ProxyId id = std::prev(w.live.end())->first;
+                ProxyId id = w.live.begin()->first;
+                for (const auto& kv : w.live)
+                    if (kv.first.index() > id.index()) id = kv.first;
                 w.tree.destroy(id);
                 w.live.erase(id);
             }
@@ -140,10 +143,82 @@ TEST(DynamicTreeEvents, DestroyAndRecreateInOneStepIsAnEndAndABegin) {
     EXPECT_EQ(begins, (std::vector<bvhkit::ProxyPair>{{a, b}}));
     begins.clear();
     t.destroy(b);
-    EXPECT_EQ(t.create(Aabb2f({0.5f, 0}, {1.5f, 1})), b);  // same id, a new object
+    const ProxyId c = t.create(Aabb2f({0.5f, 0}, {1.5f, 1}));
+    EXPECT_EQ(c.index(), b.index());  // the same slot, a new object: a new id
+    EXPECT_NE(c, b);
     t.update_pairs(on_begin, on_end);
     EXPECT_EQ(ends, (std::vector<bvhkit::ProxyPair>{{a, b}}));
-    EXPECT_EQ(begins, (std::vector<bvhkit::ProxyPair>{{a, b}}));
+    EXPECT_EQ(begins, (std::vector<bvhkit::ProxyPair>{{a, c}}));
+}
+
+// Issue 38: the end event of a pair whose proxy was destroyed, its slot then taken by a new proxy,
+// named the new proxy (and so its user data). It names the proxy that was in the pair: a stale id,
+// which every call refuses, naming it.
+TEST(DynamicTreeEvents, EndEventNamesTheDestroyedProxyNotItsSlotsNewOne) {
+    Tree t;
+    const ProxyId body = t.create(Aabb2f({0, 0}, {1, 1}), 7);
+    const ProxyId old = t.create(Aabb2f({0.5f, 0}, {1.5f, 1}), 8);
+    std::vector<bvhkit::ProxyPair> begins, ends;
+    const auto on_begin = [&](ProxyId x, ProxyId y) { begins.push_back({x, y}); };
+    const auto on_end = [&](ProxyId x, ProxyId y) {
+        ends.push_back({x, y});
+        // In the callback: the old proxy is gone, whatever now lives in its slot.
+        EXPECT_TRUE(t.contains(x) != t.contains(y));
+    };
+    t.update_pairs(on_begin, on_end);
+    ASSERT_EQ(begins, (std::vector<bvhkit::ProxyPair>{{body, old}}));
+    begins.clear();
+    t.destroy(old);
+    const ProxyId fresh = t.create(Aabb2f({50, 50}, {51, 51}), 9);  // far away, same slot
+    ASSERT_EQ(fresh.index(), old.index());
+    t.update_pairs(on_begin, on_end);
+    ASSERT_EQ(ends.size(), 1u);
+    EXPECT_TRUE(begins.empty());
+    const ProxyId gone = ends[0].a == body ? ends[0].b : ends[0].a;
+    EXPECT_EQ(gone, old);
+    EXPECT_NE(gone, fresh);
+    EXPECT_FALSE(t.contains(gone));
+    EXPECT_TRUE(t.contains(fresh));
+    EXPECT_EQ(t.user_data(fresh), 9u);
+    EXPECT_EQ(t.user_data(body), 7u);
+    // A stale id is an error naming it, for every call that takes an id.
+    const auto refuses = [&](auto&& call) {
+        try {
+            call();
+            ADD_FAILURE() << "a stale id was accepted";
+        } catch (const bvhkit::Error& e) {
+            EXPECT_NE(std::string(e.what()).find("was destroyed"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(bvhkit::to_string(old)), std::string::npos)
+                << e.what();
+        }
+    };
+    refuses([&] { (void)t.user_data(old); });
+    refuses([&] { (void)t.box(old); });
+    refuses([&] { t.move(old, Aabb2f({0, 0}, {1, 1})); });
+    refuses([&] { t.enlarge(old, Aabb2f({0, 0}, {1, 1})); });
+    refuses([&] { t.destroy(old); });
+    EXPECT_TRUE(t.contains(fresh));  // nothing happened to the slot's new proxy
+    EXPECT_EQ(t.box(fresh), Aabb2f({50, 50}, {51, 51}));
+    t.validate();
+}
+
+// Ids of a slot reused many times never repeat; shrink_to_fit() and clear() drop slots without
+// letting a new proxy take an id handed out before.
+TEST(DynamicTreeEvents, IdsNeverRepeatThroughReuseShrinkAndClear) {
+    Tree t;
+    std::set<ProxyId> seen;
+    const auto fresh = [&](ProxyId id) { EXPECT_TRUE(seen.insert(id).second) << id; };
+    std::vector<ProxyId> live;
+    for (int round = 0; round < 50; ++round) {
+        for (int i = 0; i < 8; ++i)
+            live.push_back(t.create(Aabb2f({0, 0}, {1, 1}))), fresh(live.back());
+        for (int i = 0; i < 5; ++i) t.destroy(live.back()), live.pop_back();
+        if (round % 7 == 3) t.shrink_to_fit();
+        if (round % 11 == 5) t.clear(), live.clear();
+        t.validate();
+    }
+    for (const ProxyId id : seen)
+        EXPECT_EQ(t.contains(id), std::find(live.begin(), live.end(), id) != live.end()) << id;
 }
 
 TEST(DynamicTreeEvents, CastCallbacksReceiveTheInput) {
@@ -171,7 +246,7 @@ TEST(DynamicTreeEvents, CastCallbacksReceiveTheInput) {
         closest = id;
         return entry;
     });
-    EXPECT_EQ(closest, 0);
+    EXPECT_EQ(closest, ProxyId(0, 0));
     EXPECT_GE(calls, 1);
     // Box cast: origin is the box's centre, half_extent its half size.
     const Aabb2f cast({-1, 0}, {0, 2});

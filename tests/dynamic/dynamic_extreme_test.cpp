@@ -243,7 +243,7 @@ TEST(DynamicTreeExtreme, NanQueriesAreRefused) {
     EXPECT_EQ(reported, 0);
     // Non-finite boxes on create and move were already refused; still are.
     EXPECT_THROW(t.create(Aabb2f({0, 0}, {inf, 1})), bvhkit::Error);
-    EXPECT_THROW(t.move(0, Aabb2f({nan, 0}, {1, 1})), bvhkit::Error);
+    EXPECT_THROW(t.move(ProxyId(0, 0), Aabb2f({nan, 0}, {1, 1})), bvhkit::Error);
     t.validate();
 }
 

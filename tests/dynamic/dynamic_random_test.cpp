@@ -54,10 +54,12 @@ struct Harness {
 
     std::mt19937_64 rng;
     Tree tree;
-    std::vector<Box> boxes;     // by id; the test's own copy
-    std::vector<char> alive;    // by id
-    std::set<ProxyId> moved;    // created or moved since the last find_pairs
-    std::vector<ProxyId> live;  // ids, for picking
+    std::vector<Box> boxes;        // by slot; the test's own copy
+    std::vector<char> alive;       // by slot
+    std::set<ProxyId> moved;       // created or moved since the last find_pairs
+    std::vector<ProxyId> live;     // ids, for picking
+    std::set<ProxyId> handed_out;  // every id create() returned: none twice
+    std::vector<ProxyId> dead;     // some destroyed ids: stale for good, slots reused or not
     T world = T(100);
     std::size_t target = 800;
 
@@ -80,18 +82,20 @@ struct Harness {
     }
 
     void remember(ProxyId id, const Box& b) {
-        if (std::size_t(id) >= boxes.size()) boxes.resize(id + 1), alive.resize(id + 1, 0);
-        boxes[id] = b;
-        alive[id] = 1;
+        const auto slot = std::size_t(id.index());
+        if (slot >= boxes.size()) boxes.resize(slot + 1), alive.resize(slot + 1, 0);
+        boxes[id.index()] = b;
+        alive[id.index()] = 1;
         moved.insert(id);
     }
 
     void op_create() {
         const Box b = random_box();
         const ProxyId id = tree.create(b, std::uint64_t(id_salt(b)));
-        ASSERT_TRUE(id >= 0);
-        ASSERT_FALSE(std::size_t(id) < alive.size() && alive[id])
+        ASSERT_TRUE(id.index() >= 0);
+        ASSERT_FALSE(std::size_t(id.index()) < alive.size() && alive[id.index()])
             << "id " << id << " handed out twice";
+        ASSERT_TRUE(handed_out.insert(id).second) << "id " << id << " handed out again";
         remember(id, b);
         live.push_back(id);
     }
@@ -101,7 +105,9 @@ struct Harness {
         const std::size_t k = pick(live.size());
         const ProxyId id = live[k];
         tree.destroy(id);
-        alive[id] = 0;
+        alive[id.index()] = 0;
+        ASSERT_FALSE(tree.contains(id));
+        if (dead.size() < 64) dead.push_back(id);
         moved.erase(id);
         live[k] = live.back();
         live.pop_back();
@@ -109,7 +115,7 @@ struct Harness {
 
     void op_move(bool far, bool use_enlarge) {
         const ProxyId id = live[pick(live.size())];
-        Box b = boxes[id];
+        Box b = boxes[id.index()];
         V d;
         if (far) {
             b = random_box();
@@ -117,7 +123,7 @@ struct Harness {
             for (std::size_t i = 0; i < N; ++i) d[i] = uni(T(-0.3), T(0.3));
             b = Box(b.min + d, b.max + d);
         }
-        ASSERT_EQ(tree.user_data(id), id_salt(boxes[id])) << "user data of " << id;
+        ASSERT_EQ(tree.user_data(id), id_salt(boxes[id.index()])) << "user data of " << id;
         use_enlarge ? tree.enlarge(id, b, d) : tree.move(id, b, d);
         tree.user_data(id) = id_salt(b);
         remember(id, b);
@@ -132,7 +138,7 @@ struct Harness {
         tree.query(
             q, [&](ProxyId id) { return got.push_back(id), true; }, &st);
         for (ProxyId id : live)
-            if (boxes[id].overlaps(q)) want.push_back(id);
+            if (boxes[id.index()].overlaps(q)) want.push_back(id);
         std::sort(got.begin(), got.end());
         std::sort(want.begin(), want.end());
         ASSERT_EQ(got, want) << "box query";
@@ -143,14 +149,14 @@ struct Harness {
         // Half the points are box corners, to hit boundaries exactly.
         V p;
         if (pick(2) && !live.empty()) {
-            p = boxes[live[pick(live.size())]].max;
+            p = boxes[live[pick(live.size())].index()].max;
         } else {
             for (std::size_t i = 0; i < N; ++i) p[i] = uni(0, world);
         }
         std::vector<ProxyId> got, want;
         tree.query_point(p, [&](ProxyId id) { return got.push_back(id), true; });
         for (ProxyId id : live)
-            if (boxes[id].contains(p)) want.push_back(id);
+            if (boxes[id.index()].contains(p)) want.push_back(id);
         std::sort(got.begin(), got.end());
         std::sort(want.begin(), want.end());
         ASSERT_EQ(got, want) << "point query";
@@ -180,8 +186,8 @@ struct Harness {
         std::set<ProxyId> got_set(got.begin(), got.end());
         ASSERT_EQ(got_set.size(), got.size()) << "cast reported a proxy twice";
         for (ProxyId id : live) {
-            const bool sure = exact_entry(o, d, boxes[id], half, Long(maxf), -tol) >= 0;
-            const bool maybe = exact_entry(o, d, boxes[id], half, Long(maxf), tol) >= 0;
+            const bool sure = exact_entry(o, d, boxes[id.index()], half, Long(maxf), -tol) >= 0;
+            const bool maybe = exact_entry(o, d, boxes[id.index()], half, Long(maxf), tol) >= 0;
             if (sure) {
                 ASSERT_TRUE(got_set.count(id))
                     << (box_cast ? "box" : "ray") << " cast missed " << id;
@@ -194,12 +200,12 @@ struct Harness {
         // Closest hit by clipping: the smallest entry fraction must be found.
         Long best = -1;
         for (ProxyId id : live) {
-            const Long t = exact_entry(o, d, boxes[id], half, Long(maxf), 0);
+            const Long t = exact_entry(o, d, boxes[id.index()], half, Long(maxf), 0);
             if (t >= 0 && (best < 0 || t < best)) best = t;
         }
         Long found = -1;
         const auto clip = [&](ProxyId id, T mf) -> T {
-            const Long t = exact_entry(o, d, boxes[id], half, Long(mf), 0);
+            const Long t = exact_entry(o, d, boxes[id.index()], half, Long(mf), 0);
             if (t < 0) return T(-1);
             found = found < 0 ? t : std::min(found, t);
             return std::max(T(t), std::numeric_limits<T>::min());  // clip there, keep it > 0
@@ -216,7 +222,8 @@ struct Harness {
         std::vector<bvhkit::ProxyPair> want;
         for (ProxyId m : moved)
             for (ProxyId o : live)
-                if (o != m && boxes[m].overlaps(boxes[o]) && !(moved.count(o) && o < m))
+                if (o != m && boxes[m.index()].overlaps(boxes[o.index()]) &&
+                    !(moved.count(o) && o < m))
                     want.push_back({std::min(m, o), std::max(m, o)});
         std::sort(want.begin(), want.end());
         ASSERT_EQ(got.size(), want.size()) << "pair count";
@@ -228,8 +235,9 @@ struct Harness {
         std::vector<std::pair<ProxyId, ProxyId>> got, want;
         tree.query_tree(other, [&](ProxyId a, ProxyId b) { return got.emplace_back(a, b), true; });
         for (ProxyId a : live)
-            for (ProxyId b = 0; b < ProxyId(other_boxes.size()); ++b)
-                if (boxes[a].overlaps(other_boxes[b])) want.emplace_back(a, b);
+            for (std::int32_t b = 0; b < std::int32_t(other_boxes.size()); ++b)
+                if (boxes[a.index()].overlaps(other_boxes[std::size_t(b)]))
+                    want.emplace_back(a, ProxyId(b, 0));  // `other` never destroys
         std::sort(got.begin(), got.end());
         std::sort(want.begin(), want.end());
         ASSERT_TRUE(got == want) << "tree against tree: " << got.size() << " vs " << want.size();
@@ -269,6 +277,7 @@ struct Harness {
             if (enlarged > 200) tree.rebuild(false), enlarged = 0;
             if (k % 1000 == 0) {
                 ASSERT_NO_THROW(tree.validate()) << "after op " << k;
+                for (const ProxyId id : dead) ASSERT_FALSE(tree.contains(id)) << id;
                 for (int q = 0; q < 3; ++q) {
                     ASSERT_NO_FATAL_FAILURE(check_box_query());
                     ASSERT_NO_FATAL_FAILURE(check_point_query());

@@ -126,8 +126,9 @@ void load_dynamic_tree_and_use(std::span<const std::uint8_t> bytes) {
         const bvhkit::Aabb<T, N> box(bvhkit::Vec<T, N>(T(-1)), bvhkit::Vec<T, N>(T(1)));
         tree.query(box,
                    [&](bvhkit::ProxyId id) { return tree.contains(id) || (std::abort(), false); });
-        for (bvhkit::ProxyId id = 0; id < tree.id_bound() && id < 8; ++id)
-            if (tree.contains(id)) tree.move(id, box);
+        for (std::int32_t slot = 0; slot < tree.id_bound() && slot < 8; ++slot)
+            if (const bvhkit::ProxyId id = tree.proxy_at(slot); tree.contains(id))
+                tree.move(id, box);
         (void)tree.create(box);
         tree.update_pairs([](bvhkit::ProxyId, bvhkit::ProxyId) {},
                           [](bvhkit::ProxyId, bvhkit::ProxyId) {});

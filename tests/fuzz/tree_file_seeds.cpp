@@ -85,15 +85,15 @@ int main(int argc, char** argv) {
     bvhkit::DynamicTree<float, 2> flat;
     for (int i = 0; i < 12; ++i)
         flat.create(bvhkit::Aabb<float, 2>({float(i), 0}, {float(i) + 1.5f, 1}), std::uint64_t(i));
-    flat.destroy(3);
+    flat.destroy(bvhkit::ProxyId(3, 0));  // a fresh tree: slot i, generation 0
     flat.update_pairs([](bvhkit::ProxyId, bvhkit::ProxyId) {},
                       [](bvhkit::ProxyId, bvhkit::ProxyId) {});
-    flat.move(5, bvhkit::Aabb<float, 2>({20, 0}, {21, 1}));
+    flat.move(bvhkit::ProxyId(5, 0), bvhkit::Aabb<float, 2>({20, 0}, {21, 1}));
     bvhkit::save(flat, dir / "dynamic_2d_float.bvh");
     bvhkit::DynamicTree<double, 3> solid;
     for (int i = 0; i < 10; ++i)
         solid.create(bvhkit::Aabb<double, 3>({0, double(i), 0}, {1, double(i) + 1.5, 1}));
-    solid.enlarge(2, bvhkit::Aabb<double, 3>({5, 5, 5}, {6, 6, 6}));
+    solid.enlarge(bvhkit::ProxyId(2, 0), bvhkit::Aabb<double, 3>({5, 5, 5}, {6, 6, 6}));
     bvhkit::save(solid, dir / "dynamic_3d_double.bvh");
     // Collision models: every volume type over the octahedron, one over a grid with skipped
     // triangles, one in double.

@@ -11,12 +11,13 @@
 //
 // Two layers. The tree below is a LinkedTree (bvh/linked_tree.hpp): leaves with a fat box and a
 // proxy id, inserted next to the sibling that raises the SAH cost least and rotated on the way up.
-// This class is the broadphase above it: each proxy has a stable id into a table holding its tight
-// box, its user data (UserData, a std::uint64_t unless chosen otherwise: an index, a handle or a
-// pointer cast to an integer) and its leaf; it computes the fat boxes (fat_box.hpp: the box grown
-// by a margin and stretched along the predicted displacement, so a small motion stays inside it and
-// move() only updates the tight box), keeps the move buffer and finds the pairs (tree_pairs.hpp).
-// Queries report a proxy when its tight box passes; the fat boxes only steer the descent.
+// This class is the broadphase above it: each proxy has a stable id (a slot of a table and the
+// slot's generation, so that an id outlives its proxy harmlessly) naming its tight box, its user
+// data (UserData, a std::uint64_t unless chosen otherwise: an index, a handle or a pointer cast to
+// an integer) and its leaf; it computes the fat boxes (fat_box.hpp: the box grown by a margin and
+// stretched along the predicted displacement, so a small motion stays inside it and move() only
+// updates the tight box), keeps the move buffer and finds the pairs (tree_pairs.hpp). Queries
+// report a proxy when its tight box passes; the fat boxes only steer the descent.
 //
 // Callbacks: while a query, cast, for_each_node or pair callback of a tree runs, the calls that
 // change its structure (create, destroy, move, enlarge, rebuild, optimize, clear, shift_origin,
@@ -67,29 +68,34 @@ class DynamicTree {
     ProxyId create(const Box& box, const UserData& user_data = {}) {
         check_not_walking("DynamicTree::create");
         dynamic_detail::check_box(box, "DynamicTree::create");
-        const ProxyId id = alloc_proxy();
-        const std::int32_t leaf = tree_.make_leaf(fat_box(box, VecT{}), id);
-        Proxy& p = proxies_[id];
+        const std::int32_t slot = alloc_proxy();
+        const std::int32_t leaf = tree_.make_leaf(fat_box(box, VecT{}), slot);
+        Proxy& p = proxies_[std::size_t(slot)];
         p.box = box;
         p.user_data = user_data;
         p.node = leaf;
         tree_.insert(leaf, insertion());
-        buffer_move(id);
-        return id;
+        buffer_move(slot);
+        return ProxyId(slot, p.generation);
     }
 
+    /// Removes the proxy; `id` is stale from now on (its slot's next proxy gets a new generation).
     void destroy(ProxyId id) {
         check_not_walking("DynamicTree::destroy");
         check_id(id, "DynamicTree::destroy");
-        Proxy& p = proxies_[id];
+        const std::int32_t slot = id.index();
+        Proxy& p = proxies_[std::size_t(slot)];
         tree_.detach(p.node, options_.rotate);
         tree_.free_leaf(p.node);
         p.node = dynamic_detail::kNullNode;
         p.moved = false;  // find_pairs() skips its buffer entry
         p.ended = true;   // update_pairs() ends its pairs
-        if (!p.buffered) p.buffered = true, move_buffer_.push_back(id);
-        p.next_free = free_proxy_;
-        free_proxy_ = id;
+        if (!p.buffered) p.buffered = true, move_buffer_.push_back(slot);
+        if (p.generation < ProxyId::max_generation) {
+            ++p.generation;
+            p.next_free = free_proxy_;
+            free_proxy_ = slot;
+        }  // else the slot is retired: reusing it would give a live proxy the id of a dead one
         --proxy_count_;
     }
 
@@ -167,11 +173,20 @@ class DynamicTree {
         return static_cast<int>(k);
     }
 
-    /// Removes every proxy and returns all memory (memory_bytes() is 0 afterwards).
+    /// Removes every proxy and returns all memory (memory_bytes() is 0 afterwards, unless a slot
+    /// has used its last generation: then the proxy table stays, every slot retired). Ids from
+    /// before stay stale: a new proxy in a slot gets a later generation than any before it.
     void clear() {
         check_not_walking("DynamicTree::clear");
+        std::uint64_t floor = generation_floor_;
+        for (const Proxy& p : proxies_) floor = std::max(floor, next_generation(p));
         tree_.clear();
-        release(proxies_);
+        if (floor > ProxyId::max_generation) {
+            for (Proxy& p : proxies_) p = Proxy{}, p.generation = ProxyId::max_generation;
+        } else {
+            release(proxies_);
+            generation_floor_ = std::uint32_t(floor);
+        }
         release(move_buffer_);
         release(pairs_);
         release(pending_ends_);
@@ -182,42 +197,54 @@ class DynamicTree {
     }
 
     /// Returns unused memory: the node pool is repacked (depth first) to exactly the nodes in use,
-    /// free proxy slots past the largest live id are dropped, and the scratch
+    /// free proxy slots past the largest live one are dropped, and the scratch
     /// storage is freed. Live proxy ids do not change. O(nodes).
     void shrink_to_fit() {
         check_not_walking("DynamicTree::shrink_to_fit");
         std::size_t keep = proxies_.size();
-        while (keep > 0 && proxies_[keep - 1].node == dynamic_detail::kNullNode) --keep;
+        // A retired slot stays: a new one in its place could only start at its last generation.
+        while (keep > 0 && proxies_[keep - 1].node == dynamic_detail::kNullNode &&
+               proxies_[keep - 1].generation < ProxyId::max_generation) {
+            // A slot made again later starts past every generation a dropped one handed out.
+            generation_floor_ = std::max(generation_floor_, proxies_[keep - 1].generation);
+            --keep;
+        }
         if (keep < proxies_.size()) {
-            // Pairs naming a dropped id end at the next update_pairs().
+            // Pairs naming a dropped slot end at the next update_pairs().
             std::size_t kept = 0;
             for (const ProxyPair& p : pairs_)
-                if (std::size_t(p.b) >= keep)
+                if (std::size_t(p.a.index()) >= keep || std::size_t(p.b.index()) >= keep)
                     pending_ends_.push_back(p);
                 else
                     pairs_[kept++] = p;
             pairs_.resize(kept);
-            // Destroyed ids past the end leave the move buffer (find_pairs skips them anyway).
+            // Destroyed slots past the end leave the move buffer (find_pairs skips them anyway).
             move_buffer_.erase(
                 std::remove_if(move_buffer_.begin(), move_buffer_.end(),
-                               [keep](ProxyId id) { return std::size_t(id) >= keep; }),
+                               [keep](std::int32_t slot) { return std::size_t(slot) >= keep; }),
                 move_buffer_.end());
             proxies_.resize(keep);
-            free_proxy_ = dynamic_detail::kNullNode;  // relist the free slots, smallest id first
-            for (std::size_t id = keep; id-- > 0;)
-                if (proxies_[id].node == dynamic_detail::kNullNode)
-                    proxies_[id].next_free = free_proxy_, free_proxy_ = std::int32_t(id);
+            free_proxy_ = dynamic_detail::kNullNode;  // relist the free slots, smallest first
+            for (std::size_t slot = keep; slot-- > 0;)
+                if (proxies_[slot].node == dynamic_detail::kNullNode &&
+                    proxies_[slot].generation < ProxyId::max_generation)
+                    proxies_[slot].next_free = free_proxy_, free_proxy_ = std::int32_t(slot);
         }
         proxies_.shrink_to_fit();
-        tree_.shrink_to_fit([this](ProxyId p, std::int32_t leaf) { proxies_[p].node = leaf; });
+        tree_.shrink_to_fit([this](std::int32_t slot, std::int32_t leaf) {
+            proxies_[std::size_t(slot)].node = leaf;
+        });
         move_buffer_.shrink_to_fit();
         pairs_.shrink_to_fit();
         release_scratch();
     }
 
+    /// Whether `id` names a live proxy: false once it is destroyed, also after its slot is reused.
     bool contains(ProxyId id) const {
-        return id >= 0 && id < static_cast<ProxyId>(proxies_.size()) &&
-               proxies_[id].node != dynamic_detail::kNullNode;
+        const std::int32_t i = id.index();
+        return i >= 0 && std::size_t(i) < proxies_.size() &&
+               proxies_[std::size_t(i)].node != dynamic_detail::kNullNode &&
+               proxies_[std::size_t(i)].generation == id.generation();
     }
     const Box& box(ProxyId id) const { return proxies_[checked(id, "DynamicTree::box")].box; }
     const Box& fat_box(ProxyId id) const {
@@ -232,8 +259,16 @@ class DynamicTree {
     /// Number of live proxies.
     std::size_t size() const { return proxy_count_; }
     bool empty() const { return proxy_count_ == 0; }
-    /// One past the largest proxy id ever handed out (ids are reused after destroy()).
-    ProxyId id_bound() const { return static_cast<ProxyId>(proxies_.size()); }
+    /// One past the largest slot index ever handed out (slots are reused after destroy(), with a
+    /// new generation).
+    std::int32_t id_bound() const { return static_cast<std::int32_t>(proxies_.size()); }
+    /// The live proxy in slot `index` (0 <= index < id_bound()), or kNullProxy when it is free.
+    ProxyId proxy_at(std::int32_t index) const {
+        if (index < 0 || std::size_t(index) >= proxies_.size() ||
+            proxies_[std::size_t(index)].node == dynamic_detail::kNullNode)
+            return kNullProxy;
+        return ProxyId(index, proxies_[std::size_t(index)].generation);
+    }
     const Options& options() const { return options_; }
     /// New options apply to later inserts and moves; the present fat boxes stay until they move.
     void set_options(const Options& o) {
@@ -328,16 +363,20 @@ class DynamicTree {
     /// last call and no longer does (or whose proxy was destroyed), then on_begin(a, b) for every
     /// pair that overlaps now and did not, each sorted by (a, b). Pairs that persist are not
     /// reported. Keeps a sorted persistent pair set; the work is one query per moved proxy plus a
-    /// linear merge. An id destroyed and created again in one step gives an end and a begin. The
-    /// ids in an end event may name proxies destroyed since. clear() forgets the set silently.
+    /// linear merge. An end event names the proxies that were in the pair: an id destroyed since
+    /// is stale (contains(id) is false; its slot may hold a new proxy, under another id), so the
+    /// caller can tell it from a live one and never gets the new proxy's user data for it. A
+    /// slot destroyed and created again in one step gives an end (old id) and a begin (new id).
+    /// clear() forgets the set silently.
     template <class Begin, class End>
     void update_pairs(Begin&& on_begin, End&& on_end) {
         check_not_walking("DynamicTree::update_pairs");
         const Guard guard(walks_);
         const bool stale = !pairs_valid_;
         if (stale) {  // after find_pairs(): every pair of the set is checked again
-            for (std::size_t id = 0; id < proxies_.size(); ++id)
-                if (proxies_[id].node != dynamic_detail::kNullNode) buffer_move(ProxyId(id));
+            for (std::size_t slot = 0; slot < proxies_.size(); ++slot)
+                if (proxies_[slot].node != dynamic_detail::kNullNode)
+                    buffer_move(std::int32_t(slot));
             pairs_valid_ = true;
         }
         dynamic_detail::collect_moved_pairs(view(), move_buffer_, pair_scratch_);
@@ -346,8 +385,10 @@ class DynamicTree {
         ends.swap(pending_ends_);  // pairs of ids dropped by shrink_to_fit()
         pending_ends_.clear();
         begins.clear();
-        const auto touched = [this, stale](ProxyId id) { return stale || proxies_[id].buffered; };
-        const auto ended = [this](ProxyId id) { return proxies_[id].ended; };
+        const auto touched = [this, stale](ProxyId id) {
+            return stale || proxies_[std::size_t(id.index())].buffered;
+        };
+        const auto ended = [this](ProxyId id) { return proxies_[std::size_t(id.index())].ended; };
         dynamic_detail::step_pair_set(pairs_, pair_scratch_, touched, ended, pair_next_, ends,
                                       begins);
         pairs_.swap(pair_next_);
@@ -386,7 +427,7 @@ class DynamicTree {
     }
     std::size_t memory_bytes() const {
         return tree_.memory_bytes() + proxies_.capacity() * sizeof(Proxy) +
-               move_buffer_.capacity() * sizeof(ProxyId) +
+               move_buffer_.capacity() * sizeof(std::int32_t) +
                pair_scratch_.capacity() * sizeof(ProxyPair) +
                rebuild_centroids_.capacity() * sizeof(VecT) +
                optimize_scratch_.capacity() * sizeof(optimize_scratch_[0]) +
@@ -411,15 +452,16 @@ class DynamicTree {
     void shift_origin(const VecT& new_origin) {
         check_not_walking("DynamicTree::shift_origin");
         dynamic_detail::check_vector(new_origin, "new_origin", "DynamicTree::shift_origin");
-        for (std::size_t id = 0; id < proxies_.size(); ++id) {
-            const Proxy& p = proxies_[id];
+        for (std::size_t slot = 0; slot < proxies_.size(); ++slot) {
+            const Proxy& p = proxies_[slot];
             if (p.node == dynamic_detail::kNullNode) continue;
             const Box b(p.box.min - new_origin, p.box.max - new_origin);
             for (std::size_t i = 0; i < N; ++i)
                 if (!std::isfinite(b.min[i]) || !std::isfinite(b.max[i]))
                     throw Error("DynamicTree::shift_origin: new_origin[" + std::to_string(i) +
                                 "] = " + dynamic_detail::format_value(double(new_origin[i])) +
-                                " would move proxy " + std::to_string(id) +
+                                " would move proxy " +
+                                to_string(ProxyId(std::int32_t(slot), p.generation)) +
                                 "'s box outside the finite range");
         }
         constexpr T big = std::numeric_limits<T>::max();
@@ -446,7 +488,8 @@ class DynamicTree {
         while (!stack.empty()) {
             const Item it = stack.pop();
             const Node& n = tree_.node(it.node);
-            visitor(n.box, int(it.depth), n.is_leaf(), n.is_leaf() ? n.value() : kNullProxy);
+            visitor(n.box, int(it.depth), n.is_leaf(),
+                    n.is_leaf() ? dynamic_detail::proxy_id(view(), n.value()) : kNullProxy);
             if (!n.is_leaf()) {
                 stack.push({n.child2, it.depth + 1});
                 stack.push({n.child1, it.depth + 1});
@@ -492,14 +535,21 @@ class DynamicTree {
     }
 
     void check_id(ProxyId id, const char* where) const {
-        if (!contains(id))
-            throw Error(std::string(where) + ": proxy id " + std::to_string(id) +
-                        (id >= 0 && id < static_cast<ProxyId>(proxies_.size()) ? " was destroyed"
-                                                                               : " is unknown"));
+        if (contains(id)) return;
+        const std::int32_t i = id.index();
+        const bool handed_out = i >= 0 && std::size_t(i) < proxies_.size() &&
+                                id.generation() <= proxies_[std::size_t(i)].generation;
+        throw Error(std::string(where) + ": proxy id " + to_string(id) +
+                    (handed_out ? " was destroyed (a stale id)" : " is unknown"));
     }
-    ProxyId checked(ProxyId id, const char* where) const {
+    std::size_t checked(ProxyId id, const char* where) const {
         check_id(id, where);
-        return id;
+        return std::size_t(id.index());
+    }
+    /// The generation a slot's next proxy would get (max_generation + 1: none, it is retired).
+    static std::uint64_t next_generation(const Proxy& p) {
+        return std::uint64_t(p.generation) +
+               (p.node != dynamic_detail::kNullNode || p.generation == ProxyId::max_generation);
     }
 
     template <class V>
@@ -518,7 +568,7 @@ class DynamicTree {
 
     /// Clears the move buffer and its flags after a pair step.
     void end_pair_step() {
-        for (const ProxyId q : move_buffer_) {
+        for (const std::int32_t q : move_buffer_) {
             Proxy& p = proxies_[q];
             p.moved = p.buffered = p.ended = false;
         }
@@ -528,45 +578,49 @@ class DynamicTree {
     /// The first step of move() and enlarge(): the checks, the new tight box, the move buffer.
     const Proxy& set_box(ProxyId id, const Box& box, const VecT& displacement, const char* where) {
         check_not_walking(where);
-        check_id(id, where);
+        const std::size_t slot = checked(id, where);
         dynamic_detail::check_box(box, where);
         dynamic_detail::check_vector(displacement, "displacement", where);
-        proxies_[id].box = box;
-        buffer_move(id);
-        return proxies_[id];
+        proxies_[slot].box = box;
+        buffer_move(std::int32_t(slot));
+        return proxies_[slot];
     }
 
-    void buffer_move(ProxyId id) {
-        Proxy& p = proxies_[id];
+    void buffer_move(std::int32_t slot) {
+        Proxy& p = proxies_[std::size_t(slot)];
         p.moved = true;
-        if (p.buffered) return;  // a reused id may still be there from before its destroy
+        if (p.buffered) return;  // a reused slot may still be there from before its destroy
         p.buffered = true;
-        move_buffer_.push_back(id);
+        move_buffer_.push_back(slot);
     }
 
     // ---- pools
 
-    ProxyId alloc_proxy() {
-        ProxyId id = free_proxy_;
-        if (id == dynamic_detail::kNullNode) {
+    std::int32_t alloc_proxy() {
+        std::int32_t slot = free_proxy_;
+        if (slot == dynamic_detail::kNullNode) {
             if (proxies_.size() >= std::size_t(INT32_MAX))
                 throw Error("DynamicTree: more than 2^31 proxies");
-            id = static_cast<ProxyId>(proxies_.size());
+            slot = static_cast<std::int32_t>(proxies_.size());
             proxies_.emplace_back();
+            proxies_.back().generation = generation_floor_;
         } else {
-            free_proxy_ = proxies_[id].next_free;
+            free_proxy_ = proxies_[std::size_t(slot)].next_free;
         }
-        proxies_[id].next_free = dynamic_detail::kNullNode;
-        proxies_[id].moved = false;  // `buffered` and `ended` stay: the id may wait in the buffer
+        Proxy& p = proxies_[std::size_t(slot)];
+        p.next_free = dynamic_detail::kNullNode;
+        p.moved = false;  // `buffered` and `ended` stay: the slot may wait in the buffer
         ++proxy_count_;
-        return id;
+        return slot;
     }
 
     Options options_;
     LinkedTree<T, N> tree_;  // leaves: the fat boxes, valued by proxy id
     std::vector<Proxy> proxies_;
-    std::vector<ProxyId> move_buffer_;
+    std::vector<std::int32_t> move_buffer_;  // slot indices
     std::int32_t free_proxy_ = dynamic_detail::kNullNode;
+    // The generation of a slot appended to the table: past every one a dropped slot handed out.
+    std::uint32_t generation_floor_ = 0;
     std::size_t proxy_count_ = 0;
     // Scratch storage kept between calls so that steady use allocates nothing.
     std::vector<ProxyPair> pair_scratch_;

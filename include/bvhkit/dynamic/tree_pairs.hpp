@@ -3,6 +3,7 @@
 // (DynamicTree::find_pairs), and the step from one persistent pair set to the next with the pairs
 // that began and ended in between (DynamicTree::update_pairs).
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "bvhkit/dynamic/tree_queries.hpp"
@@ -11,20 +12,22 @@
 namespace bvhkit::dynamic_detail {
 
 /// Every overlapping pair (tight boxes, touching counts) that involves a moved proxy of `buffer`
-/// (sorted in place), each once as (a, b) with a < b, into `out`, sorted.
+/// (slot indices, sorted in place), each once as (a, b) with a < b, into `out`, sorted.
 template <class T, std::size_t N, class U>
-void collect_moved_pairs(const TreeView<T, N, U>& v, std::vector<ProxyId>& buffer,
+void collect_moved_pairs(const TreeView<T, N, U>& v, std::vector<std::int32_t>& buffer,
                          std::vector<ProxyPair>& out) {
     out.clear();
     std::sort(buffer.begin(), buffer.end());
-    for (const ProxyId q : buffer) {
+    for (const std::int32_t q : buffer) {
         if (!v.proxies[q].moved) continue;  // destroyed since it was buffered
+        const ProxyId qid = proxy_id(v, q);
         query_box(
             v, v.proxies[q].box,
-            [&](ProxyId o) {
-                // Skip itself; when both moved, only the query from the smaller id reports.
+            [&](ProxyId oid) {
+                // Skip itself; when both moved, only the query from the smaller slot reports.
+                const std::int32_t o = oid.index();
                 if (o != q && !(v.proxies[o].moved && o < q))
-                    out.push_back(o < q ? ProxyPair{o, q} : ProxyPair{q, o});
+                    out.push_back(oid < qid ? ProxyPair{oid, qid} : ProxyPair{qid, oid});
                 return true;
             },
             nullptr);
@@ -33,10 +36,11 @@ void collect_moved_pairs(const TreeView<T, N, U>& v, std::vector<ProxyId>& buffe
 }
 
 /// One pair step. `prev`: the pairs overlapping after the last step (sorted). `found`: every pair
-/// overlapping now that involves a moved proxy (sorted). touched(id): the proxy moved, was
-/// created or was destroyed since the last step; ended(id): it was destroyed since (its id may be
-/// live again, for a new proxy). A pair of prev with no touched proxy still overlaps; one with a
-/// touched proxy persists only if found again and neither proxy ended. Writes the new set to
+/// overlapping now that involves a moved proxy (sorted). touched(id): the proxy's slot moved, was
+/// created or was destroyed since the last step; ended(id): the slot was destroyed since. A pair of
+/// prev with no touched proxy still overlaps; one with a touched proxy persists only if found again
+/// (the same ids: a slot reused since has a new generation, so its pairs end and begin) and, for
+/// trees loaded from files without generations, neither slot ended. Writes the new set to
 /// `next` and appends the ended and begun pairs (both sorted) to `ends` and `begins`.
 template <class Touched, class Ended>
 void step_pair_set(const std::vector<ProxyPair>& prev, const std::vector<ProxyPair>& found,
@@ -54,7 +58,7 @@ void step_pair_set(const std::vector<ProxyPair>& prev, const std::vector<ProxyPa
         } else if (i == prev.size() || found[j] < prev[i]) {
             begins.push_back(found[j]);
             next.push_back(found[j++]);
-        } else {  // in both: the same ids, but maybe not the same proxies
+        } else {  // in both: the same ids (without generations, maybe not the same proxies)
             const ProxyPair p = found[j++];
             ++i;
             if (ended(p.a) || ended(p.b)) ends.push_back(p), begins.push_back(p);

@@ -23,6 +23,12 @@ struct TreeView {
     std::int32_t root;
 };
 
+/// The id of the proxy in slot `i`: its generation sits in the record the leaf test just read.
+template <class T, std::size_t N, class U>
+inline ProxyId proxy_id(const TreeView<T, N, U>& t, std::int32_t i) {
+    return ProxyId(i, t.proxies[i].generation);
+}
+
 template <class T, std::size_t N, class U>
 inline void prefetch_next(const TreeView<T, N, U>& t, const Node<T, N>& n) {
 #if defined(__GNUC__)
@@ -53,7 +59,7 @@ void query_box(const TreeView<T, N, U>& t, const Aabb<T, N>& box, F&& callback, 
         const Node<T, N>& n = t.nodes[stack.pop()];
         if (n.is_leaf()) {
             ++tested;
-            if (t.proxies[n.value()].box.overlaps(box) && !callback(n.value())) break;
+            if (t.proxies[n.value()].box.overlaps(box) && !callback(proxy_id(t, n.value()))) break;
             continue;
         }
         visited += 2;
@@ -116,9 +122,9 @@ void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, CastInput<T, N> 
             if (seg.entry(t.proxies[n.value()].box, pad, max_fraction) < T(0)) continue;
             T value;
             if constexpr (std::is_invocable_v<F&, const CastInput<T, N>&, ProxyId>)
-                value = callback(std::as_const(in), n.value());
+                value = callback(std::as_const(in), proxy_id(t, n.value()));
             else
-                value = callback(n.value(), max_fraction);
+                value = callback(proxy_id(t, n.value()), max_fraction);
             if (value == T(0)) break;
             if (value > T(0)) max_fraction = value;
         } else {
@@ -152,7 +158,7 @@ void query_tree(const TreeView<T, N, U>& a, const TreeView<T, N, V>& b, F&& call
         if (leaf_a && leaf_b) {
             ++tested;
             if (a.proxies[na.value()].box.overlaps(b.proxies[nb.value()].box) &&
-                !callback(na.value(), nb.value()))
+                !callback(proxy_id(a, na.value()), proxy_id(b, nb.value())))
                 break;
         } else if (leaf_b || (!leaf_a && na.box.area() >= nb.box.area())) {
             stack.push({na.child2, p.b});

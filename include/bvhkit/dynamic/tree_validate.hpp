@@ -63,7 +63,7 @@ void check_leaf(const Node<T, N>& n, std::int32_t i, const std::vector<Proxy<T, 
     const auto broken = [](const std::string& what) {
         throw Error("DynamicTree::validate: " + what);
     };
-    const ProxyId p = n.value();
+    const std::int32_t p = n.value();
     const std::string leaf = "leaf node " + std::to_string(i);
     if (p < 0 || std::size_t(p) >= proxies.size())
         broken(leaf + " has proxy id " + std::to_string(p) + " out of range");
@@ -79,7 +79,7 @@ template <class T, std::size_t N, class U>
 struct ProxyParts {
     const LinkedTree<T, N>& tree;
     const std::vector<Proxy<T, N, U>>& proxies;
-    const std::vector<ProxyId>& move_buffer;
+    const std::vector<std::int32_t>& move_buffer;
     std::int32_t free_proxy;
     std::size_t proxy_count;
     std::size_t leaves;  // leaves in the tree (LinkedTree::validate)
@@ -100,12 +100,16 @@ void validate_proxies(const ProxyParts<T, N, U>& t) {
     if (t.tree.node_count() != (t.leaves == 0 ? 0 : 2 * t.leaves - 1))
         broken("node count: " + std::to_string(t.tree.node_count()) + " nodes in use for " +
                std::to_string(t.leaves) + " leaves");
-    std::size_t live = 0;
+    std::size_t live = 0, retired = 0;
     for (std::int64_t p = 0; p < pcap; ++p) {
         const auto& px = t.proxies[std::size_t(p)];
+        if (px.generation > ProxyId::max_generation)
+            broken("proxy table: slot " + std::to_string(p) + " has generation " +
+                   std::to_string(px.generation) + " past the largest");
         if (px.node == kNullNode) {
             if (px.moved)
                 broken("proxy table: free proxy " + std::to_string(p) + " is marked moved");
+            retired += px.generation == ProxyId::max_generation;
             continue;
         }
         ++live;
@@ -123,19 +127,23 @@ void validate_proxies(const ProxyParts<T, N, U>& t) {
             broken("proxy free list: id " + std::to_string(p) + " out of range");
         if (t.proxies[std::size_t(p)].node != kNullNode)
             broken("proxy free list: proxy " + std::to_string(p) + " is live");
+        if (t.proxies[std::size_t(p)].generation == ProxyId::max_generation)
+            broken("proxy free list: slot " + std::to_string(p) +
+                   " is retired (its generation "
+                   "is the largest) but listed");
         if (++free_proxies > t.proxies.size()) broken("proxy free list has a cycle");
     }
-    if (free_proxies + t.proxy_count != t.proxies.size())
+    if (free_proxies + retired + t.proxy_count != t.proxies.size())
         broken("proxy free list: " + std::to_string(free_proxies) + " free + " +
-               std::to_string(t.proxy_count) + " live != table size " +
-               std::to_string(t.proxies.size()));
+               std::to_string(retired) + " retired + " + std::to_string(t.proxy_count) +
+               " live != table size " + std::to_string(t.proxies.size()));
     // Move buffer: each id in range, flagged, and there once; every moved proxy is in it.
     std::size_t flagged = 0;
     for (const auto& px : t.proxies) {
         flagged += px.buffered;
         if (px.moved && !px.buffered) broken("move buffer: a moved proxy is not in it");
     }
-    for (const ProxyId id : t.move_buffer)
+    for (const std::int32_t id : t.move_buffer)
         if (id < 0 || id >= pcap || !t.proxies[std::size_t(id)].buffered)
             broken("move buffer: id " + std::to_string(id) + " is out of range or not flagged");
     if (flagged != t.move_buffer.size())

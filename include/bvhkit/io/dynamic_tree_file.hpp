@@ -13,6 +13,9 @@
 //
 // UserData must be an integer type of at most 8 bytes (the default std::uint64_t is); it is
 // stored as 8 little-endian bytes.
+//
+// Layout 2 holds the proxy ids' generations (each slot's, the floor for new slots, and whole ids in
+// the pair sets); layout 1, written before ids had them, still loads: its ids are generation 0.
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -30,9 +33,16 @@ namespace serial_detail {
 
 template <class T, std::size_t N>
 inline constexpr std::uint64_t dynamic_node_bytes = 2 * N * sizeof(T) + 20;
+// Layout 1 and 2 (which adds the slot's generation, u32).
 template <class T, std::size_t N>
-inline constexpr std::uint64_t dynamic_proxy_bytes = 2 * N * sizeof(T) + 8 + 9;
-inline constexpr std::uint64_t dynamic_pair_bytes = 8;
+inline constexpr std::uint64_t dynamic_proxy_bytes(std::uint8_t layout) {
+    return 2 * N * sizeof(T) + 8 + 9 + (layout >= 2 ? 4 : 0);
+}
+// Layout 1: two i32 slots; layout 2: two u64 ids (ProxyId::bits()).
+inline constexpr std::uint64_t dynamic_pair_bytes(std::uint8_t layout) {
+    return layout >= 2 ? 16 : 8;
+}
+inline constexpr std::uint8_t dynamic_layout = 2;
 // Options and scalars: three T, three bytes, three int32, four uint64, padded.
 template <class T>
 inline constexpr std::uint64_t dynamic_state_bytes = (3 * sizeof(T) + 3 + 12 + 7) / 8 * 8 + 32;
@@ -53,7 +63,8 @@ struct DynamicTreeAccess {
         w.u32(std::uint32_t(tree.root_)), w.u32(std::uint32_t(tree.free_));
         w.u32(std::uint32_t(t.free_proxy_));
         w.pad(8);
-        w.u64(tree.node_count_), w.u64(t.proxy_count_), w.u64(t.pending_ends_.size()), w.u64(0);
+        w.u64(tree.node_count_), w.u64(t.proxy_count_), w.u64(t.pending_ends_.size());
+        w.u64(t.generation_floor_);
         for (const auto& n : tree.nodes_) {
             put_box(w, n.box);
             w.u32(std::uint32_t(n.parent)), w.u32(std::uint32_t(n.child1));
@@ -66,17 +77,18 @@ struct DynamicTreeAccess {
             w.u64(std::uint64_t(p.user_data));
             w.u32(std::uint32_t(p.node)), w.u32(std::uint32_t(p.next_free));
             w.u8(std::uint8_t(p.moved | p.buffered << 1 | p.ended << 2));
+            w.u32(p.generation);
         }
         w.pad(8);
-        for (const ProxyId id : t.move_buffer_) w.u32(std::uint32_t(id));
+        for (const std::int32_t slot : t.move_buffer_) w.u32(std::uint32_t(slot));
         w.pad(8);
         for (const auto* set : {&t.pairs_, &t.pending_ends_})
-            for (const ProxyPair& p : *set) w.u32(std::uint32_t(p.a)), w.u32(std::uint32_t(p.b));
+            for (const ProxyPair& p : *set) w.u64(p.a.bits()), w.u64(p.b.bits());
         TreeFileHeader h;
         h.kind = FileKind::DynamicTree;
         h.scalar = scalar_code<T>();
         h.volume = N == 2 ? VolumeCode::Aabb2 : VolumeCode::Aabb3;
-        h.layout = 1;
+        h.layout = dynamic_layout;
         h.counts = {tree.nodes_.size(), t.proxies_.size(), t.move_buffer_.size(), t.pairs_.size()};
         return seal_tree_file(h, w.bytes());
     }
@@ -88,11 +100,12 @@ struct DynamicTreeAccess {
         const OpenedTreeFile f = open_tree_file(file, FileKind::DynamicTree, what);
         const TreeFileHeader& h = f.header;
         check_kind(h, N == 2 ? VolumeCode::Aabb2 : VolumeCode::Aabb3, scalar_code<T>());
+        const std::uint8_t layout = h.layout;
         const auto [node_count, proxy_count, buffer_count, pair_count] = h.counts;
         const std::uint64_t limit = f.payload.size();
         std::uint64_t need = dynamic_state_bytes<T>;
         need += section_bytes(node_count, dynamic_node_bytes<T, N>, limit, what, "node");
-        need += section_bytes(proxy_count, dynamic_proxy_bytes<T, N>, limit, what, "proxy");
+        need += section_bytes(proxy_count, dynamic_proxy_bytes<T, N>(layout), limit, what, "proxy");
         need += section_bytes(buffer_count, 4, limit, what, "move buffer");
         if (node_count > std::uint64_t(INT32_MAX) || proxy_count > std::uint64_t(INT32_MAX))
             throw Error(std::string(what) + ": more than 2^31 nodes or proxies");
@@ -105,23 +118,27 @@ struct DynamicTreeAccess {
         r.skip_padding(8);
         tree.node_count_ = r.u64(), t.proxy_count_ = r.u64();
         const std::uint64_t end_count = r.u64();
-        if (r.u64() != 0) r.fail("reserved field is not zero");
+        const std::uint64_t floor = r.u64();
+        if (layout < 2 && floor != 0) r.fail("reserved field is not zero");
+        if (floor > ProxyId::max_generation) r.fail("a generation floor past the largest");
+        t.generation_floor_ = std::uint32_t(floor);
+        const std::uint64_t pair_bytes = dynamic_pair_bytes(layout);
         if (need > limit ||
-            section_bytes(pair_count, dynamic_pair_bytes, limit - need, what, "pair") +
-                    section_bytes(end_count, dynamic_pair_bytes, limit - need, what, "ended pair") >
+            section_bytes(pair_count, pair_bytes, limit - need, what, "pair") +
+                    section_bytes(end_count, pair_bytes, limit - need, what, "ended pair") >
                 limit - need)
             r.fail("the counts claim more than the file's " + std::to_string(limit) + " bytes");
         tree.nodes_.resize(node_count);
         for (auto& n : tree.nodes_) read_node(r, n);
         r.skip_padding(8);
         t.proxies_.resize(proxy_count);
-        for (auto& p : t.proxies_) read_proxy(r, p);
+        for (auto& p : t.proxies_) read_proxy(r, p, layout);
         r.skip_padding(8);
         t.move_buffer_.resize(buffer_count);
-        for (ProxyId& id : t.move_buffer_) id = ProxyId(r.u32());
+        for (std::int32_t& slot : t.move_buffer_) slot = std::int32_t(r.u32());
         r.skip_padding(8);
-        read_pairs(r, t.pairs_, pair_count, proxy_count, true);
-        read_pairs(r, t.pending_ends_, end_count, proxy_count, false);
+        read_pairs(r, t.pairs_, pair_count, proxy_count, layout, true);
+        read_pairs(r, t.pending_ends_, end_count, proxy_count, layout, false);
         if (r.remaining() != 0) r.fail("bytes left after the last section");
         try {
             t.validate();
@@ -141,7 +158,7 @@ struct DynamicTreeAccess {
             throw Error(std::string(what) + ": the file holds " +
                         scalar_name(std::uint8_t(h.scalar)) + " coordinates, " +
                         scalar_name(std::uint8_t(scalar)) + " were asked for");
-        if (h.layout != 1)
+        if (h.layout != 1 && h.layout != dynamic_layout)
             throw Error(std::string(what) + ": unknown layout " + std::to_string(int(h.layout)));
     }
 
@@ -199,7 +216,7 @@ struct DynamicTreeAccess {
         if (height >= 0) check_box(r, n.box);
     }
     template <class T, std::size_t N, class U>
-    static void read_proxy(ByteReader& r, dynamic_detail::Proxy<T, N, U>& p) {
+    static void read_proxy(ByteReader& r, dynamic_detail::Proxy<T, N, U>& p, std::uint8_t layout) {
         p.box = get_box<T, N>(r);
         const std::uint64_t user = r.u64();
         if (std::uint64_t(U(user)) != user) r.fail("user data out of the UserData type's range");
@@ -208,18 +225,33 @@ struct DynamicTreeAccess {
         const std::uint8_t flags = r.u8();
         if (flags > 7) r.fail("unknown proxy flags");
         p.moved = flags & 1, p.buffered = flags >> 1 & 1, p.ended = flags >> 2 & 1;
+        // validate() checks the range. Layout 1 named a proxy by its slot alone: a live one keeps
+        // that id (generation 0); a free slot's next proxy gets generation 1, so an id its old
+        // proxy left behind (in the caller's hands, or in the pair sets) is stale.
+        if (layout >= 2)
+            p.generation = r.u32();
+        else
+            p.generation = p.node == dynamic_detail::kNullNode ? 1 : 0;
         if (p.node != dynamic_detail::kNullNode) check_box(r, p.box);
     }
     /// Pairs with ids in the table and a < b; the current set also strictly sorted (the pair step
     /// merges it as a sorted list).
     static void read_pairs(ByteReader& r, std::vector<ProxyPair>& out, std::uint64_t count,
-                           std::uint64_t proxies, bool sorted) {
+                           std::uint64_t proxies, std::uint8_t layout, bool sorted) {
         out.resize(count);
+        const auto id = [&] {
+            if (layout < 2) return ProxyId(std::int32_t(r.u32()), 0);
+            return ProxyId::from_bits(r.u64());
+        };
+        const auto in_table = [&](ProxyId x) {
+            return x.index() >= 0 && std::uint64_t(x.index()) < proxies &&
+                   x.generation() <= ProxyId::max_generation;
+        };
         for (std::size_t i = 0; i < out.size(); ++i) {
             ProxyPair& p = out[i];
-            p.a = ProxyId(r.u32()), p.b = ProxyId(r.u32());
-            if (p.a < 0 || p.b <= p.a || std::uint64_t(p.b) >= proxies)
-                r.fail("a pair (" + std::to_string(p.a) + ", " + std::to_string(p.b) +
+            p.a = id(), p.b = id();
+            if (!in_table(p.a) || !in_table(p.b) || !(p.a < p.b))
+                r.fail("a pair (" + to_string(p.a) + ", " + to_string(p.b) +
                        ") that is not two proxy ids in order");
             if (sorted && i > 0 && !(out[i - 1] < p)) r.fail("the pair set is not sorted");
         }
