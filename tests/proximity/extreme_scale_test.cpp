@@ -88,7 +88,7 @@ void check_scale(const TriangleMesh& unit, double scale, double offset, std::siz
 template <class T>
 void across_the_range(int lowest, int highest, int step, double offset_sizes) {
     const TriangleMesh unit = make_sphere(1);  // 80 triangles
-    const std::size_t points = test::scaled(16, 2);
+    const std::size_t points = test::scaled(16, 4);
     std::uint64_t seed = 1;
     for (int k = lowest; k <= highest; k += step) {
         const double scale = std::pow(10.0, k);
