@@ -250,7 +250,7 @@ class Scene {
             const MeshPoint<T> c = scratch.previous = sdf_->closest_point_mesh().closest_point(
                 p, scratch.previous, scratch.nearest, max2);
             const T nan = std::numeric_limits<T>::quiet_NaN();
-            dp[i] = c ? std::sqrt(c.distance_squared) : std::numeric_limits<T>::infinity();
+            dp[i] = c ? c.distance : std::numeric_limits<T>::infinity();
             for (int a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;
             fp[i] = c ? std::int64_t(c.triangle) : -1;
             bp[3 * i] = c ? T(1) - c.u - c.v : T(0);
@@ -274,7 +274,7 @@ class Scene {
             points(pts, threads, true, true, [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
                 const MeshPoint<T> c = scratch.previous =
                     sdf_->closest_point_mesh().closest_point(p, scratch.previous, scratch.nearest);
-                const T d = c ? std::sqrt(c.distance_squared) : std::numeric_limits<T>::infinity();
+                const T d = c ? c.distance : std::numeric_limits<T>::infinity();
                 op[i] = winding_->inside(p) ? -d : d;
             });
         } else {

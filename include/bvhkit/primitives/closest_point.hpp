@@ -193,7 +193,10 @@ AccurateClosestPoint<T> closest_point_accurate(const Triangle<T>& tri, const Acc
         py >= W(0) && (cx - l1) * py - cy * (px - l1) >= W(0) && cy * px - cx * py >= W(0);
     if (inside) {
         r.distance_squared = pz * pz;
-        r.point = q - z * pz;
+        // p less its height rounds in proportion to |p|; the corner plus the in-plane offset, to
+        // the corner and the triangle: the second is the smaller where p is farther from the
+        // plane than the triangle is long (a far point's foot stays on the triangle).
+        r.point = std::fabs(pz) > l1 ? c[a] + f.x * px + f.y * py : q - z * pz;
         W w[3];
         w[cc] = py / cy;
         w[b] = (px - w[cc] * cx) / l1;
@@ -202,10 +205,21 @@ AccurateClosestPoint<T> closest_point_accurate(const Triangle<T>& tri, const Acc
         return r;
     }
     W t[3], d2[3];
-    closest_detail::segment_2d(px, py, W(0), W(0), l1, W(0), t[0], d2[0]);   // A->B
-    closest_detail::segment_2d(px, py, l1, W(0), cx - l1, cy, t[1], d2[1]);  // B->C
-    closest_detail::segment_2d(px, py, cx, cy, -cx, -cy, t[2], d2[2]);       // C->A
-    const int k = d2[1] < d2[0] ? (d2[2] < d2[1] ? 2 : 1) : (d2[2] < d2[0] ? 2 : 0);
+    const W sx[3] = {W(0), l1, cx}, sy[3] = {W(0), W(0), cy};
+    const W ex[3] = {l1, cx - l1, -cx}, ey[3] = {W(0), cy, -cy};  // A->B, B->C, C->A
+    // The nearest edge. Its squared distance rounds by eps_W d (d + L): from a far point that
+    // is more than the gaps between the edges' distances (1e25 from a unit triangle, in long
+    // double). There the squared distance less px^2 + py^2, which the three share, ranks them:
+    // |X|^2 - 2 (px, py).X, X the edge's closest point, which rounds by eps_W L (L + d). Each
+    // is used where its bound is the smaller: the key beyond twice the longest edge (d > L).
+    const bool far = px * px + py * py > W(4) * l1 * l1;
+    W key[3];
+    for (int e = 0; e < 3; ++e) {
+        closest_detail::segment_2d(px, py, sx[e], sy[e], ex[e], ey[e], t[e], d2[e]);
+        const W x = sx[e] + t[e] * ex[e], y = sy[e] + t[e] * ey[e];
+        key[e] = far ? (x * x + y * y) - W(2) * (px * x + py * y) : d2[e];
+    }
+    const int k = key[1] < key[0] ? (key[2] < key[1] ? 2 : 1) : (key[2] < key[0] ? 2 : 0);
     r.distance_squared = pz * pz + d2[k];
     const int from[3] = {a, b, cc};
     on_edge(from[k], from[(k + 1) % 3], t[k]);

@@ -46,6 +46,10 @@ template <class T>
 struct MeshPoint {
     Vec<T, 3> point{};
     T distance_squared = std::numeric_limits<T>::infinity();
+    /// The distance itself, rounded from the wider type the triangle was measured in: finite and
+    /// non-zero where distance_squared over- or underflows T (a point 1e20 from a float mesh, a
+    /// mesh 1e-25 across).
+    T distance = std::numeric_limits<T>::infinity();
     std::uint32_t triangle = invalid_index;
     T u = 0, v = 0;
     explicit operator bool() const { return triangle != invalid_index; }
@@ -180,17 +184,26 @@ class ClosestPointMesh {
         // The best triangle's answer is kept, not measured again at the end: the triangle
         // measured is tris_[s] bit for bit (a pack's copy only when it unscales exactly).
         AccurateClosestPoint<T> best_point;
+        // Candidates are ranked by their squared distance, which rounds by eps_W d^2: from a
+        // point far off (d beyond twice the mesh's extent) that is more than the gaps between
+        // its triangles' distances (1e16 from a float unit sphere, double's ulp there is 2). The
+        // ranking then uses far_key (see there), which rounds in proportion to the mesh's
+        // extent and coordinates, not to d.
+        const FarFrame far = far_frame(p);
+        W best_key = std::numeric_limits<W>::infinity();
         const auto measure = [&](std::uint32_t s, const Triangle<T>& t) {
             const AccurateClosestPoint<T> c = frames_.empty()
                                                   ? closest_point_accurate(t, p)
                                                   : closest_point_accurate(t, frames_[s], p);
             const W d2 = c.distance_squared;
-            // The limit is judged on the distance as returned (rounded to T). Of triangles at
-            // the same distance the one in the lowest slot wins, whatever the order they were
+            const W key = far.far ? far_key(far, t, c) : d2;
+            // The limit is judged on the distance as returned (rounded to T). Of triangles with
+            // the same key the one in the lowest slot wins, whatever the order they were
             // measured in: every triangle that ties with the best is measured (its estimate is
             // within the slack), so the answer does not depend on where the walk started.
-            if ((d2 < best2 || (d2 == best2 && s < best.slot)) && T(d2) <= max_distance_squared)
-                best = {s, T(d2)}, best2 = d2, best_point = c;
+            if ((key < best_key || (key == best_key && s < best.slot)) &&
+                T(d2) <= max_distance_squared)
+                best = {s, T(d2)}, best2 = d2, best_key = key, best_point = c;
         };
         const auto tighten = [&] {
             T bound = std::min(limit2, widened_scaled(widened_scaled(best_estimate)));
@@ -323,6 +336,18 @@ class ClosestPointMesh {
                 ? std::ldexp(T(1), std::clamp(-std::ilogb(magnitude), -max_shift, max_shift))
                 : T(1);
         scaled_longest_edge_ = longest_edge_ * pack_scale_;
+        // The far points' frame (far_key): the box's centre and squared diagonal, in W.
+        far_origin_ = {};
+        far_extent2_ = 0;
+        if (!bvh_.empty()) {
+            using W = AccurateScalar<T>;
+            const Aabb<T, 3>& box = bvh_.root().bounds;
+            for (int k = 0; k < 3; ++k) {
+                const W lo = W(box.min[k]), hi = W(box.max[k]);
+                far_origin_[k] = lo / 2 + hi / 2;  // halves first: no overflow
+                far_extent2_ += (hi - lo) * (hi - lo);
+            }
+        }
         // A power of two scales exactly unless a coordinate falls into denormals; then the walk
         // measures from tris_ instead.
         packs_.assign(wide_.group_count(), TrianglePack4<T>{});
@@ -337,6 +362,53 @@ class ClosestPointMesh {
             if (!(back.p0 == t.p0 && back.p1 == t.p1 && back.p2 == t.p2))
                 packs_unscale_exactly_ = false;
         }
+    }
+    /// What far_key needs of a query point: whether it is far (its distance to the mesh's box
+    /// above twice the box's diagonal), and p - o in W, o the box's centre.
+    struct FarFrame {
+        bool far = false;
+        Vec<AccurateScalar<T>, 3> from_origin;
+    };
+    FarFrame far_frame(const Vec<T, 3>& p) const {
+        using W = AccurateScalar<T>;
+        FarFrame f;
+        if (bvh_.empty()) return f;
+        const Aabb<T, 3>& box = bvh_.root().bounds;
+        W gap2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            const W g = std::max({W(box.min[k]) - W(p[k]), W(p[k]) - W(box.max[k]), W(0)});
+            gap2 += g * g;
+        }
+        f.far = gap2 > W(4) * far_extent2_;
+        f.from_origin = Vec<W, 3>(p) - far_origin_;
+        return f;
+    }
+    /// The rank of a candidate for a far point p: |p - x|^2 - |p - o|^2 = |y|^2 - 2 (p - o).y
+    /// with x the candidate's closest point and y = x - o, o the mesh box's centre. The common
+    /// |p - o|^2, whose rounding (eps_W d^2) hides the differences, is never formed: y is a
+    /// corner's offset from o (one rounding, of a length within the box) plus the barycentric
+    /// offset (nothing for a corner, so that the triangles around a closest vertex tie exactly
+    /// and the lowest slot wins), and the products round by eps_W d |y|. The closest point is
+    /// the exact one for p moved by rounding (eps_W d), which costs a few eps_W L in distance
+    /// at most: the point found stays within the triangle, and a far point's distance changes
+    /// to first order only along the direction to p. Divided by 2d, the key's error in distance
+    /// is within 128 eps_W (E + L), E the box's diagonal, whatever d (docs/accuracy.md).
+    AccurateScalar<T> far_key(const FarFrame& f, const Triangle<T>& t,
+                              const AccurateClosestPoint<T>& c) const {
+        using W = AccurateScalar<T>;
+        using V = Vec<W, 3>;
+        V y;
+        if (c.u == W(0) && c.v == W(0)) {
+            y = V(t.p0) - far_origin_;
+        } else if (c.u == W(1)) {
+            y = V(t.p1) - far_origin_;
+        } else if (c.v == W(1)) {
+            y = V(t.p2) - far_origin_;
+        } else {
+            const V a(t.p0);
+            y = (a - far_origin_) + (V(t.p1) - a) * c.u + (V(t.p2) - a) * c.v;
+        }
+        return dot(y, y) - W(2) * dot(f.from_origin, y);
     }
     /// `radius2` widened by what rounding can put between a triangle's true distance and the
     /// float bounds on it: the pack's distance, the triangle's box, a node's box. Each is computed
@@ -411,7 +483,11 @@ class ClosestPointMesh {
         return point_of(slot, closest_point_accurate(tris_[slot], p));
     }
     MeshPoint<T> point_of(std::uint32_t slot, const AccurateClosestPoint<T>& c) const {
-        return {Vec<T, 3>(c.point), T(c.distance_squared), bvh_.primitive_indices[slot], T(c.u),
+        return {Vec<T, 3>(c.point),
+                T(c.distance_squared),
+                T(std::sqrt(c.distance_squared)),
+                bvh_.primitive_indices[slot],
+                T(c.u),
                 T(c.v)};
     }
 
@@ -424,6 +500,8 @@ class ClosestPointMesh {
     T pack_scale_ = 1;                      // packs_ hold the triangles times this (a power of 2)
     T scaled_longest_edge_ = 0;             // longest_edge_ * pack_scale_
     bool packs_unscale_exactly_ = true;     // and dividing by it gives tris_ back, bit for bit
+    Vec<AccurateScalar<T>, 3> far_origin_;  // the box's centre, for far_key
+    AccurateScalar<T> far_extent2_ = 0;     // the box's squared diagonal
     std::vector<std::uint32_t> slot_of_triangle_;  // mesh triangle -> leaf slot (or invalid)
     std::uint32_t triangle_slots_ = 0;             // bvh_.primitive_indices.size()
     std::size_t triangle_count_ = 0;

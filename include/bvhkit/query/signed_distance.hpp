@@ -83,16 +83,19 @@ class SignedDistanceMesh {
             const Vec<double, 3> p[3] = {Vec<double, 3>(mesh.vertex(t[0])),
                                          Vec<double, 3>(mesh.vertex(t[1])),
                                          Vec<double, 3>(mesh.vertex(t[2]))};
-            const Vec<double, 3> n = cross(p[1] - p[0], p[2] - p[0]);
-            const double len = length(n);
-            const Vec<double, 3> unit = len > 0 ? n / len : Vec<double, 3>{};
+            // Edges made unit before any product: products of lengths would overflow or sink
+            // to zero for a double mesh near the ends of its range (1e300 or 1e-300 across).
+            const auto unit_of = [](const Vec<double, 3>& v) {
+                const double l = std::hypot(v[0], v[1], v[2]);
+                return l > 0 && std::isfinite(l) ? v / l : Vec<double, 3>{};
+            };
+            const Vec<double, 3> unit = unit_of(cross(unit_of(p[1] - p[0]), unit_of(p[2] - p[0])));
             face_normals_[f] = Vec<T, 3>(unit);
             for (int k = 0; k < 3; ++k) {
-                const Vec<double, 3> a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
-                const double la = length(a), lb = length(b);
-                const double angle = la > 0 && lb > 0
-                                         ? std::acos(std::clamp(dot(a, b) / (la * lb), -1.0, 1.0))
-                                         : 0.0;
+                const Vec<double, 3> a = unit_of(p[(k + 1) % 3] - p[k]),
+                                     b = unit_of(p[(k + 2) % 3] - p[k]);
+                const bool both = length_squared(a) > 0 && length_squared(b) > 0;
+                const double angle = both ? std::acos(std::clamp(dot(a, b), -1.0, 1.0)) : 0.0;
                 vertex_normals_[c[k]] += Vec<T, 3>(unit * angle);
                 const std::uint32_t lo = std::min(c[k], c[(k + 1) % 3]);
                 const std::uint32_t hi = std::max(c[k], c[(k + 1) % 3]);
@@ -124,8 +127,10 @@ class SignedDistanceMesh {
         SignedDistance<T> r;
         r.closest = closest_.closest_point(p, near, scratch);
         if (!r.closest) return {std::numeric_limits<T>::infinity(), r.closest};
-        const T d = std::sqrt(r.closest.distance_squared);
-        r.distance = dot(p - r.closest.point, pseudonormal(r.closest)) < T(0) ? -d : d;
+        const T d = r.closest.distance;
+        // In W: p - point and the products would overflow T for a point near T's maximum.
+        using V = Vec<AccurateScalar<T>, 3>;
+        r.distance = dot(V(p) - V(r.closest.point), V(pseudonormal(r.closest))) < 0 ? -d : d;
         return r;
     }
     SignedDistance<T> signed_distance(const Vec<T, 3>& p) const {
