@@ -136,19 +136,13 @@ void check_rigid_pose(const Transform<T>& pose, const char* where, const char* a
             if (!std::isfinite(double(pose.rotation[i][j])))
                 fail("has a non-finite rotation entry (NaN or infinity); a pose must be finite");
     }
-    const Mat3<double> r(pose.rotation);
-    double worst = 0;
-    for (std::size_t i = 0; i < 3; ++i)
-        for (std::size_t j = 0; j < 3; ++j) {
-            const double d = dot(r.column(i), r.column(j)) - (i == j ? 1.0 : 0.0);
-            worst = std::max(worst, std::fabs(d));
-        }
-    const double det = dot(r.row[0], cross(r.row[1], r.row[2]));
     const double tol = rigid_tolerance<T>();
-    if (worst > tol || std::fabs(det - 1.0) > tol) {
+    if (const double deviation = rigid_deviation(pose.rotation); deviation > tol) {
+        const Mat3<double> r(pose.rotation);
+        const double det = dot(r.row[0], cross(r.row[1], r.row[2]));
         std::ostringstream m;
         m << "is not a rigid motion: its rotation must satisfy R^T R = I and det R = +1 within "
-          << tol << " (found max |R^T R - I| = " << worst << ", det R = " << det
+          << tol << " (found max(|R^T R - I|, |det R - 1|) = " << deviation << ", det R = " << det
           << "); scaled, sheared or mirrored poses are not supported";
         fail(m.str());
     }
