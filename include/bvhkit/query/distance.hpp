@@ -16,6 +16,7 @@
 // then lie on an intersection segment), the others are measured in double. An empty model gives
 // +infinity.
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -81,8 +82,17 @@ DistanceResult<typename V::Scalar> distance(
     const auto& nb_ = b.bvh().nodes;
     const auto ta = a.slot_triangles();
     const auto tb = b.slot_triangles();
-    const T slack = pose_slack(a.scale(), b.scale(), pose_of_b_in_a);
     const PosedTriangles<T> posed(pose_of_b_in_a, b.scale());
+    // The volumes' distance bounds square lengths of the scene in T: where those squares leave
+    // T's range (float models near 1e19 and beyond) a bound can overflow to inf and drop the
+    // closest pair. Such models are measured without pruning (an infinite slack makes every
+    // bound -inf): every pair, exactly; slow, but right.
+    const T reach = a.scale() + b.scale() +
+                    max_component(bvhkit::max(pose_of_b_in_a.translation,
+                                              -pose_of_b_in_a.translation));
+    const T slack = std::isfinite(T(16) * reach * reach)
+                        ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a)
+                        : std::numeric_limits<T>::infinity();
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
     const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
     // The best squared distance is kept in double (finite for any finite float input: a float
