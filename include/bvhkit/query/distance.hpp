@@ -87,9 +87,9 @@ DistanceResult<typename V::Scalar> distance(
     // T's range (float models near 1e19 and beyond) a bound can overflow to inf and drop the
     // closest pair. Such models are measured without pruning (an infinite slack makes every
     // bound -inf): every pair, exactly; slow, but right.
-    const T reach = a.scale() + b.scale() +
-                    max_component(bvhkit::max(pose_of_b_in_a.translation,
-                                              -pose_of_b_in_a.translation));
+    const T reach =
+        a.scale() + b.scale() +
+        max_component(bvhkit::max(pose_of_b_in_a.translation, -pose_of_b_in_a.translation));
     const T slack = std::isfinite(T(16) * reach * reach)
                         ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a)
                         : std::numeric_limits<T>::infinity();
