@@ -87,10 +87,10 @@ DistanceResult<typename V::Scalar> distance(
     // T's range (float models near 1e19 and beyond) a bound can overflow to inf and drop the
     // closest pair. Such models are measured without pruning (an infinite slack makes every
     // bound -inf): every pair, exactly; slow, but right.
-    const T reach =
+    const T extent =
         a.scale() + b.scale() +
         max_component(bvhkit::max(pose_of_b_in_a.translation, -pose_of_b_in_a.translation));
-    const T slack = std::isfinite(T(16) * reach * reach)
+    const T slack = std::isfinite(T(16) * extent * extent)
                         ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a)
                         : std::numeric_limits<T>::infinity();
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
