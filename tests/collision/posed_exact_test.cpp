@@ -148,9 +148,9 @@ TEST(PosedExact, FloatNearTouchingPairsMatchTheExactPoseAcrossScales) {
 
 TEST(PosedExact, DoubleNearTouchingPairsMatchTheExactPoseAcrossScales) {
     std::size_t meeting = 0, flipped = 0;
-    // Coordinates 1e-75 to 1e81: the predicates' double range (differences within 2^+-300) and
-    // where Obb trees still find every contact (at 1e86 they lose them all, in the volume test).
-    check_scales<double>(-75, 75, 15, 1e6, meeting, flipped);
+    // Sizes 1e-90 to 1e90 (coordinates to 1e96): the predicates' double range, differences
+    // within 2^+-300; Aabb and Obb trees find every contact across it.
+    check_scales<double>(-90, 90, 15, 1e6, meeting, flipped);
     EXPECT_GT(meeting, 0u);
     EXPECT_GT(flipped, 0u);
 }

@@ -198,17 +198,12 @@ void collision_all(const BasicTriangleMesh<T>& mesh, double scale) {
     collision<Kdop<T, 14>>(mesh, scale, "kdop14");
     collision<Kdop<T, 18>>(mesh, scale, "kdop18");
     collision<Kdop<T, 26>>(mesh, scale, "kdop26");
-    // Known limits of the double fits, not of the loader: the RSS fit's squared radius (rss.hpp)
-    // and the hull's GJK distances (convex_hull.hpp) square coordinates in double, so from about
-    // 1e150 (hull also below 1e-150) their volumes do not hold every vertex, and the loader
-    // rightly refuses them; the OBB fit's extents at half DBL_MAX likewise. Float covers all.
-    const bool huge = sizeof(T) == 8 && scale > 1e150, tiny = sizeof(T) == 8 && scale < 1e-149;
-    const bool top = scale > double(std::numeric_limits<T>::max()) / 4;
-    if (!(sizeof(T) == 8 && top)) collision<Obb<T>>(mesh, scale, "obb");
-    if (!huge) collision<Rss<T>>(mesh, scale, "rss");
-    if (!huge) collision<ObbRss<T>>(mesh, scale, "obbrss");
-    if (!huge && !tiny && !(sizeof(T) == 8 && scale > 1e149))
-        collision<ConvexHull<T>>(mesh, scale, "hull");
+    // The oriented fits square coordinates (RSS radius budgets, hull distances, Quickhull's
+    // orientations) or sum them (OBB extents at half the largest value): every scale here.
+    collision<Obb<T>>(mesh, scale, "obb");
+    collision<Rss<T>>(mesh, scale, "rss");
+    collision<ObbRss<T>>(mesh, scale, "obbrss");
+    collision<ConvexHull<T>>(mesh, scale, "hull");
 }
 
 template <class T>

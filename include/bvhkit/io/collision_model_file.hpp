@@ -160,10 +160,13 @@ struct VolumeCodec<Obb<T>> {
         return finite_vec(v.center) && orthonormal(v.axes) && size_ok(v.extents[0]) &&
                size_ok(v.extents[1]) && size_ok(v.extents[2]);
     }
+    // In halves (exact outside denormals, which tol's floor covers): p - centre and its
+    // projections pass DBL_MAX for a double model at the top of the range, where the halves' do
+    // not.
     static bool contains(const V& v, const Vec3d& p, double tol) {
-        const Vec3d q = Mat3<double>(v.axes) * (p - Vec3d(v.center));
+        const Vec3d q = Mat3<double>(v.axes) * (p * 0.5 - Vec3d(v.center) * 0.5);
         for (std::size_t a = 0; a < 3; ++a)
-            if (!(std::fabs(q[a]) <= double(v.extents[a]) + tol)) return false;
+            if (!(std::fabs(q[a]) <= double(v.extents[a]) * 0.5 + tol * 0.5)) return false;
         return true;
     }
 };
@@ -190,11 +193,12 @@ struct VolumeCodec<Rss<T>> {
         return finite_vec(v.center) && orthonormal(v.axes) && size_ok(v.half[0]) &&
                size_ok(v.half[1]) && size_ok(v.radius);
     }
+    // In halves, as for the box.
     static bool contains(const V& v, const Vec3d& p, double tol) {
-        const Vec3d q = Mat3<double>(v.axes) * (p - Vec3d(v.center));
-        const double dx = std::max(std::fabs(q[0]) - double(v.half[0]), 0.0);
-        const double dy = std::max(std::fabs(q[1]) - double(v.half[1]), 0.0);
-        return wide_length(Vec3d(dx, dy, q[2])) <= double(v.radius) + tol;
+        const Vec3d q = Mat3<double>(v.axes) * (p * 0.5 - Vec3d(v.center) * 0.5);
+        const double dx = std::max(std::fabs(q[0]) - double(v.half[0]) * 0.5, 0.0);
+        const double dy = std::max(std::fabs(q[1]) - double(v.half[1]) * 0.5, 0.0);
+        return wide_length(Vec3d(dx, dy, q[2])) <= double(v.radius) * 0.5 + tol * 0.5;
     }
 };
 

@@ -32,6 +32,21 @@ double wide_length(const Vec<T, N>& v) {
     return std::ldexp(std::sqrt(s), k);
 }
 
+/// The power of two 2^k to divide coordinates of magnitude up to m by before squaring them in
+/// double: 0 (no scaling, results bit for bit as before) while m lies in [2^-256, 2^256], where
+/// sums of squares and of products of three such values neither overflow nor sink into
+/// denormals, and their differences stay within the exact predicates' 2^+-300; else a k that
+/// brings m to about 2^250 from above (scaling down: tinier coordinates in the same set keep more
+/// bits than scaling to 1 would) or to about 1 from below (scaling up is exact). Not for
+/// products of four (they overflow from 2^256).
+inline int squaring_exponent(double m) {
+    if (!(m > 0) || !std::isfinite(m)) return 0;
+    const int e = std::ilogb(m);
+    if (e > 256) return e - 250;
+    if (e < -256) return e;
+    return 0;
+}
+
 /// x rounded to T: to nearest, inf beyond T's largest finite value (rather than the undefined
 /// conversion of an out-of-range double).
 template <class T>

@@ -135,9 +135,40 @@ T round_up(double x) {
 /// distance is an upper bound and the candidates wait in a max-heap until their turn). Adds the
 /// largest distance of a vertex left out to `margin`.
 template <class T>
+std::vector<std::uint32_t> select_farthest_as_given(std::span<const Vec<T, 3>> points,
+                                                    const std::vector<std::uint32_t>& hull,
+                                                    std::size_t cap, double& margin);
+
+/// The distances square coordinates in double, which overflows for a double model beyond about
+/// 1e154 and sinks below 1e-154: there the points are divided by a power of two first (exact but
+/// for coordinates far below the rest, which move by less than the fit's pads) and the margin
+/// multiplied back.
+template <class T>
 std::vector<std::uint32_t> select_farthest(std::span<const Vec<T, 3>> points,
                                            const std::vector<std::uint32_t>& hull, std::size_t cap,
                                            double& margin) {
+    if constexpr (sizeof(T) > sizeof(float)) {
+        double m = 0;
+        for (std::uint32_t i : hull)
+            for (std::size_t a = 0; a < 3; ++a) m = std::max(m, std::fabs(double(points[i][a])));
+        if (const int k = squaring_exponent(m); k != 0) {
+            std::vector<Vec<T, 3>> scaled(points.size());
+            const T unit = T(std::ldexp(1.0, -k));
+            for (std::uint32_t i : hull) scaled[i] = points[i] * unit;
+            double added = 0;
+            std::vector<std::uint32_t> keep =
+                select_farthest_as_given<T>(std::span<const Vec<T, 3>>(scaled), hull, cap, added);
+            margin += std::ldexp(added, k);
+            return keep;
+        }
+    }
+    return select_farthest_as_given<T>(points, hull, cap, margin);
+}
+
+template <class T>
+std::vector<std::uint32_t> select_farthest_as_given(std::span<const Vec<T, 3>> points,
+                                                    const std::vector<std::uint32_t>& hull,
+                                                    std::size_t cap, double& margin) {
     std::vector<std::uint32_t> keep;
     std::vector<Vec<T, 3>> kept;
     auto take = [&](std::uint32_t i) {

@@ -74,8 +74,10 @@ Obb<T> obb_around(const Mat3<double>& axes, ForEachPoint&& for_each_point) {
     if (!(lo[0] <= hi[0])) return o;
     const Vec3d mid = (lo + hi) * 0.5;
     const Vec3d c = axes.transpose_times(mid) * 2.0;
-    const double scale = max_component(max(hi, -lo)) * 2.0 + max_component(max(c, -c));
-    const Vec3d e = (hi - lo) + Vec3d(scale * double(fit_pad<T>));
+    // The coordinates' scale, halved too (the whole of it passes DBL_MAX at the top of the
+    // range); the pad is the same product, as doubling is exact.
+    const double half_scale = max_component(max(hi, -lo)) + max_component(max(c, -c)) * 0.5;
+    const Vec3d e = (hi - lo) + Vec3d(half_scale * (2.0 * double(fit_pad<T>)));
     o.center = Vec<T, 3>(c);
     o.axes = Mat3<T>(axes);
     o.extents = Vec<T, 3>(e);

@@ -22,6 +22,7 @@
 
 #include "bvhkit/math/predicates.hpp"
 #include "bvhkit/math/vec.hpp"
+#include "bvhkit/math/wide_length.hpp"
 
 namespace bvhkit {
 
@@ -301,8 +302,29 @@ class Quickhull {
 
 /// Indices of the hull's vertices among `sorted_unique` (sorted lexicographically, no
 /// duplicates): every input point lies in their convex hull, exactly.
+///
+/// The orientation tests are exact only for coordinate differences within 2^±300 (predicates.hpp):
+/// a double model beyond about 1e77 or below 1e-77 is divided by a power of two first (an exact,
+/// order-keeping scaling), unless that would merge points (coordinates far below the rest sinking
+/// into denormals), where the points are taken as they are.
 template <class T>
 std::vector<std::uint32_t> quickhull_vertices(std::span<const Vec<T, 3>> sorted_unique) {
+    if constexpr (sizeof(T) > sizeof(float)) {
+        double m = 0;
+        for (const Vec<T, 3>& p : sorted_unique)
+            for (std::size_t a = 0; a < 3; ++a) m = std::max(m, std::fabs(double(p[a])));
+        if (const int k = squaring_exponent(m); k != 0) {
+            std::vector<Vec<T, 3>> scaled(sorted_unique.size());
+            const T unit = T(std::ldexp(1.0, -k));
+            bool distinct = true;
+            for (std::size_t i = 0; i < scaled.size(); ++i) {
+                scaled[i] = sorted_unique[i] * unit;
+                if (i > 0 && scaled[i] == scaled[i - 1]) distinct = false;
+            }
+            if (distinct)
+                return hull_detail::Quickhull<T>(std::span<const Vec<T, 3>>(scaled)).vertices();
+        }
+    }
     return hull_detail::Quickhull<T>(sorted_unique).vertices();
 }
 

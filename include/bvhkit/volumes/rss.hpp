@@ -12,6 +12,7 @@
 #include <algorithm>
 
 #include "bvhkit/math/select.hpp"
+#include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/volumes/obb.hpp"
 
 namespace bvhkit {
@@ -262,9 +263,31 @@ struct VolumeTraits<Rss<T>> {
     /// thickness along it; then each rectangle side is pulled in as far as every point stays
     /// within the radius: first x with a point's whole remaining budget sqrt(r² - z²), then y
     /// with what x left it, so no point ends farther than r from the rectangle.
+    ///
+    /// The squares r², z² and x² overflow double for coordinates beyond about 1e154 and sink for
+    /// ones below 1e-154: there the points are divided by a power of two 2^k first (exact but for
+    /// coordinates far below the rest, which sink into denormals by less than the pad) and the
+    /// volume's sizes multiplied back.
     template <class ForEachPoint>
     static V around(const Mat3<double>& frame, const Vec<T, 3>& extents,
                     ForEachPoint&& for_each_point) {
+        int k = 0;
+        if constexpr (sizeof(T) > sizeof(float)) {  // float coordinates square safely in double
+            double m = 0;
+            for_each_point(
+                [&](const Vec3d& p) { m = std::max(m, max_component(bvhkit::max(p, -p))); });
+            k = squaring_exponent(m);
+        }
+        if (k == 0) return around_scaled(frame, extents, for_each_point, 0);
+        const double unit = std::ldexp(1.0, -k);
+        return around_scaled(
+            frame, extents, [&](auto&& f) { for_each_point([&](const Vec3d& p) { f(p * unit); }); },
+            k);
+    }
+    /// around() on points divided by 2^k (k = 0: as given); the volume is multiplied back.
+    template <class ForEachPoint>
+    static V around_scaled(const Mat3<double>& frame, const Vec<T, 3>& extents,
+                           ForEachPoint&& for_each_point, int k) {
         int normal = 0;
         for (int i = 1; i < 3; ++i)
             if (extents[i] < extents[normal]) normal = i;
@@ -311,11 +334,12 @@ struct VolumeTraits<Rss<T>> {
         // Rounding of the sums above and of storing in T: widen the radius by a few ulps of the
         // coordinates' scale.
         const double pad = (scale + max_component(bvhkit::max(c, -c))) * double(detail::fit_pad<T>);
-        v.center = Vec<T, 3>(c);
+        const auto back = [k](double x) { return k == 0 ? x : std::ldexp(x, k); };
+        v.center = Vec<T, 3>(Vec3d(back(c[0]), back(c[1]), back(c[2])));
         v.axes = Mat3<T>(axes);
-        v.half[0] = T((xhi - xlo) * 0.5);
-        v.half[1] = T((yhi - ylo) * 0.5);
-        v.radius = T(r + pad);
+        v.half[0] = T(back((xhi - xlo) * 0.5));
+        v.half[1] = T(back((yhi - ylo) * 0.5));
+        v.radius = T(back(r + pad));
         return v;
     }
 };
