@@ -1,5 +1,6 @@
 // `bvhkit render`: a picture of a mesh through its BVH, shaded, or as a heat map of the traversal
-// cost (BVH nodes visited per ray) with its colour scale: the picture BVH users look at to judge a tree.
+// cost (BVH nodes visited per ray) with its colour scale: the picture BVH users look at to judge a
+// tree.
 #include <algorithm>
 #include <chrono>
 #include <cmath>

@@ -61,21 +61,11 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
                                 IndexAtSlot&& index_at_slot) {
     WideRayBvh<W> out;
     // Every node's lanes filled (collapse_to_wide's fill_lanes), and a lane of up to leaf_limit
-    // triangles not opened further is a leaf child. Against leaf limit 8 without filling (3.7
-    // lanes an eight-wide node on igea, 16k nodes, 4.2 MB), 1M random rays, closest hit, against
-    // Embree 3 in the same run: eight wide, igea 0.72-0.81x -> 0.88-0.97x, bunny 0.69x ->
-    // 0.74-0.77x, spot, dragon and teapot +1-4%; four wide, igea 0.67-0.71x -> 0.79-0.80x
-    // (occlusion 0.74-0.78x -> 0.91-1.04x), bunny, spot and dragon within noise. Leaf limits 16-32
-    // measured within noise of 24. (Four wide without filling, leaf limit 2 / 4 / 8 / 16, ms: igea
-    // 861 / 736 / 637 / 583, spot 296 (4) / 268 (8) / 273 (16); the binary walk 853 and 380.)
-    // Eight wide, leaves in blocks of four (2026-11-26, 1M random rays, one thread): leaf limit
-    // 24 / 48 / 64, closest hit, ms: the 1.3M-triangle displaced sphere 586 / 456-489 / 458,
-    // bunny 141-143 / 141-143 / 144-146, igea 246 / 241-247 / 244-250; R1 and occlusion within
-    // noise on bunny and igea, the sphere's occlusion 517 / 384-407. Once the tree outgrows the
-    // caches, a node costs more than the groups of a larger leaf, which lie side by side. Four
-    // wide, 48 was mixed (bunny 5% faster, the sphere 6% slower): it keeps 24. With the tree's
-    // leaves priced in blocks of eight (2026-11-27, 500,000 rays), 32 / 48 / 64 on igea R2:
-    // 130-133 / 119-121 / 119-120 ms, bunny and the 5k sphere within noise.
+    // triangles not opened further is a leaf child. Why these limits: once the tree outgrows the
+    // caches, a node costs more than the groups of a larger leaf, which lie side by side, so the
+    // eight-wide layout takes large leaves; the four-wide one, whose groups are half as wide, gains
+    // less from them and keeps 24. The measurements behind both are in docs/rays.md ("Leaf
+    // limits"; `bvhkit bench rays` on the bunny, igea and the displaced sphere).
     constexpr std::uint32_t leaf_limit = W == 8 ? 48 : 24;
     const WideBvh<float, W> wide = collapse_to_wide<float, W>(bvh, leaf_limit, true);
     out.nodes.resize(wide.nodes.size());

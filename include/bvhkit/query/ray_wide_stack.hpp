@@ -7,7 +7,7 @@
 // hit children at once, with no branch on how many they are or on their order: the branches of a
 // push one by one (the number of hit children, which of two is nearer, where an entry goes in the
 // stack) are taken by the data, and were 3.6 of a random ray's 7.9 mispredicted branches on the
-// bunny (callgrind's branch simulation; docs/rays.md, "Stop 35"). Their stack holds its
+// bunny (callgrind's branch simulation; docs/rays.md). Their stack holds its
 // entries one array per field, so that eight entries go on in one vector store a field, in the
 // order a sorting network gives them (a bitonic network of six compare-exchange layers, Batcher
 // 1968).
@@ -137,9 +137,9 @@ struct WideStack8 {
 
 /// Asks for the first line of the entry on top of a stack of `size` entries (slot 0 when it is
 /// empty): the one the walk pops next, whose line then arrives while the walk is still below
-/// the current entry. Asked after every push and pop of the one-ray eight-wide walk: random rays
-/// on the bunny 2-3% faster (closest and any hit), igea 4%; camera rays, which find their lines in
-/// the caches, 1-3% slower (docs/rays.md, "Stop 36").
+/// the current entry. Asked after every push and pop of the one-ray eight-wide walk: random rays,
+/// whose next entry is rarely in the caches, gain more than camera rays, which find their lines
+/// there, lose (measured in docs/rays.md).
 template <class Line>
 [[gnu::always_inline]] inline void ask_for_top8(const WideStack8& stack, std::uint32_t size,
                                                 Line&& line) {
