@@ -128,14 +128,7 @@ inline Filtered decide_within(const Vec<double, 3>* u, const Vec<double, 3>* v, 
         if (du[i] == 0) return Filtered::Undecided;
     }
     if (du[0] == du[1] && du[1] == du[2]) return Filtered::None;
-    int su = 0, sv = 0;
-    const int iu = apex(du, su), iv = apex(dv, sv);
-    for (int k = 0; k < 3; ++k) {
-        a[k] = u[(iu + k) % 3];
-        b[k] = v[(iv + k) % 3];
-    }
-    if (su < 0) std::swap(b[1], b[2]);
-    if (sv < 0) std::swap(a[1], a[2]);
+    to_apexes(u, v, du, dv, a, b);
     const int o1 = orient3d_within(a[0], a[1], b[0], b[1], 0, 0, e, e);
     if (o1 == 0) return Filtered::Undecided;
     if (o1 > 0) return Filtered::None;

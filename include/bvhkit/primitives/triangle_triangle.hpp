@@ -165,6 +165,21 @@ inline int apex(const int* d, int& s) {
     return 0;  // not reached for the inputs described
 }
 
+/// Guigue-Devillers' reordering: a = u rotated so its apex (apex(), from du: u's corners'
+/// sides of v's plane) comes first, b = v likewise from dv, and each one's last two corners
+/// swapped where the other's apex is on the negative side, so both apexes read as positive.
+template <class P>
+void to_apexes(const P* u, const P* v, const int* du, const int* dv, P* a, P* b) {
+    int su = 0, sv = 0;
+    const int iu = apex(du, su), iv = apex(dv, sv);
+    for (int k = 0; k < 3; ++k) {
+        a[k] = u[(iu + k) % 3];
+        b[k] = v[(iv + k) % 3];
+    }
+    if (su < 0) std::swap(b[1], b[2]);
+    if (sv < 0) std::swap(a[1], a[2]);
+}
+
 enum class Meet { None, Crossing, General };
 
 /// The exact decision. On Crossing, a[0..2] and b[0..2] are the triangles reordered so that
@@ -181,14 +196,7 @@ Meet decide(const P* u, const P* v, P* a, P* b) {
     // are not coplanar. Guigue-Devillers: rotate each so its apex comes first, flip the other's
     // orientation so that the apex is on the positive side; the cuts overlap exactly when
     // orient(a0, a1, b0, b1) <= 0 and orient(a0, a2, b2, b0) <= 0.
-    int su = 0, sv = 0;
-    const int iu = apex(du, su), iv = apex(dv, sv);
-    for (int k = 0; k < 3; ++k) {
-        a[k] = u[(iu + k) % 3];
-        b[k] = v[(iv + k) % 3];
-    }
-    if (su < 0) std::swap(b[1], b[2]);
-    if (sv < 0) std::swap(a[1], a[2]);
+    to_apexes(u, v, du, dv, a, b);
     if (orient3d_sign(a[0], a[1], b[0], b[1]) > 0) return Meet::None;
     if (orient3d_sign(a[0], a[2], b[2], b[0]) > 0) return Meet::None;
     return Meet::Crossing;
