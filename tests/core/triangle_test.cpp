@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdlib>
+
 #include "bvhkit/primitives/segment.hpp"
 #include "bvhkit/primitives/triangle.hpp"
 #include "random_geometry.hpp"
@@ -99,6 +102,56 @@ TEST(Watertight, RaysThroughASharedEdgeNeverSlipBetween) {
     }
     std::printf("Moller-Trumbore slipped through a shared edge on %d of 100000 rays\n",
                 fast_misses);
+}
+
+TEST(Watertight, DoubleHitsAtEveryScale) {
+    // The triangle (0, 0, z), (L, 0, z), (0, L, z) and a ray from (L/4, L/4, 0) along (0, 0, m),
+    // with L, z and m powers of two across double's range: t = z / m and u = v = 1/4 exactly.
+    // Without the scaled path the edge functions (L^2) and t's numerator (L^2 z) leave the range.
+    int tested = 0;
+    for (int a = -1000; a <= 1000; a += 50)
+        for (int b = -1000; b <= 1000; b += 50)
+            for (int c = -1000; c <= 1000; c += 50) {
+                if (std::abs(b - c) > 1000) continue;  // t itself must be a normal double
+                const double L = std::ldexp(1.0, a), z = std::ldexp(1.0, b),
+                             m = std::ldexp(1.0, c);
+                const Triangled tri{{0, 0, z}, {L, 0, z}, {0, L, z}};
+                const Ray<double, 3> ray({L / 4, L / 4, 0}, {0, 0, m});
+                const auto h = tri.intersect_watertight(ray);
+                ASSERT_TRUE(h) << "L 2^" << a << " z 2^" << b << " m 2^" << c;
+                ASSERT_EQ(h->t, std::ldexp(1.0, b - c)) << a << " " << b << " " << c;
+                ASSERT_NEAR(h->u, 0.25, 1e-15);
+                ASSERT_NEAR(h->v, 0.25, 1e-15);
+                ++tested;
+            }
+    EXPECT_GT(tested, 40000);
+}
+
+TEST(Watertight, DoubleRaysThroughASharedEdgeAtEveryScale) {
+    // As above in double, the quad scaled by 2^k across double's range, and one triangle's third
+    // corner sometimes 2^f farther out, so that the two triangles of the shared edge take
+    // different scales (or one the scaled path and the other the direct one).
+    test::Random rng(29);
+    for (int i = 0; i < 100000; ++i) {
+        const int f = i % 3 == 0 ? int(rng.below(600)) : 0;
+        const int k = int(rng.below(std::uint32_t(1900 - f))) - 950;  // 2^(k + f + 3) stays finite
+        const double far = std::ldexp(1.0, f);
+        const auto point = [&](double reach) {
+            const Vec3d p = rng.point_in(Aabb3d({-1, -1, -1}, {1, 1, 1}));
+            return Vec3d(std::ldexp(p[0] * reach, k), std::ldexp(p[1] * reach, k),
+                         std::ldexp(p[2] * reach, k));
+        };
+        const Vec3d a = point(1), c = point(1), b0 = point(1);
+        const Vec3d b = a + (b0 - a) * far;  // on b0's side of the edge a-c
+        const Vec3d d = a + c - b0;          // on the other side
+        const Triangled t1{a, b, c}, t2{a, c, d};
+        const double s = rng.uniform(0.05, 0.95);
+        const Vec3d on_edge = a + (c - a) * s;
+        const Vec3d origin = point(4);
+        const Ray<double, 3> ray(origin, on_edge - origin);
+        ASSERT_TRUE(t1.intersect_watertight(ray) || t2.intersect_watertight(ray))
+            << i << " at 2^" << k;
+    }
 }
 
 TEST(Segment, RayHitsAgreeWithParametricSolve) {

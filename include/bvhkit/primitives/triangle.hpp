@@ -8,6 +8,8 @@
 //   (or vertex) can be outside both triangles by a rounding error and slip through to whatever lies
 //   behind; measured, about 1 in 10^5..10^6 camera rays on a scanned mesh.
 // PrecomputedTriangle keeps the edges and normal so the fast test does one cross product.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <type_traits>
@@ -100,24 +102,89 @@ template <class T>
 }
 }  // namespace detail
 
-/// The watertight test's second half, for the triangle's corners already moved to the ray's origin
-/// and sheared (a*, b*, c*: corners p0, p1, p2; x, y sheared, z along the ray): the edge functions
-/// and t in `Wide`. Shared by the scalar test below and the four-abreast one
-/// (primitives/triangle_group.hpp), which shears in SIMD and finishes here.
-template <class T>
-inline bool watertight_finish(const WatertightRay<T>& r, T ax_, T ay_, T az, T bx_, T by_, T bz,
-                              T cx_, T cy_, T cz, T tmin, T tmax, TriangleHit<T>& hit) {
-    using W = typename WatertightRay<T>::Wide;
-    const W ax = ax_, ay = ay_, bx = bx_, by = by_, cx = cx_, cy = cy_;
-    using detail::opaque;
+namespace detail {
+
+/// The edge functions and t of the watertight test for sheared corners, in W: the arithmetic of
+/// watertight_finish's paths. Gives t (before any power of two of the scaled path), det and the
+/// edge functions of p1 and p2, whose quotients by det are the barycentrics.
+template <class W>
+[[gnu::always_inline]] inline bool watertight_solve(W ax, W ay, W az, W bx, W by, W bz, W cx, W cy,
+                                                    W cz, W dz, W& t, W& det, W& ev_out,
+                                                    W& ew_out) {
     const W eu = opaque(cx * by) - opaque(cy * bx);  // edge b-c: weight of p0
     const W ev = opaque(ax * cy) - opaque(ay * cx);  // edge c-a: weight of p1
     const W ew = opaque(bx * ay) - opaque(by * ax);  // edge a-b: weight of p2
     if ((eu < 0 || ev < 0 || ew < 0) && (eu > 0 || ev > 0 || ew > 0)) return false;
-    const W det = eu + ev + ew;
+    det = eu + ev + ew;
     if (det == W(0)) return false;
     // t = (eu az + ev bz + ew cz) / (det d[kz]): the paper's scaled z without 1 / d[kz].
-    const W t_wide = (eu * W(az) + ev * W(bz) + ew * W(cz)) / (det * r.dz);
+    t = (eu * az + ev * bz + ew * cz) / (det * dz);
+    ev_out = ev;
+    ew_out = ew;
+    return true;
+}
+
+/// Whether double sheared corners can take the direct path: with every |x|, |y| and |z| and the
+/// direction's |d[kz]| in [2^-200, 2^200], the edge functions (products of two), t's numerator
+/// (of three) and det d[kz] neither overflow nor sink into denormals, so scaling could not change
+/// a bit.
+inline bool watertight_direct(double mxy, double mz, double dz) {
+    constexpr double lo = 0x1p-200, hi = 0x1p200;
+    const double az = std::fabs(dz);
+    return mxy >= lo && mxy <= hi && mz >= lo && mz <= hi && az >= lo && az <= hi;
+}
+
+/// The exponent e with x = f 2^e, f in [1, 2); 0 for 0 (nothing to scale).
+inline int scale_exponent(double x) {
+    return x > 0 && std::isfinite(x) ? std::ilogb(x) : 0;
+}
+
+}  // namespace detail
+
+/// The watertight test's second half, for the triangle's corners already moved to the ray's origin
+/// and sheared (a*, b*, c*: corners p0, p1, p2; x, y sheared, z along the ray): the edge functions
+/// and t in `Wide`. Shared by the scalar test below and the four-abreast one
+/// (primitives/triangle_group.hpp), which shears in SIMD and finishes here.
+///
+/// Double corners or a direction outside [2^-200, 2^200] (meshes beyond about 1e+-60 across, or a
+/// ray far from them) are first scaled by powers of two, x and y by one, z by another, and the direction's
+/// component by a third: the products of two and three coordinates would otherwise leave double's
+/// range. Scaling by 2^k is exact and rounding is monotonic, so a scaled edge function has the
+/// unscaled one's sign or is zero, and the edge shared by two triangles still gets opposite (or
+/// zero) values from them whatever scale each triangle took: the test stays watertight. Float
+/// corners never need it: their products of three stay within double's range.
+template <class T>
+inline bool watertight_finish(const WatertightRay<T>& r, T ax_, T ay_, T az, T bx_, T by_, T bz,
+                              T cx_, T cy_, T cz, T tmin, T tmax, TriangleHit<T>& hit) {
+    using W = typename WatertightRay<T>::Wide;
+    W t_wide, det, ev, ew;
+    if constexpr (std::is_same_v<T, double>) {
+        const double mxy = std::max({std::fabs(ax_), std::fabs(ay_), std::fabs(bx_), std::fabs(by_),
+                                     std::fabs(cx_), std::fabs(cy_)});
+        const double mz = std::max({std::fabs(az), std::fabs(bz), std::fabs(cz)});
+        if (detail::watertight_direct(mxy, mz, r.dz)) {
+            if (!detail::watertight_solve<W>(ax_, ay_, az, bx_, by_, bz, cx_, cy_, cz, r.dz, t_wide,
+                                             det, ev, ew))
+                return false;
+        } else {
+            const int exy = detail::scale_exponent(mxy), ez = detail::scale_exponent(mz),
+                      ed = detail::scale_exponent(std::fabs(r.dz));
+            const auto xy = [exy](double x) { return std::ldexp(x, -exy); };
+            const auto z = [ez](double x) { return std::ldexp(x, -ez); };
+            // t = (scaled numerator 2^(2 exy + ez)) / (scaled det 2^(2 exy) * dz): the powers of
+            // 2 exy cancel, leaving 2^(ez - ed).
+            if (!detail::watertight_solve<W>(xy(ax_), xy(ay_), z(az), xy(bx_), xy(by_), z(bz),
+                                             xy(cx_), xy(cy_), z(cz), std::ldexp(r.dz, -ed), t_wide,
+                                             det, ev, ew))
+                return false;
+            t_wide = std::ldexp(t_wide, ez - ed);
+        }
+    } else {
+        const W ax = ax_, ay = ay_, bx = bx_, by = by_, cx = cx_, cy = cy_;
+        if (!detail::watertight_solve<W>(ax, ay, W(az), bx, by, W(bz), cx, cy, W(cz), r.dz, t_wide,
+                                         det, ev, ew))
+            return false;
+    }
     const T t = T(t_wide);
     if (!(t >= tmin && t <= tmax) || !std::isfinite(t)) return false;
     const W inv_det = W(1) / det;
