@@ -255,3 +255,25 @@ def test_spatial_splits_bad_arguments():
         with pytest.raises(ValueError, match="spatial_splits"):
             bvhkit.TriangleMesh(v, f, builder=builder, spatial_splits=True)
     assert bvhkit.TriangleMesh(v, f, spatial_splits=np.bool_(True)).stats()["spatial_splits"]
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200, 1e-120, 1e120, 1e200, 1e300])
+def test_float64_rays_at_extreme_scales(scale):
+    # t does not change when the mesh, the origins and the directions are scaled together, so the
+    # numpy reference at unit scale (whose own products would leave float64's range out there)
+    # judges the scaled scene. Rays grazing an edge at unit scale are left out.
+    rng = np.random.default_rng(5)
+    v, f = random_soup(rng, 60, scale=1.0, offset=0)
+    o, d = random_rays(rng, 600)
+    t_ref, margin = ray_hits(v, f, o, d, tmax=np.full(len(o), np.inf))
+    clean = ((margin >= 1e-6) | ~np.isfinite(margin)).all(axis=1)
+    assert clean.sum() > 300
+    best = t_ref.min(axis=1)
+    hit = np.isfinite(best)
+    assert hit[clean].sum() > 100
+    scene = bvhkit.TriangleMesh(v * scale, f, dtype=np.float64)
+    hits = scene.intersect(o * scale, d * scale)
+    np.testing.assert_array_equal(np.isfinite(hits.t[clean]), hit[clean])
+    both = clean & hit
+    np.testing.assert_allclose(hits.t[both], best[both], rtol=1e-9)
+    np.testing.assert_array_equal(scene.occluded(o * scale, d * scale)[clean], hit[clean])
