@@ -1,5 +1,5 @@
-// `bvhkit bench dynamic`: workloads D1, D2, D3 (the dynamic tree against Box2D's and Bullet's
-// broadphases); see bench/workloads/dynamic_bench.hpp.
+// `bvhkit bench dynamic`: workloads D1-D4 (the dynamic tree against Box2D's and Bullet's
+// broadphases and Box2D's tree ray cast); see bench/workloads/dynamic_bench.hpp.
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -18,9 +18,10 @@ namespace {
 void usage(std::FILE* out) {
     std::fprintf(
         out,
-        "usage: bvhkit bench dynamic [--json] [--n N] [--steps S] [--reps R] [--only D1|D2|D3]\n"
+        "usage: bvhkit bench dynamic [--json] [--n N] [--steps S] [--reps R] [--only D1|D2|D3|D4]\n"
         "  D1 2D crowd (vs Box2D b2BroadPhase), D2 3D crowd (vs Bullet btDbvtBroadphase),\n"
-        "  D3 churn. Defaults: --n 100000 --steps 40 --reps 3 (bvhkit-exact, bvhkit-greedy: 1 rep).\n"
+        "  D3 churn, D4 closest-hit ray casts (vs Box2D b2DynamicTree). Defaults: --n 100000 "
+        "--steps 40 --reps 3 (bvhkit-exact, bvhkit-greedy: 1 rep).\n"
         "  step_ms: ms per step (D3: per round of 1,000 ops); speedup: that row's step_ms over\n"
         "  bvhkit's; pairs: pairs found over all steps; agree: same pairs as bvhkit every step.\n");
 }
@@ -41,8 +42,9 @@ int bench_dynamic_command(int argc, char** argv) {
     c.reps = int(args.integer("--reps", c.reps, 1, 100000000));
     if (args.has("--only")) {
         const std::string w = args.value("--only");
-        c.d1 = w == "D1", c.d2 = w == "D2", c.d3 = w == "D3";
-        if (!c.d1 && !c.d2 && !c.d3) throw Error("--only: '" + w + "' is not D1, D2 or D3");
+        c.d1 = w == "D1", c.d2 = w == "D2", c.d3 = w == "D3", c.d4 = w == "D4";
+        if (!c.d1 && !c.d2 && !c.d3 && !c.d4)
+            throw Error("--only: '" + w + "' is not D1, D2, D3 or D4");
     }
     print_rows(bench::run_dynamic_bench(c, stderr), args.flag("--json"));
     return 0;

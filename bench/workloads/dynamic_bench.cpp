@@ -468,6 +468,7 @@ std::vector<Row> run_dynamic_bench(const DynamicBenchConfig& c, std::FILE* log) 
             median_run(c.reps, [&] { return run_churn(std::max(1, c.n / 10), c.steps, 3003); });
         rows.push_back(make_row("D3", "bvhkit", r, nullptr));
     }
+    if (c.d4) dynamic_ray_casts(c, log, rows);
     return rows;
 }
 

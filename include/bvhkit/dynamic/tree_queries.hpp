@@ -104,19 +104,31 @@ struct Segment {
 ///   < 0  ignore this proxy, go on with the same max fraction
 ///   == 0 stop the query
 ///   > 0  go on, clipping the segment to this new max fraction
+/// Children are clipped before they are pushed and the nearer one (by entry fraction) is walked
+/// first, so a callback that clips (closest hit) shortens the segment early and the farther
+/// subtrees are dropped when popped: their entry then lies beyond the new max fraction.
 template <class T, std::size_t N, class U, class F>
 void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, CastInput<T, N> in, F&& callback,
           QueryStats* stats) {
     if (t.root == kNullNode) return;
     const Vec<T, N> pad = in.half_extent;
     T& max_fraction = in.max_fraction;
-    std::uint64_t visited = 0, tested = 0;
-    SmallStack<std::int32_t> stack;
-    stack.push(t.root);
+    std::uint64_t visited = 1, tested = 0;
+    struct Pending {
+        std::int32_t node;
+        T entry;
+    };
+    const T root_entry = seg.entry(t.nodes[t.root].box, pad, max_fraction);
+    if (root_entry < T(0)) {
+        if (stats) stats->nodes_visited += visited;
+        return;
+    }
+    SmallStack<Pending> stack;
+    stack.push({t.root, root_entry});
     while (!stack.empty()) {
-        const Node<T, N>& n = t.nodes[stack.pop()];
-        ++visited;
-        if (seg.entry(n.box, pad, max_fraction) < T(0)) continue;
+        const Pending p = stack.pop();
+        if (p.entry > max_fraction) continue;  // clipped away since it was pushed
+        const Node<T, N>& n = t.nodes[p.node];
         if (n.is_leaf()) {
             ++tested;
             if (seg.entry(t.proxies[n.value()].box, pad, max_fraction) < T(0)) continue;
@@ -127,9 +139,22 @@ void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, CastInput<T, N> 
                 value = callback(proxy_id(t, n.value()), max_fraction);
             if (value == T(0)) break;
             if (value > T(0)) max_fraction = value;
-        } else {
-            stack.push(n.child2);
-            stack.push(n.child1);
+            continue;
+        }
+        visited += 2;
+        const T e1 = seg.entry(t.nodes[n.child1].box, pad, max_fraction);
+        const T e2 = seg.entry(t.nodes[n.child2].box, pad, max_fraction);
+        // The farther child goes on the stack first, so the nearer is popped next.
+        const bool first_is_1 = e1 <= e2;
+        const Pending near{first_is_1 ? n.child1 : n.child2, first_is_1 ? e1 : e2};
+        const Pending far{first_is_1 ? n.child2 : n.child1, first_is_1 ? e2 : e1};
+        if (far.entry >= T(0)) {
+            stack.push(far);
+            prefetch_next(t, t.nodes[far.node]);
+        }
+        if (near.entry >= T(0)) {
+            stack.push(near);
+            prefetch_next(t, t.nodes[near.node]);
         }
     }
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
