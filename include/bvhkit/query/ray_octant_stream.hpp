@@ -13,7 +13,8 @@
 //
 // Each ray's clip is clip8's arithmetic, lane for lane, and its leaf tests are walk8's: a ray
 // reaches a leaf here exactly when the one-ray walk, not stopping early, would, so the any-hit
-// answer is the one-ray call's. Measured in docs/rays.md ("Occlusion in octant streams").
+// answer is the one-ray call's. Design in docs/rays.md ("Occlusion in octant streams"), figures in
+// docs/benchmarks.md.
 #include <cstddef>
 #include <cstdint>
 
