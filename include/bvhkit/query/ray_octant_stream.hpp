@@ -121,8 +121,8 @@ template <class Blocked>
                 const int first = __builtin_ctz(children);
                 children &= children - 1;
                 current = Entry{node.child[first], node.groups[first], mask[first]};
-                // The next entry's first three lines, as walk8 asks for them (bunny 1.14-1.16x
-                // -> 1.20-1.22x the one-ray loop).
+                // The next entry's first three lines, as walk8 asks for them, so that they arrive
+                // while the stream finishes this node.
                 const char* next =
                     entry_address(nodes, groups, WideEntry{current.child, current.groups, 0});
                 _mm_prefetch(next, _MM_HINT_T0);
