@@ -1,17 +1,19 @@
 #pragma once
-// The speed settings of bvhkit, in one place. Each value here trades time or memory for time and
-// nothing else: any other value in its stated range gives a valid tree and the same answers, except
-// the builders' defaults, which shape the tree (so a closest hit on a tie may name another
-// triangle). Each line says why the value is what it is and which bench shows it; the figures, with
-// their dates and machines, are in docs/benchmarks.md. The headers that use a value name it from
-// here, under their own names where they had one.
+// The speed settings of bvhkit, in one place. Each value here is chosen for time or memory, not
+// for correctness: another value in its stated range still gives a valid tree and queries that
+// decide the same. The builders' settings and the leaf limits do shape the tree, so where two
+// triangles are hit at the same t, which one a query names may change with them. Each line says
+// why the value is what it is and which bench shows it; the figures, with their dates and
+// machines, are in docs/benchmarks.md. The headers that use a value name it from here, under their
+// own names where they had one.
 //
 // Correctness limits are not here: file format versions, max_bvh_depth and the stack capacities
 // it bounds, the exact-arithmetic widths, the 32-bit masks that bound a stream's size.
 //
 // Benches (docs/benchmarks.md): `bvhkit bench rays MESH` (build, R1-R3, batch rows R2-mt/R3-mt),
 // `bvhkit info MESH --all-builders` (SAH cost, boxes and triangles a ray), `bvhkit bench nearest
-// MESH [--scaling]`, `bvhkit bench dynamic`, `bvhkit bsp MESH`.
+// MESH [--scaling]`, `bvhkit bench dynamic`, `bvhkit bsp MESH`, and the micro benchmarks of
+// bench/micro (`bvhkit_micro`).
 #include <cstddef>
 #include <cstdint>
 
@@ -41,7 +43,8 @@ inline constexpr std::uint32_t ploc_radius = 16;
 inline constexpr std::uint32_t binned_sah_min_bins = 4;
 inline constexpr std::uint32_t binned_sah_primitives_per_bin = 20;
 /// Binned SAH: nodes of at least this many primitives bin in chunks on several threads; below,
-/// a task costs more than it saves. `bvhkit bench nearest MESH --scaling` (parallel builds).
+/// a task costs more than it saves. `bvhkit_micro --benchmark_filter=build` (builds on every
+/// core; bench/micro).
 inline constexpr std::size_t parallel_binning_from = std::size_t(1) << 15;
 /// Binned SAH: primitives per chunk of the parallel binning.
 inline constexpr std::size_t binning_chunk = 8192;
@@ -55,7 +58,7 @@ inline constexpr std::size_t partition_chunk = 8192;
 inline constexpr std::size_t stable_partition_from = 4 * partition_chunk;
 /// Top-down builders: nodes larger than this are split one task each; a smaller node builds its
 /// subtree serially as one task (small against large meshes, to balance; not tiny, to pay for a
-/// task's allocations). `bvhkit bench nearest MESH --scaling`.
+/// task's allocations). `bvhkit_micro --benchmark_filter=build`.
 inline constexpr std::uint32_t parallel_subtree_cutoff = 4096;
 /// Insertion builder and reinsertion optimizer: nodes the sibling search expands per insertion
 /// before it takes the best found; bounds the build on heavily overlapping boxes, which would
