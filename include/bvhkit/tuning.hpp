@@ -28,6 +28,13 @@ inline constexpr std::uint32_t sah_bins = 16;
 /// block (wide8_leaf_block), below which nodes would be split at the object median.
 /// `bvhkit info MESH --all-builders`.
 inline constexpr std::uint32_t max_leaf_size = 8;
+/// BuildOptions::max_leaf_size of the classic top-down rules' configurations (parse_builder,
+/// all_builder_configurations): with no SAH to stop them, smaller leaves than the SAH builders'.
+/// `bvhkit info MESH --all-builders`.
+inline constexpr std::uint32_t top_down_max_leaf_size = 4;
+/// collision_build_options(): small leaves, since a leaf pair costs count_a * count_b triangle
+/// tests. `bvhkit bench collide MESH`.
+inline constexpr std::uint32_t collision_max_leaf_size = 2;
 /// SahCosts: a box test and a triangle test priced alike; 0.5 to 2 for the box changed no ray row
 /// beyond noise. `bvhkit bench rays MESH`.
 inline constexpr double sah_traversal_cost = 1.0;
