@@ -3,6 +3,7 @@
 
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/error.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -51,7 +52,7 @@ std::vector<std::pair<std::string, BuildOptions>> all_builder_configurations() {
             t.builder = Builder::TopDown;
             t.axis_rule = a;
             t.point_rule = p;
-            t.max_leaf_size = 4;
+            t.max_leaf_size = tuning::top_down_max_leaf_size;
             out.emplace_back(std::string(to_string(p)) + "-" + to_string(a), t);
         }
     for (Builder b : {Builder::BottomUp, Builder::Insertion, Builder::Lbvh}) {
@@ -108,7 +109,7 @@ BuildOptions parse_builder(std::string_view name) {
     if (name == "top-down" || name == "top-down+opt") {
         BuildOptions o;
         o.builder = Builder::TopDown;
-        o.max_leaf_size = 4;
+        o.max_leaf_size = tuning::top_down_max_leaf_size;
         o.optimize = name.ends_with("+opt");
         return o;
     }

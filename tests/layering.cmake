@@ -5,7 +5,7 @@
 #
 # Layers, lowest first. Two folders of one layer may not include each other (bvh and bsp, dynamic and
 # query); the only allowed crossing is listed in `allowed` below.
-#   0 error.hpp version.hpp
+#   0 error.hpp version.hpp tuning.hpp
 #   1 math exec
 #   2 primitives
 #   3 volumes
@@ -18,6 +18,7 @@
 cmake_policy(VERSION 3.25)  # a script has no project(): IN_LIST and the like need the policies set
 set(rank_error.hpp 0)
 set(rank_version.hpp 0)
+set(rank_tuning.hpp 0)
 set(rank_math 1)
 set(rank_exec 1)
 set(rank_primitives 2)

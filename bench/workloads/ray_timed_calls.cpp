@@ -1,9 +1,8 @@
 // bvhkit's timed ray loops of workload R, alone in their file, as a renderer's would be in its own.
 //
 // Compiled inside ray_bench.cpp (which also holds Embree's calls, the table code and the other
-// workloads' lambdas), the very same R1 loop measured 7-10% slower (igea: 0.74x Embree, 0.76x once
-// traverse_ray shared one stack among its octant instances, against 0.81-0.82x here): GCC's
-// inlining budget is per file (--param inline-unit-growth). Embree's
+// workloads' lambdas), the very same R1 loop ran slower: GCC's inlining budget is per file
+// (--param inline-unit-growth). Embree's
 // traversal is precompiled in its own library and never pays for the file it is called from;
 // here bvhkit does not either. (The build stays in ray_bench.cpp: put here too, it made this file
 // large enough for GCC's unit-growth limit to cost the loops their speed again.)

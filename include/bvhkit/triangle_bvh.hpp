@@ -43,6 +43,7 @@
 #include "bvhkit/query/ray_stream.hpp"
 #include "bvhkit/query/ray_wide.hpp"
 #include "bvhkit/query/triangle_rays.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -349,14 +350,13 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     void build(TriangleAt&& triangle, std::size_t count, const TriangleBvhOptions& options) {
         BuildOptions tree_options = options;
         // The wide layouts test a leaf's triangles four or eight abreast: leaves priced in blocks
-        // as wide as the walk's groups. Against one triangle a test (bunny and igea, one thread),
-        // blocks of four made the build about a quarter faster (nodes of one block are leaves
-        // without a search), R1-R3 within noise; for the eight-wide walk, blocks of eight against
-        // four: igea 74-87 -> 66-69 ms, bunny 18.6 -> 17.5-17.8 ms, R2/R3 within noise. Never
-        // above max_leaf_size: nodes between the two would be split at the object median.
+        // as wide as the walk's groups, so that a node of one block is a leaf without a search (a
+        // faster build, the same rays; tuning.hpp). Never above max_leaf_size: nodes between the
+        // two would be split at the object median.
         if (tree_options.costs.leaf_block == 0 && wide_layout())
-            tree_options.costs.leaf_block =
-                std::min<std::uint32_t>(eight_wide() ? 8 : 4, tree_options.max_leaf_size);
+            tree_options.costs.leaf_block = std::min<std::uint32_t>(
+                eight_wide() ? tuning::wide8_leaf_block : tuning::wide4_leaf_block,
+                tree_options.max_leaf_size);
         if (options.spatial_splits) {
             if (options.builder != Builder::BinnedSah || options.optimize)
                 throw Error(

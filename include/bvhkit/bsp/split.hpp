@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bvhkit/bsp/plane.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -56,7 +57,7 @@ void split_polygon(std::span<const Vec<T, N>> v, const Plane<T, N>& plane, T eps
         return;
     }
     // Each vertex goes to the front part (+1), the back part (-1) or both (0, a cut point).
-    constexpr std::size_t max_inline = 64;
+    constexpr std::size_t max_inline = tuning::bsp_split_inline;
     T dist_inline[max_inline];
     signed char tag_inline[max_inline];
     std::vector<T> dist_heap;

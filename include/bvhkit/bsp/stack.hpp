@@ -1,15 +1,17 @@
 #pragma once
-// The explicit stack of the BSP traversals: a fixed array of 128 entries on the call stack (a ray
+// The explicit stack of the BSP traversals: a fixed array on the call stack (tuning.hpp; a ray
 // query needs depth + 2, a visit 2 depth + 4), one heap block per query beyond; none per step.
 #include <cstddef>
 #include <vector>
+
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit::bsp_detail {
 
 template <class E>
 class TraversalStack {
   public:
-    static constexpr std::size_t inline_capacity = 128;
+    static constexpr std::size_t inline_capacity = tuning::bsp_stack_inline;
     explicit TraversalStack(std::size_t capacity) {
         if (capacity > inline_capacity) {
             heap_.resize(capacity);

@@ -2,24 +2,24 @@
 // Binned SAH split (Wald 2007, "On fast construction of SAH-based bounding volume hierarchies"):
 // the centroids are dropped into equal bins along each axis, and the SAH is evaluated only at the
 // bin boundaries, with one sweep from each side. Linear in the node's size per axis. As in Embree,
-// smaller nodes get fewer bins (4 + n / 20, up to bin_count): the sweep over bins is a per-node
-// cost that would otherwise dominate the many small nodes. (Nodes of up to 8 primitives once went
-// to the exact full sweep instead: on bunny and igea the SAH cost came out within 0.01% of four
-// bins', and the build took 15-20% longer.)
+// smaller nodes get fewer bins (4 + n / 20, up to bin_count; tuning.hpp): the sweep over bins is a
+// per-node cost that would otherwise dominate the many small nodes. Every node is binned, the
+// smallest too: an exact sweep there found no cheaper trees and cost build time.
 //
 // A large node (parallel_binning_from primitives) bins in chunks on several threads when the
 // driver's executor allows, each chunk into its own bins, merged afterwards; box unions and
 // counts are exact in any order, so the split is the same as binned serially.
 #include "bvhkit/build/sah.hpp"
 #include "bvhkit/build/top_down_core.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
 template <class T, std::size_t N>
 class BinnedSahRule {
   public:
-    static constexpr std::size_t parallel_binning_from = 1u << 15;
-    static constexpr std::size_t binning_chunk = 8192;
+    static constexpr std::size_t parallel_binning_from = tuning::parallel_binning_from;
+    static constexpr std::size_t binning_chunk = tuning::binning_chunk;
 
     BinnedSahRule(const BuildInput<T, N>& in, const BuildOptions& options)
         : in_(in),
@@ -31,7 +31,8 @@ class BinnedSahRule {
     Split<T> operator()(const SplitTask<T, N>& task, const Executor& exec) {
         const auto count = static_cast<std::uint32_t>(task.indices.size());
         if (sah_leaf_certain(costs_, count, task.bounds.area())) return Split<T>::leaf();
-        const std::uint32_t bin_count = std::min(max_bins_, 4 + count / 20);
+        const std::uint32_t bin_count = std::min(
+            max_bins_, tuning::binned_sah_min_bins + count / tuning::binned_sah_primitives_per_bin);
         const Aabb<T, N>& cb = task.centroid_bounds;
         T scale[N];
         for (std::size_t a = 0; a < N; ++a) {
@@ -139,7 +140,7 @@ class BinnedSahRule {
     /// Bins the primitives of `indices` into the N rows of `mapping.count` bins at `out`, using
     /// as many more after them as scratch. Every other primitive goes to the scratch rows, merged
     /// at the end: one set alone makes a chain of loads and stores through the same bin whenever
-    /// neighbouring primitives share one, as they mostly do (the build measured 3-5% faster).
+    /// neighbouring primitives share one, as they mostly do.
     void bin_range(std::span<const std::uint32_t> indices, const BinMapping& mapping,
                    Bin* out) const {
         const std::size_t row = N * mapping.count;

@@ -21,6 +21,7 @@
 
 #include "bvhkit/bvh/bvh.hpp"
 #include "bvhkit/bvh/statistics.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -55,7 +56,8 @@ struct BinaryTree {
 };
 
 struct FlattenOptions {
-    std::uint32_t max_leaf_size = 8;  // collapse only subtrees at most this large (1: never)
+    // Collapse only subtrees at most this large (1: never).
+    std::uint32_t max_leaf_size = tuning::max_leaf_size;
     std::uint32_t max_depth = max_bvh_depth;
     SahCosts costs{};
 };

@@ -12,6 +12,7 @@
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/bvh/linked_tree.hpp"
 #include "bvhkit/math/random.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -19,7 +20,7 @@ namespace bvhkit {
 /// per insertion. Ordinary input needs far fewer (the bound prunes early); heavily overlapping
 /// boxes (coincident centroids) weaken the bound until the exact search visits most of the tree,
 /// a quadratic build. Beyond this the best sibling found so far is taken.
-inline constexpr std::size_t insertion_max_expansions = 64;
+inline constexpr std::size_t insertion_max_expansions = tuning::insertion_max_expansions;
 
 template <class T, std::size_t N>
 Bvh<Aabb<T, N>> build_insertion(std::span<const Aabb<T, N>> boxes,

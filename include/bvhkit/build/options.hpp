@@ -8,6 +8,7 @@
 
 #include "bvhkit/bvh/bvh.hpp"
 #include "bvhkit/bvh/statistics.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -42,8 +43,8 @@ enum class NonFinitePolicy {
 /// beside it throws bvhkit::Error naming the field and its range.
 struct BuildOptions {
     Builder builder = Builder::BinnedSah;
-    std::uint32_t bin_count = 16;     // binned SAH: 2..256 (16 to 32 are good values)
-    std::uint32_t max_leaf_size = 8;  // >= 1; a larger node is always split
+    std::uint32_t bin_count = tuning::sah_bins;           // binned SAH: 2..256
+    std::uint32_t max_leaf_size = tuning::max_leaf_size;  // >= 1; a larger node is always split
     std::uint32_t max_depth =
         max_bvh_depth;  // 0..max_bvh_depth; a node at this depth becomes a leaf, whatever its size
     /// SAH builders and the bottom-up builders' collapse: leaf cost vs split cost. traversal
@@ -63,7 +64,7 @@ struct BuildOptions {
     unsigned threads = 0;
     /// Bottom-up: neighbours searched on each side, 1..max_ploc_radius (each round costs
     /// 2 * radius area evaluations per cluster).
-    std::uint32_t ploc_radius = 16;
+    std::uint32_t ploc_radius = tuning::ploc_radius;
 };
 
 inline constexpr std::uint32_t max_ploc_radius = 64;

@@ -33,20 +33,20 @@
 #include "bvhkit/build/top_down_core.hpp"
 #include "bvhkit/bvh/bvh.hpp"
 #include "bvhkit/primitives/triangle.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
 /// The spatial-split build's own parameters; TriangleBvhOptions::spatial carries them.
 struct SpatialSplitOptions {
     /// Spatial splits are tried where the object split's children overlap by more than alpha of
-    /// the root's surface area: 0 tries them everywhere; finite, >= 0. The paper's 1e-5 built the
-    /// bunny in 3x the time of 1e-3 for the same rays (docs/rays.md).
-    double alpha = 1e-3;
+    /// the root's surface area: 0 tries them everywhere; finite, >= 0. Smaller values build
+    /// slower for the same rays on the meshes measured (tuning.hpp).
+    double alpha = tuning::spatial_split_alpha;
     /// Extra references allowed, as a fraction of the triangles: 0..4. Bounds the memory.
     double budget = 1.0;
-    /// Bins of a spatial split on each axis: 2..256. 16 built the room and the soup of
-    /// docs/rays.md in 0.74-0.79x the time of 32, to the same SAH cost within 1%.
-    std::uint32_t bins = 16;
+    /// Bins of a spatial split on each axis: 2..256 (tuning.hpp).
+    std::uint32_t bins = tuning::spatial_split_bins;
 };
 
 /// Throws bvhkit::Error naming the first field outside its range.
@@ -517,7 +517,7 @@ class Builder {
     std::size_t budget_ = 0;      // extra references the node being split may make
     // Nodes of at most this many references try object splits only (spatial binning is most of
     // the build's time, and few of its splits win in small nodes).
-    static constexpr std::uint32_t min_spatial_count = 8;
+    static constexpr std::uint32_t min_spatial_count = tuning::spatial_split_min_count;
     std::vector<double> right_area_;
     std::vector<std::uint32_t> right_count_;
     std::vector<std::uint32_t> left_ids_, right_ids_;

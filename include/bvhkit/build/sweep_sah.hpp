@@ -9,13 +9,14 @@
 // serial order (lowest cost, first axis, first position on it), so it is the serial one.
 #include "bvhkit/build/sah.hpp"
 #include "bvhkit/build/top_down_core.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
 template <class T, std::size_t N>
 class SweepSahRule {
   public:
-    static constexpr std::size_t parallel_axes_from = 1u << 15;
+    static constexpr std::size_t parallel_axes_from = tuning::parallel_axes_from;
 
     SweepSahRule(const BuildInput<T, N>& in, const BuildOptions& options)
         : in_(in), costs_(options.costs) {}

@@ -27,6 +27,7 @@
 #include "bvhkit/build/options.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/exec/executor.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -96,11 +97,11 @@ Vec<T, N> safe_centroid(const Aabb<T, N>& box) {
 namespace top_down_detail {
 /// Primitives per chunk of the parallel passes over a range. Fixed, so what a chunk computes never
 /// depends on the thread count.
-inline constexpr std::size_t chunk = 8192;
+inline constexpr std::size_t chunk = tuning::partition_chunk;
 /// Ranges at least this long are partitioned stably through a scratch buffer (in parallel chunks
 /// when the executor allows), shorter ones in place. The choice depends on the size alone, so the
 /// order of primitive_indices is the same with any number of threads.
-inline constexpr std::size_t stable_partition_from = 4 * chunk;
+inline constexpr std::size_t stable_partition_from = tuning::stable_partition_from;
 }  // namespace top_down_detail
 
 /// The builders' rule for bad input: a primitive whose box is non-finite or empty is left out (or
@@ -159,8 +160,8 @@ std::vector<std::uint32_t> usable_primitives(BuildInput<T, N>& in, std::vector<V
 template <class T, std::size_t N>
 struct RangeBounds {
     BoxAccumulator<T, N> boxes, centroids;
-    // Forced inline: GCC 12 otherwise calls it out of line from the partition loops (which then
-    // took 22% more instructions).
+    // Forced inline: GCC otherwise calls it out of line from the partition loops, which then run
+    // more instructions (docs/benchmarks.md, "Figures behind code comments").
     [[gnu::always_inline]] void add(const BuildInput<T, N>& in, std::uint32_t i) {
         boxes.grow(in.boxes[i]);
         centroids.grow_point(in.centroids[i]);
@@ -490,7 +491,7 @@ void build_serial(const Context<T, N>& cx, const Work<T, N>& root, SplitRule& ru
 /// Nodes of more primitives than this are split one task each by the parallel driver; a smaller
 /// node becomes one task building its whole subtree serially (to balance many such tasks over the
 /// threads, it is small against the large meshes; to pay for a task's few allocations, not tiny).
-inline constexpr std::uint32_t parallel_subtree_cutoff = 4096;
+inline constexpr std::uint32_t parallel_subtree_cutoff = tuning::parallel_subtree_cutoff;
 
 /// A node of the parallel driver's top tree: split there (children), or the root of a subtree the
 /// serial driver built into `subtree` (node 0 its root, child indices local to it).

@@ -38,8 +38,8 @@ enum class InsertionStrategy : std::uint8_t {
     /// (Bittner, Hapala, Havran 2013). The cheapest trees; each insertion may visit many nodes.
     BranchAndBound,
     /// One path guided by lower bounds on the insertion cost (Catto, GDC 2019): the cost of the
-    /// greedy descent, trees within a few percent of BranchAndBound's (2-10% on the D1/D2 crowds,
-    /// where it halves move()'s time).
+    /// greedy descent, trees within a few percent of BranchAndBound's (figures in
+    /// docs/dynamic.md).
     Guided,
 };
 

@@ -53,8 +53,8 @@ static_assert(sizeof(Node<float, 2>) == 32 && sizeof(Node<float, 3>) == 40);
 /// to 2 * FLT_MAX) and every area (up to ~1e78) is then finite, so costs never overflow to inf and
 /// tie (which would turn the tree into a list). A double tree keeps them ordered while extents stay
 /// below ~1e150; past that it stays correct but may lose balance. A float tree whose boxes are all
-/// small enough (float_costs_fit) computes them in float: the conversions cost ~20% of an
-/// insertion.
+/// small enough (float_costs_fit) computes them in float: the conversions are a large share of
+/// an insertion.
 template <class Cost, std::size_t N>
 inline Cost area_of_extents(const Cost (&e)[N]) {
     if constexpr (N == 2) {

@@ -10,12 +10,13 @@
 #include <algorithm>
 
 #include "bvhkit/bvh/iterate.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
 struct SahCosts {
-    double traversal = 1.0;
-    double intersection = 1.0;
+    double traversal = tuning::sah_traversal_cost;
+    double intersection = tuning::sah_intersection_cost;
     /// Primitives a leaf tests at once: a leaf of n costs intersection * ceil(n / leaf_block)
     /// (Embree's SAH block size), so a builder stops splitting where the halves would cost a test
     /// each. 1..64, or 0 for the tree's own choice: 8 or 4 for TriangleBvh's eight- or four-wide

@@ -7,12 +7,10 @@
 // entered in the order of a recursive pre-order walk.
 //
 // Used by the overlap queries (query/overlap.hpp) and within_radius (query/nearest.hpp), where it
-// took fewer instructions than their own loops did (callgrind: 132.7M against 147.6M for 160,000
-// box and sphere queries on a 36,864-triangle torus; 434.6M against 438.6M for 20,000
-// within_radius). Not used by the winding number (query/winding_number.hpp says why), the ray
-// walk (nearer child first by entry distance, branch-free pushes) or the tree-vs-tree walks
-// (pairs of nodes, query/pairs.hpp), which keep their own loops on a TraversalStack or their
-// own pair stacks.
+// took fewer instructions than their own loops did. Not used by the winding number
+// (query/winding_number.hpp says why), the ray walk (nearer child first by entry distance,
+// branch-free pushes) or the tree-vs-tree walks (pairs of nodes, query/pairs.hpp), which keep their
+// own loops on a TraversalStack or their own pair stacks.
 //
 // Leaves hand out leaf slots (positions in primitive_indices): LeafSlot keeps them apart from
 // primitive indices, so a callback cannot take one for the other by mistake.

@@ -6,9 +6,11 @@
 #include <cstddef>
 #include <vector>
 
+#include "bvhkit/tuning.hpp"
+
 namespace bvhkit::dynamic_detail {
 
-template <class E, std::size_t Inline = 256>
+template <class E, std::size_t Inline = tuning::dynamic_stack_inline>
 class SmallStack {
   public:
     bool empty() const { return size_ == 0; }

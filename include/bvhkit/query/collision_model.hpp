@@ -17,6 +17,7 @@
 #include "bvhkit/error.hpp"
 #include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -28,7 +29,7 @@ struct CollisionModelAccess;  // io/collision_model_file.hpp: saves and loads th
 /// triangle tests.
 inline BuildOptions collision_build_options() {
     BuildOptions o;
-    o.max_leaf_size = 2;
+    o.max_leaf_size = tuning::collision_max_leaf_size;
     return o;
 }
 

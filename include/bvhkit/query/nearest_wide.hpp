@@ -82,9 +82,7 @@ void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>
             const unsigned leaves = wide_detail::leaf_children(node) & within;
             // Ask for every child within the radius before opening any: the leaves' triangles
             // and the inner nodes' lines load together instead of one after another. (The lanes'
-            // addresses chosen without jumps, for all four lanes, cost ~90 instructions a node,
-            // a fifth of a grid query's: 3-5% slower on a grid around spot, the same on random
-            // points around igea and the displaced 1.3M-triangle sphere.)
+            // addresses chosen without jumps, for all four lanes, cost more than the jumps.)
             for (unsigned m = within; m; m &= m - 1) {
                 const int c = __builtin_ctz(m);
                 std::uintptr_t line;

@@ -17,6 +17,7 @@
 #include "bvhkit/bvh/traverse.hpp"
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/query/stats.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -81,7 +82,7 @@ namespace overlap_detail {
 /// order, so the result does not depend on the threads.
 template <class Query>
 BatchHits run_batch(std::size_t count, const Executor& exec, Query&& query) {
-    constexpr std::size_t grain = 256;
+    constexpr std::size_t grain = tuning::overlap_batch_grain;
     const std::size_t chunks = (count + grain - 1) / grain;
     std::vector<std::vector<std::uint32_t>> chunk_hits(chunks);
     std::vector<std::size_t> counts(count);

@@ -97,8 +97,8 @@ concept Placeable = requires(const V& v, const typename VolumeTraits<V>::Prepare
 /// query). Returns false when stopped early. `slack` widens every volume test by that absolute
 /// amount (see volumes/bounding_volume.hpp; CollisionModel picks it from the models' scale).
 // One function of some 100 lines on purpose: it is the collide walk's hot loop, and its child
-// opening moved into a function (shared with distance.hpp) cost 2.2% more instructions on Rss
-// (callgrind, 823.7M -> 842.0M; the figures are in distance.hpp).
+// opening moved into a function (shared with distance.hpp) cost it instructions on Rss
+// (docs/benchmarks.md, "Figures behind code comments").
 template <BoundingVolume V, class OnPair, class Stats = NoStats>
 bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
                                const Transform<typename V::Scalar>& pose_of_b_in_a,

@@ -1,10 +1,9 @@
 #pragma once
 // spatial_order: the indices of a batch of query points sorted along a Morton curve over the
 // batch's bounding box, so that points answered one after another lie close together and find
-// the tree's nodes and triangles still in cache. Closest points for 200,000 random points around
-// igea took a third less time in this order, each walk started from its neighbour's answer, the
-// sort included (docs/proximity.md); a grid in row order gained 13%. Rays gained nothing from
-// the like (docs/rays.md).
+// the tree's nodes and triangles still in cache. Closest-point batches gain from it, the sort
+// included, random points more than a grid in row order (docs/proximity.md); rays gained nothing
+// from the like (docs/benchmarks.md, "Ray measurements").
 //
 // The sort is a radix sort of 32-bit keys (ten bits an axis), stable, so points in one cell keep
 // their order and the result is the same on every run and thread count. Points with a NaN or
@@ -21,13 +20,14 @@
 #include "bvhkit/error.hpp"
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/hit.hpp"  // invalid_index
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
 /// The most points spatial_order sorts as one run: a larger batch is sorted in consecutive runs
-/// of this many, each along its own curve, so the sort's buffers stay at 64 MB (16 bytes a point)
-/// whatever the batch; 4M points to a run are dense enough that neighbours still share the tree.
-inline constexpr std::size_t spatial_order_run = std::size_t(1) << 22;
+/// of this many, each along its own curve, so the sort's buffers stay bounded (16 bytes a point)
+/// whatever the batch, in runs dense enough that neighbours still share the tree (tuning.hpp).
+inline constexpr std::size_t spatial_order_run = tuning::spatial_order_run;
 
 namespace point_order_detail {
 
@@ -62,7 +62,7 @@ std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const E
         throw Error("spatial_order: " + std::to_string(n) +
                     " points, more than 32-bit indices hold");
     run = std::max<std::size_t>(run, 1);
-    constexpr std::size_t grain = 16384;
+    constexpr std::size_t grain = tuning::spatial_order_grain;
     std::vector<std::uint32_t> order(n);
     std::vector<std::uint64_t> items, spare;
     std::vector<Box> chunk_bounds;
@@ -110,10 +110,9 @@ std::vector<std::uint32_t> spatial_order(std::size_t n, PointAt&& point, const E
         // bucket sorted on the bits below, least significant first: the same order as one sort
         // from the least significant digit, with the buckets sorted in parallel, most of them
         // small enough to stay in cache (points bunched in a few coarse cells leave few buckets
-        // to share out). A 128^3 grid, one / two threads: 102 / 90 ms as one sort, 85 / 50 ms
-        // so. A small run is one sort: 129 buckets would cost more than they save.
+        // to share out). A small run is one sort: 129 buckets would cost more than they save.
         constexpr int top = 55;
-        if (count < (std::size_t(1) << 16)) {
+        if (count < tuning::spatial_order_one_sort_below) {
             point_order_detail::radix_sort(items.data(), spare.data(), count, 32, 64);
         } else {
             std::array<std::size_t, 257> start{};
@@ -146,8 +145,8 @@ std::vector<std::uint32_t> spatial_order(std::span<const Vec<T, 3>> points, cons
 }
 
 /// Batches from this many points on are answered in spatial_order; smaller ones as they come
-/// (their sort would cost about what it saves).
-inline constexpr std::size_t spatial_order_from = 4096;
+/// (their sort would cost about what it saves; tuning.hpp).
+inline constexpr std::size_t spatial_order_from = tuning::spatial_order_from;
 
 /// The order to answer a batch of n points in: spatial_order from spatial_order_from points on,
 /// else 0 .. n - 1.

@@ -51,7 +51,7 @@ void traverse_ray(BvhView<Aabb<T, N>> bvh, Ray<T, N>& ray, const RaySlabData<T, 
     };
     // One stack for all eight octant instances, outside them: each with its own 512-byte array,
     // GCC's stack-frame growth limit stopped it from inlining them into the dispatch in a large
-    // file (the bench's), and the out-of-line walk measured 5-6% slower on R1.
+    // file (the bench's), and the out-of-line walk is slower.
     FixedStack<Entry, max_bvh_depth> stack;
     slab.with_octant([&](auto octant) {
         constexpr unsigned O = decltype(octant)::value;
@@ -88,7 +88,7 @@ void traverse_ray(BvhView<Aabb<T, N>> bvh, Ray<T, N>& ray, const RaySlabData<T, 
                     // children are hit, the far child's children, read when it is popped (its
                     // node is in the line just tested, so the address costs nothing). For a leaf
                     // `first` is a primitive slot and the address meaningless, which a prefetch
-                    // tolerates (it never faults). R1 -3 to -7%, R2 on igea -10%.
+                    // tolerates (it never faults).
                     __builtin_prefetch(nodes + nodes[current].first);
                     if (both) __builtin_prefetch(nodes + nodes[left + !right_first].first);
                     continue;
@@ -124,7 +124,7 @@ Hit<T, N> closest_hit(BvhView<Aabb<T, N>> bvh, const Ray<T, N>& ray_in, Test&& t
     const RaySlabData<T, N> slab(ray_in);
     Ray<T, N> ray = ray_in;
     // The test's output is a local of the leaf loop, which the compiler keeps in registers; the
-    // best hit is copied out only on a hit (3.5% on R1 against one record shared by reference).
+    // best hit is copied out only on a hit (faster than one record shared by reference).
     struct Best {
         TriangleHit<T> hit;
         std::uint32_t slot = invalid_index;

@@ -13,30 +13,28 @@
 //
 // Each ray's clip is clip8's arithmetic, lane for lane, and its leaf tests are walk8's: a ray
 // reaches a leaf here exactly when the one-ray walk, not stopping early, would, so the any-hit
-// answer is the one-ray call's. Measured in docs/rays.md ("Occlusion in octant streams").
+// answer is the one-ray call's. Design in docs/rays.md ("Occlusion in octant streams"), figures in
+// docs/benchmarks.md.
 #include <cstddef>
 #include <cstdint>
 
 #include "bvhkit/query/ray_wide.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
 #if BVHKIT_RAY_AVX2
 namespace detail {
 
-/// Rays an octant stream holds: one bit each in a 32-bit mask (16 measured 1.14x the one-ray
-/// loop on the bunny against 1.16x with 32, and 1.06x against 1.12x on igea).
-inline constexpr int octant_stream_size = 32;
+/// Rays an octant stream holds: one bit each in a 32-bit mask, so at most 32 (tuning.hpp).
+inline constexpr int octant_stream_size = tuning::octant_stream_size;
+static_assert(octant_stream_size >= 1 && octant_stream_size <= 32);
 
 /// Whether octant streams serve an occlusion batch on `tree` better than the interleaved walks of
-/// query/ray_stream.hpp: below 8 MB. Occlusion batches against the one-ray loop, 500,000 random
-/// rays, one thread (docs/rays.md): octant streams 1.28x / 1.22x / 1.19-1.22x / 1.19-1.21x on
-/// layouts of 0.3 / 1.1 / 3.2 / 3.7 MB, where the interleaved walks gave 1.02x and 1.00x on the
-/// last two (and lose below 2 MB); at 13 MB 1.15-1.17x against 1.13-1.22x, at 17 and 60 MB 1.19x
-/// and 1.09x against 1.25x and 1.22x: there a node's rays are few and the walk waits for memory,
-/// which the interleaving hides better.
+/// query/ray_stream.hpp: below tuning::octant_streams_below_layout_bytes. Above it a node's rays
+/// are few and the walk waits for memory, which the interleaving hides better.
 inline bool octant_streams_pay(const WideRayBvh<8>& tree) {
-    return tree.bytes() < (std::size_t(8) << 20);
+    return tree.bytes() < tuning::octant_streams_below_layout_bytes;
 }
 
 /// The rays of one octant, their slab constants one array per component.
@@ -123,8 +121,8 @@ template <class Blocked>
                 const int first = __builtin_ctz(children);
                 children &= children - 1;
                 current = Entry{node.child[first], node.groups[first], mask[first]};
-                // The next entry's first three lines, as walk8 asks for them (bunny 1.14-1.16x
-                // -> 1.20-1.22x the one-ray loop).
+                // The next entry's first three lines, as walk8 asks for them, so that they arrive
+                // while the stream finishes this node.
                 const char* next =
                     entry_address(nodes, groups, WideEntry{current.child, current.groups, 0});
                 _mm_prefetch(next, _MM_HINT_T0);

@@ -12,9 +12,9 @@
 // slab test runs twice.
 //
 // The pair test and its gather are marked always_inline: GCC's inlining budget is per translation
-// unit, and in a large one (the bench's) it left the test out of line, which cost R1 about 8%; a
-// user's own large file would pay the same. Forcing more (the leaf and triangle calls, the scalar
-// clip) made the walk slower in small files, so only these are forced.
+// unit, and in a large one (the bench's) it left the test out of line, which cost camera rays
+// time; a user's own large file would pay the same. Forcing more (the leaf and triangle calls, the
+// scalar clip) made the walk slower in small files, so only these are forced.
 #include "bvhkit/bvh/sibling_pair.hpp"
 #include "bvhkit/math/ray.hpp"
 

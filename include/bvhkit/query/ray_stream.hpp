@@ -11,28 +11,27 @@
 //
 // Each ray's walk is walk8's, step for step, with the same arithmetic (clip8, the same leaf
 // tests): the answers are the one-by-one calls', bit for bit; only the order in which the rays'
-// steps run is interleaved. Measured in docs/rays.md ("Streams").
+// steps run is interleaved. Design in docs/rays.md ("Streams"), figures in docs/benchmarks.md.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
 #include "bvhkit/query/ray_wide.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
 #if BVHKIT_RAY_AVX2
 namespace detail {
 
-/// Rays a stream keeps in flight. Four, eight and sixteen measured within a few percent of each
-/// other on igea and the 1.3M-triangle sphere (docs/rays.md); eight is kept.
-inline constexpr int stream_width = 8;
+/// Rays a stream keeps in flight (tuning.hpp).
+inline constexpr int stream_width = tuning::stream_width;
 
-/// Whether a stream pays for `tree`: once its layout is 2 MB or more. A layout that stays in a
-/// core's L2 has little latency to hide, and the walks' interleaving costs it some (the branch
-/// history of one ray's walk no longer predicts its next step): on the machine of
-/// docs/rays.md, 0.91-0.95x one ray at a time below 1 MB, 1.0x at 2-4 MB, 1.03-1.3x above.
+/// Whether a stream pays for `tree`: once its layout is tuning::stream_from_layout_bytes or more.
+/// A layout that stays in a core's L2 has little latency to hide, and the walks' interleaving
+/// costs it some (the branch history of one ray's walk no longer predicts its next step).
 inline bool stream_pays(const WideRayBvh<8>& tree) {
-    return tree.bytes() >= (std::size_t(2) << 20);
+    return tree.bytes() >= tuning::stream_from_layout_bytes;
 }
 
 /// One ray's walk in a stream: its constants and its stack, kept in memory between its steps

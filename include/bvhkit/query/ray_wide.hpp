@@ -59,8 +59,8 @@ struct alignas(16) SlabConstants {
         constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
         // All axes at once: the same IEEE quotients and products as one axis at a time. The
         // fields are read one by one: one 16-byte load of a ray the caller has just written
-        // spans several of its stores, which the CPU cannot forward (camera rays made just before
-        // each call ran 13-18% slower that way, any hit 9%).
+        // spans several of its stores, which the CPU cannot forward (rays made just before each
+        // call would wait for those stores to retire).
         const __m128 d = _mm_setr_ps(ray.direction[0], ray.direction[1], ray.direction[2], 1.0f);
         const __m128 r = _mm_div_ps(_mm_set1_ps(1.0f), d);
         _mm_store_ps(origin, _mm_setr_ps(ray.origin[0], ray.origin[1], ray.origin[2], 0.0f));
@@ -391,8 +391,8 @@ inline bool ray_meets_box(const Ray<float, 3>& ray, const Aabb<float, 3>& box) {
 /// reciprocal the slab test would ignore, letting the ray into empty lanes).
 inline bool wide_ray_usable(const Ray<float, 3>& ray) {
 #if defined(__SSE2__)
-    // The same tests on all components at once (a fifth of a camera ray's instructions when
-    // written per component): |x| < inf is false for NaN and inf; a direction component is
+    // The same tests on all components at once (per component they were a large share of a
+    // camera ray's instructions): |x| < inf is false for NaN and inf; a direction component is
     // 0 or at least the least normal float; at least one is not 0.
     const __m128 sign = _mm_set1_ps(-0.0f);
     const __m128 o =

@@ -10,6 +10,7 @@
 #include "bvhkit/bvh/wide_bvh.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/primitives/triangle_group.hpp"
+#include "bvhkit/tuning.hpp"
 
 #if defined(__SSE2__) && defined(__x86_64__) && defined(__GNUC__)
 #define BVHKIT_RAY_AVX2 1  // the eight-wide walk is compiled, for CPUs that turn out to have AVX2
@@ -61,12 +62,11 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
                                 IndexAtSlot&& index_at_slot) {
     WideRayBvh<W> out;
     // Every node's lanes filled (collapse_to_wide's fill_lanes), and a lane of up to leaf_limit
-    // triangles not opened further is a leaf child. Why these limits: once the tree outgrows the
-    // caches, a node costs more than the groups of a larger leaf, which lie side by side, so the
-    // eight-wide layout takes large leaves; the four-wide one, whose groups are half as wide, gains
-    // less from them and keeps 24. The measurements behind both are in docs/rays.md ("Leaf
-    // limits"; `bvhkit bench rays` on the bunny, igea and the displaced sphere).
-    constexpr std::uint32_t leaf_limit = W == 8 ? 48 : 24;
+    // triangles not opened further is a leaf child. Large leaves for the eight-wide layout, since
+    // once the tree outgrows the caches a node costs more than the groups of a larger leaf, which
+    // lie side by side; smaller ones for the four-wide layout (tuning.hpp).
+    constexpr std::uint32_t leaf_limit =
+        W == 8 ? tuning::wide8_leaf_limit : tuning::wide4_leaf_limit;
     const WideBvh<float, W> wide = collapse_to_wide<float, W>(bvh, leaf_limit, true);
     out.nodes.resize(wide.nodes.size());
     constexpr float inf = std::numeric_limits<float>::infinity();

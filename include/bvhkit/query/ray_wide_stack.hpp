@@ -6,11 +6,10 @@
 // The four-wide walk pushes them one by one (take_hits). The eight-wide walks push all of a node's
 // hit children at once, with no branch on how many they are or on their order: the branches of a
 // push one by one (the number of hit children, which of two is nearer, where an entry goes in the
-// stack) are taken by the data, and were 3.6 of a random ray's 7.9 mispredicted branches on the
-// bunny (callgrind's branch simulation; docs/rays.md). Their stack holds its
-// entries one array per field, so that eight entries go on in one vector store a field, in the
-// order a sorting network gives them (a bitonic network of six compare-exchange layers, Batcher
-// 1968).
+// stack) are taken by the data, and were nearly half of a random ray's mispredicted branches
+// (docs/benchmarks.md, "Ray measurements"). Their stack holds its entries one array per field, so
+// that eight entries go on in one vector store a field, in the order a sorting network gives them
+// (a bitonic network of six compare-exchange layers, Batcher 1968).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -85,9 +84,8 @@ template <class Line>
 }
 
 /// take_hits for any hit, which needs no order: the first hit lane becomes `current`, the others
-/// are pushed as they come. Sorting them cost an occlusion ray 7% of its instructions and 1.2
-/// mispredicted branches (callgrind, random rays on the bunny) and bought nothing: no entry is
-/// ever dropped for being farther than a hit, the walk stops at the first one.
+/// are pushed as they come. Sorting them cost instructions and mispredicted branches and bought
+/// nothing: no entry is ever dropped for being farther than a hit, the walk stops at the first one.
 template <class Line>
 [[gnu::always_inline]] inline void take_hits_unordered(unsigned mask, const float* entry,
                                                        const RayNode<4>& node, WideEntry& current,
@@ -139,7 +137,7 @@ struct WideStack8 {
 /// empty): the one the walk pops next, whose line then arrives while the walk is still below
 /// the current entry. Asked after every push and pop of the one-ray eight-wide walk: random rays,
 /// whose next entry is rarely in the caches, gain more than camera rays, which find their lines
-/// there, lose (measured in docs/rays.md).
+/// there, lose (docs/benchmarks.md, "Ray measurements").
 template <class Line>
 [[gnu::always_inline]] inline void ask_for_top8(const WideStack8& stack, std::uint32_t size,
                                                 Line&& line) {
@@ -219,8 +217,8 @@ template <class Line>
     WideStack8& stack, std::uint32_t& size, Line&& line) {
     if ((mask & (mask - 1)) == 0) {
         // One hit child, nothing to push: a branch that coherent rays predict, and the next node's
-        // address sooner than by the reduction below. Without it, camera rays on the bunny, the
-        // 5k sphere and igea ran 6-10% slower and random rays 0-2% faster.
+        // address sooner than by the reduction below. Without it camera rays ran slower, and
+        // random rays gained little.
         go_to_lane8(node, entry, __builtin_ctz(mask), current, line);
         return;
     }

@@ -12,6 +12,7 @@
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle.hpp"
 #include "bvhkit/query/ray.hpp"
+#include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
 
@@ -85,7 +86,7 @@ class TriangleRays {
 
 /// Rays per task of the batch calls: large enough to pay for a task, small enough to balance
 /// incoherent rays over the cores.
-inline constexpr std::size_t ray_batch_grain = 256;
+inline constexpr std::size_t ray_batch_grain = tuning::ray_batch_grain;
 
 /// The batch calls of a tree with closest_hit(ray) and any_hit(ray) (TriangleBvh,
 /// MappedTriangleBvh derive from it): trace() sets hits[i] = closest_hit(rays[i]), occluded()

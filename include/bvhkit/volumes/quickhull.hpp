@@ -214,7 +214,7 @@ class Quickhull {
         std::vector<std::uint32_t> visible, stack, orphans;
         std::vector<std::uint32_t> starts(p_.size(), UINT32_MAX);
         // The round that last reached each face: clearing a flag per face every round made the
-        // rounds quadratic in the faces ever made (160k points on a sphere took 3.5 s).
+        // rounds quadratic in the faces ever made.
         std::vector<std::size_t> seen;
         // Each round makes one more hull vertex, so the rounds are at most the points; more would
         // mean a broken hull, answered by keeping every point.
