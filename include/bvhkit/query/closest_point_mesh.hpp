@@ -97,23 +97,28 @@ class ClosestPointMesh {
         return closest_point(p, scratch);
     }
 
-    /// The k nearest triangles (nearest first), each with its closest point.
+    /// The k nearest triangles (nearest first), each with its closest point. They are ranked as
+    /// closest_point ranks its candidates (in the wider type, far points by far_key), so the
+    /// order holds for squared distances past T's range (a point 2e19 from a float mesh, a mesh
+    /// 1e-25 across); of triangles with the same key the one in the lower leaf slot comes first.
     void k_nearest(const Vec<T, 3>& p, std::size_t k, std::vector<MeshPoint<T>>& out,
                    NearestScratch<T>& scratch) const {
-        thread_local std::vector<std::pair<T, std::uint32_t>> slots;
-        bvhkit::k_nearest(bvh_, p, k, distance(), scratch, slots);
+        thread_local std::vector<std::pair<AccurateScalar<T>, std::uint32_t>> slots;
+        bvhkit::k_nearest(bvh_, p, k, ranked_distance(p, true), scratch, slots);
         out.clear();
-        for (const auto& [d2, s] : slots) out.push_back(point_of(s, p));
+        for (const auto& [key, s] : slots) out.push_back(point_of(s, p));
     }
 
-    /// Every triangle within `radius` of p (inclusive, on the distances as rounded to T), in no
-    /// particular order. A negative or NaN radius finds nothing.
+    /// Every triangle within `radius` of p (inclusive: the squared distance, measured in the
+    /// wider type, against radius^2 taken there, exactly for float), in no particular order. A
+    /// negative or NaN radius finds nothing.
     void within_radius(const Vec<T, 3>& p, T radius, std::vector<MeshPoint<T>>& out) const {
         out.clear();
-        bvhkit::within_radius(bvh_, p, radius, distance(), [&](LeafSlot s, T) {
-            out.push_back(point_of(s.value, p));
-            return true;
-        });
+        bvhkit::within_radius(bvh_, p, radius, ranked_distance(p, false),
+                              [&](LeafSlot s, AccurateScalar<T>) {
+                                  out.push_back(point_of(s.value, p));
+                                  return true;
+                              });
     }
 
     /// closest_point for every point, on `threads` threads (0 = all; see exec/executor.hpp).
@@ -432,24 +437,60 @@ class ClosestPointMesh {
         const T slack = T(1024) * std::numeric_limits<T>::epsilon() * (r + longest_edge);
         return (r + slack) * (r + slack);
     }
-    /// The squared distance to the triangle in a leaf slot, for nearest().
-    struct SlotDistance {
+    /// The key of the triangle in a leaf slot, for k_nearest() and within_radius(): its squared
+    /// distance measured in W, or for a far point (ranking only) far_key, which keeps the order
+    /// where the squared distance's rounding would not.
+    struct RankedDistance {
+        using W = AccurateScalar<T>;
         const ClosestPointMesh* mesh;
-        const Triangle<T>* tris;
-        T operator()(std::uint32_t slot, const Vec<T, 3>& p, T bound) const {
-            const Triangle<T>& t = tris[slot];
+        FarFrame far;
+        W from_origin2 = 0;  // |p - o|^2, to turn a far key back into a squared distance
+        // The last bound widened: k_nearest asks again with the same bound for every triangle.
+        mutable W last_bound = std::numeric_limits<W>::quiet_NaN();
+        mutable T last_prune = 0;
+        W operator()(std::uint32_t slot, const Vec<T, 3>& p, W bound) const {
+            const Triangle<T>& t = mesh->tris_[slot];
             // The triangle's box is a cheap lower bound: most triangles of a leaf fail it.
-            const T box_d2 = box_distance_squared(t, p);
-            if (box_d2 > widen(p, bound)) return box_d2;
-            return T(distance_squared_accurate(t, p));
+            if (box_distance_squared(t, p) > widen(p, bound))
+                return std::numeric_limits<W>::infinity();
+            const AccurateClosestPoint<T> c = mesh->measure(slot, p);
+            return far.far ? mesh->far_key(far, t, c) : c.distance_squared;
         }
-        /// The bound the walks prune boxes with: see widened().
-        T widen(const Vec<T, 3>& /*p*/, T bound) const { return mesh->widened(bound); }
-        /// Asks for a leaf's first triangle ahead of time (nearest() calls it for leaves it will
-        /// open later).
-        void prefetch(std::uint32_t slot) const { __builtin_prefetch(tris + slot); }
+        /// The squared radius in T to prune boxes with (see widened_key), for a key.
+        T widen(const Vec<T, 3>& /*p*/, W bound) const {
+            if (bound == last_bound) return last_prune;
+            last_bound = bound;
+            // (A far key plus |p - o|^2 is the squared distance again, to its rounding, which
+            // the widening covers; rounding can take it below 0.)
+            return last_prune =
+                       mesh->widened_key(far.far ? std::max(bound + from_origin2, W(0)) : bound);
+        }
+        void prefetch(std::uint32_t slot) const { __builtin_prefetch(mesh->tris_.data() + slot); }
     };
-    SlotDistance distance() const { return {this, tris_.data()}; }
+    RankedDistance ranked_distance(const Vec<T, 3>& p, bool rank_far) const {
+        RankedDistance d{this, {}};
+        if (rank_far) d.far = far_frame(p);
+        if (d.far.far) d.from_origin2 = dot(d.far.from_origin, d.far.from_origin);
+        return d;
+    }
+    /// A triangle measured accurately, with its frame where there is one.
+    AccurateClosestPoint<T> measure(std::uint32_t slot, const Vec<T, 3>& p) const {
+        return frames_.empty() ? closest_point_accurate(tris_[slot], p)
+                               : closest_point_accurate(tris_[slot], frames_[slot], p);
+    }
+    /// widened() for a squared radius in W: computed there and rounded up to T, so it is inf
+    /// past T's range (no box is pruned: they are all within reach of a radius T cannot hold)
+    /// and never below 4 least normals, where the boxes' own rounding could drop one within
+    /// reach (a radius 1e-25 in float squares to 0).
+    T widened_key(AccurateScalar<T> radius2) const {
+        using W = AccurateScalar<T>;
+        if (radius2 != radius2) return std::numeric_limits<T>::quiet_NaN();
+        if (radius2 < W(0)) return T(-1);
+        const W r = std::sqrt(radius2);
+        const W slack = W(1024) * W(std::numeric_limits<T>::epsilon()) * (r + W(longest_edge_));
+        return std::max(nearest_detail::round_up_key<T>((r + slack) * (r + slack)),
+                        T(4) * std::numeric_limits<T>::min());
+    }
     /// Squared distance from p to the triangle's box. For float on x86 in SSE: each corner is one
     /// 4-float load (the fourth lane, the next coordinate, masked off), ~15 instructions where the
     /// scalar form takes ~100 (measured: a fifth of an N1 query).
@@ -480,7 +521,7 @@ class ClosestPointMesh {
         return d2;
     }
     MeshPoint<T> point_of(std::uint32_t slot, const Vec<T, 3>& p) const {
-        return point_of(slot, closest_point_accurate(tris_[slot], p));
+        return point_of(slot, measure(slot, p));
     }
     MeshPoint<T> point_of(std::uint32_t slot, const AccurateClosestPoint<T>& c) const {
         return {Vec<T, 3>(c.point),
