@@ -89,6 +89,14 @@ void check_ranking_at_scale(const TriangleMesh& unit, double scale, double offse
             EXPECT_NEAR(LD(got[j].distance), e, 2 * eps_t * e + 96 * eps_w * (e + longest))
                 << "rank " << j;
         }
+        // closest_point_within: a limit just below the least distance finds nothing, one just
+        // above finds it.
+        using W = AccurateScalar<T>;
+        EXPECT_FALSE(mesh.closest_point_within(p, W(sorted[0] * 0.999L), {}, scratch));
+        const MeshPoint<T> within =
+            mesh.closest_point_within(p, W(sorted[0] * 1.001L), {}, scratch);
+        ASSERT_TRUE(within);
+        EXPECT_LE(exact[within.triangle], sorted[0] + bound);
         // A radius between two distances farther apart than the bound, representable in T.
         for (std::size_t m = 5; m + 1 < sorted.size(); ++m) {
             const T radius = T((sorted[m - 1] + sorted[m]) / 2);

@@ -76,7 +76,8 @@ class ClosestPointMesh {
     MeshPoint<T> closest_point(const Vec<T, 3>& p, NearestScratch<T>& scratch,
                                T max_distance_squared = std::numeric_limits<T>::infinity(),
                                Stats&& stats = {}) const {
-        return closest_point_from(p, invalid_index, scratch, max_distance_squared, stats);
+        return closest_point_from(p, invalid_index, scratch, Limit::squared(max_distance_squared),
+                                  stats);
     }
     /// The same answer as closest_point(p, scratch, max_distance_squared), found sooner when
     /// `near` is the answer for a point close to p (the previous point of a grid, or of a batch
@@ -90,7 +91,21 @@ class ClosestPointMesh {
                                         ? slot_of_triangle_[near.triangle]
                                         : invalid_index;
         NoStats stats;
-        return closest_point_from(p, start, scratch, max_distance_squared, stats);
+        return closest_point_from(p, start, scratch, Limit::squared(max_distance_squared), stats);
+    }
+    /// closest_point(p, near, scratch) within `max_distance` itself, not its square, given in the
+    /// wider type W (double for a float mesh: a limit from Python or a double computation is
+    /// taken as it is, not rounded to float). Judged on the squared distance in W against
+    /// max_distance^2 taken there, so any finite limit holds at any scale (its square in T would
+    /// be inf past 1.8e19 in float and 0 below 1e-23). Inclusive; a negative or NaN limit finds
+    /// nothing.
+    MeshPoint<T> closest_point_within(const Vec<T, 3>& p, AccurateScalar<T> max_distance,
+                                      const MeshPoint<T>& near, NearestScratch<T>& scratch) const {
+        const std::uint32_t start = near.triangle < slot_of_triangle_.size()
+                                        ? slot_of_triangle_[near.triangle]
+                                        : invalid_index;
+        NoStats stats;
+        return closest_point_from(p, start, scratch, Limit::distance(max_distance), stats);
     }
     MeshPoint<T> closest_point(const Vec<T, 3>& p) const {
         thread_local NearestScratch<T> scratch;
@@ -149,13 +164,43 @@ class ClosestPointMesh {
   private:
     friend struct serial_detail::ClosestPointMeshAccess;
 
+    /// A closest point's search limit: a squared distance in T, judged on the squared distance
+    /// rounded to T (closest_point's), or a distance, judged in W (closest_point_within's).
+    struct Limit {
+        using W = AccurateScalar<T>;
+        bool by_distance = false;
+        T squared_limit = std::numeric_limits<T>::infinity();
+        W distance_limit = 0, distance_limit2 = 0;  // by distance: the limit and its square in W
+        static Limit squared(T max2) { return {false, max2, 0, 0}; }
+        static Limit distance(W max) { return {true, 0, max, max * max}; }
+        bool none() const {
+            return by_distance ? !(distance_limit >= W(0)) : !(squared_limit >= T(0));
+        }
+        /// The limit squared and times scale^2, rounded up to T (inf past its range), to prune.
+        T scaled2(T scale) const {
+            if (!by_distance) return squared_limit * scale * scale;
+            const W s = distance_limit * W(scale);
+            return nearest_detail::round_up_key<T>(s * s);
+        }
+        bool admits(W d2) const {
+            if (!by_distance)  // (rounding to T: inf past its range)
+                return (d2 > W(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::infinity()
+                                                              : T(d2)) <= squared_limit;
+            // Where the square leaves W's normal range (W is double: a double limit past 1e154),
+            // the distances are compared instead.
+            if (distance_limit2 >= std::numeric_limits<W>::min() &&
+                distance_limit2 < std::numeric_limits<W>::infinity())
+                return d2 <= distance_limit2;
+            return std::sqrt(d2) <= distance_limit;
+        }
+    };
     // closest_point, its walk started from the triangle in leaf slot `start` when that is one.
     template <class Stats>
     MeshPoint<T> closest_point_from(const Vec<T, 3>& p, std::uint32_t start,
-                                    NearestScratch<T>& scratch, T max_distance_squared,
+                                    NearestScratch<T>& scratch, const Limit& limit,
                                     Stats&& stats) const {
         // No distance is within a negative or NaN limit (and the walk would still measure).
-        if (!is_finite(p) || !(max_distance_squared >= T(0))) return {};
+        if (!is_finite(p) || limit.none()) return {};
         using W = AccurateScalar<T>;
         NearestSlot<T> best;
         // Candidates are measured accurately, in W (closest_point_accurate), and compared there:
@@ -172,7 +217,7 @@ class ClosestPointMesh {
         T best_estimate = std::numeric_limits<T>::infinity();  // scaled
         auto& candidates = scratch.candidates;
         candidates.clear();
-        const T limit2 = widened_scaled(max_distance_squared * pack_scale_ * pack_scale_);
+        const T limit2 = widened_scaled(limit.scaled2(pack_scale_));
         T search2 = limit2;  // scaled
         const Vec<T, 3> ps = p * pack_scale_;
         // The pack formula squares lengths twice over: beyond 2^(max_exponent / 4) from the
@@ -202,12 +247,11 @@ class ClosestPointMesh {
                                                   : closest_point_accurate(t, frames_[s], p);
             const W d2 = c.distance_squared;
             const W key = far.far ? far_key(far, t, c) : d2;
-            // The limit is judged on the distance as returned (rounded to T). Of triangles with
-            // the same key the one in the lowest slot wins, whatever the order they were
-            // measured in: every triangle that ties with the best is measured (its estimate is
-            // within the slack), so the answer does not depend on where the walk started.
-            if ((key < best_key || (key == best_key && s < best.slot)) &&
-                T(d2) <= max_distance_squared)
+            // The limit is judged as Limit::admits says. Of triangles with the same key the one
+            // in the lowest slot wins, whatever the order they were measured in: every triangle
+            // that ties with the best is measured (its estimate is within the slack), so the
+            // answer does not depend on where the walk started.
+            if ((key < best_key || (key == best_key && s < best.slot)) && limit.admits(d2))
                 best = {s, T(d2)}, best2 = d2, best_key = key, best_point = c;
         };
         const auto tighten = [&] {
