@@ -27,7 +27,7 @@
 // widen(point, key) turns a key into a squared radius in T that is no smaller than any box within
 // reach (inf where it is past T's range: the walk then opens every box it meets, which is slower
 // but never drops a primitive). Without widen, a key is taken for a squared distance and rounded
-// up to T. A functor returning T keeps T's range and the walks do exactly what they did.
+// up to T. A functor returning T keeps T's range.
 #include <algorithm>
 #include <cmath>
 #include <limits>
