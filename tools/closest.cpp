@@ -1,7 +1,9 @@
 // `bvhkit closest`: the closest point on the user's mesh to each of the user's points, in the
-// docs/workloads.md formats (points: 3 float32 each; result: float32 x y z, float32 squared
-// distance, uint32 triangle index per point).
+// docs/workloads.md formats (points: 3 float32 each; result, format 2: float32 x y z, uint32
+// triangle index, float64 distance per point; format 1, the earlier one: float32 x y z, float32
+// squared distance, uint32 triangle index).
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 
@@ -15,13 +17,19 @@ namespace bvhkit::tools {
 namespace {
 
 constexpr const char* kHelp =
-    R"(usage: bvhkit closest MESH --points FILE --out FILE [--builder NAME] [--threads N]
+    R"(usage: bvhkit closest MESH --points FILE --out FILE [--format 1|2] [--builder NAME]
+                       [--threads N]
 
 For every point of FILE (3 float32 each, little-endian, no header) finds the closest point on MESH
-and writes float32 x y z of that point, float32 squared distance and uint32 triangle index (the
-triangle's position in the mesh file, polygons split into fans in file order; 0xFFFFFFFF and
-+inf for an empty mesh). --threads 0 (the default) uses every core when bvhkit has oneTBB; the
-output is the same for any number of threads.
+and writes, per point, little-endian and without a header:
+  --format 2 (the default), 24 bytes: float32 x y z of that point, uint32 triangle index (the
+    triangle's position in the mesh file, polygons split into fans in file order), float64
+    distance (not squared: finite for every finite point);
+  --format 1, 20 bytes, the earlier record: float32 x y z, float32 squared distance (+inf beyond
+    1.8e19 and 0 below 1e-23, where float32 cannot hold the square), uint32 triangle index.
+0xFFFFFFFF and +inf where there is no closest point (an empty mesh, a point with a NaN or an
+infinite coordinate). --threads 0 (the default) uses every core when bvhkit has oneTBB; the output
+is the same for any number of threads.
 )";
 
 std::vector<Vec3f> read_points(const std::string& path) {
@@ -38,7 +46,7 @@ std::vector<Vec3f> read_points(const std::string& path) {
 }  // namespace
 
 int closest_command(int argc, char** argv) {
-    const Args args(argc, argv, {"--points", "--out", "--builder", "--threads"}, {});
+    const Args args(argc, argv, {"--points", "--out", "--format", "--builder", "--threads"}, {});
     if (args.help()) {
         std::fputs(kHelp, stdout);
         return 0;
@@ -47,6 +55,7 @@ int closest_command(int argc, char** argv) {
     if (!args.has("--points") || !args.has("--out"))
         throw Error("closest needs --points FILE and --out FILE");
     const auto threads = unsigned(args.integer("--threads", 0, 0, 1024));
+    const auto format = int(args.integer("--format", 2, 1, 2));
     const TriangleMesh mesh = load_mesh(args.positional()[0]);
     const std::vector<Vec3f> points = read_points(args.value("--points"));
     BuildOptions options = parse_builder(args.value("--builder", "binned-sah"));
@@ -57,12 +66,29 @@ int closest_command(int argc, char** argv) {
     std::vector<MeshPoint<float>> found(points.size());
     tree.closest_points(points, found, threads);
     const auto t2 = std::chrono::steady_clock::now();
-    std::vector<char> out(points.size() * 20);
+    const std::size_t record = format == 1 ? 20 : 24;
+    std::vector<char> out(points.size() * record);
     for (std::size_t i = 0; i < found.size(); ++i) {
-        char* o = out.data() + 20 * i;
-        std::memcpy(o, &found[i].point[0], 12);
-        std::memcpy(o + 12, &found[i].distance_squared, 4);
-        std::memcpy(o + 16, &found[i].triangle, 4);
+        char* o = out.data() + record * i;
+        const MeshPoint<float>& f = found[i];
+        std::memcpy(o, &f.point[0], 12);
+        if (format == 1) {
+            std::memcpy(o + 12, &f.distance_squared, 4);
+            std::memcpy(o + 16, &f.triangle, 4);
+            continue;
+        }
+        // The distance in double, from the triangle measured again there: float's would be inf
+        // for a point 3e38 from the mesh's far side, and its square is past float's range from
+        // 1.8e19 on.
+        double distance = std::numeric_limits<double>::infinity();
+        if (f) {
+            const auto& t = mesh.triangles[f.triangle];
+            const Triangle<float> tri{mesh.vertices[t[0]], mesh.vertices[t[1]],
+                                      mesh.vertices[t[2]]};
+            distance = double(std::sqrt(closest_point_accurate(tri, points[i]).distance_squared));
+        }
+        std::memcpy(o + 12, &f.triangle, 4);
+        std::memcpy(o + 16, &distance, 8);
     }
     const std::string out_path = args.value("--out");
     file_detail::write_file_bytes_of(out_path, out, "output file");

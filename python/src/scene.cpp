@@ -235,7 +235,7 @@ class Scene {
         });
     }
 
-    void closest_point(const Rows<T, 3>& pts, T max_distance, OutColumn<T> distance,
+    void closest_point(const Rows<T, 3>& pts, double max_distance, OutColumn<T> distance,
                        OutRows<T, 3> closest, OutColumn<std::int64_t> face,
                        OutRows<T, 3> barycentric, unsigned threads) const {
         const std::size_t k = pts.shape(0);
@@ -243,12 +243,13 @@ class Scene {
         expect_rows(closest, k, "closest");
         expect_rows(face, k, "face");
         expect_rows(barycentric, k, "barycentric");
-        const T max2 = std::isinf(max_distance) ? max_distance : max_distance * max_distance;
         T *dp = distance.data(), *cp = closest.data(), *bp = barycentric.data();
         std::int64_t* fp = face.data();
         points(pts, threads, true, false, [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
-            const MeshPoint<T> c = scratch.previous = sdf_->closest_point_mesh().closest_point(
-                p, scratch.previous, scratch.nearest, max2);
+            // The limit itself, in double, not its square in T (inf past 1.8e19 in float32).
+            const MeshPoint<T> c = scratch.previous =
+                sdf_->closest_point_mesh().closest_point_within(p, max_distance, scratch.previous,
+                                                                scratch.nearest);
             const T nan = std::numeric_limits<T>::quiet_NaN();
             dp[i] = c ? c.distance : std::numeric_limits<T>::infinity();
             for (int a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;

@@ -479,9 +479,12 @@ TEST(NearestWide, RadiusEqualToTheDistanceFindsIt) {
                 const auto got = mesh.closest_point(p, scratch, want);
                 ASSERT_TRUE(got) << "triangle " << i << " offset " << offset << " d2 " << want;
                 EXPECT_EQ(got.distance_squared, want);
-                // (sqrt(want)^2 can round below want: then no triangle is within, rightly.)
+                // within_radius compares the squared distance in double with r^2 taken there
+                // (exactly): a radius whose square is below it holds no triangle, rightly.
                 const float r = std::sqrt(want);
-                if (!(r * r >= want)) continue;
+                double exact = std::numeric_limits<double>::infinity();
+                for (const auto& u : tris) exact = std::min(exact, distance_squared_accurate(u, p));
+                if (!(double(r) * double(r) >= exact)) continue;
                 mesh.within_radius(p, r, out);
                 EXPECT_FALSE(out.empty()) << "triangle " << i << " offset " << offset;
             }

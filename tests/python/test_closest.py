@@ -66,3 +66,47 @@ def test_empty_mesh():
     assert scene.intersect([[0, 0, 0]], [[1, 0, 0]]).face[0] == -1
     assert scene.signed_distance([[0, 0, 0]])[0] == np.inf
     assert scene.winding_number([[0, 0, 0]])[0] == 0
+
+
+@pytest.mark.parametrize(
+    "dtype,scales",
+    [
+        (np.float32, [1e-38, 1e-30, 1e-25, 1e-20, 1.0, 1e20, 1e25, 1e30, 1e35]),
+        (np.float64, [1e-300, 1e-200, 1e-160, 1.0, 1e160, 1e200, 1e300]),
+    ],
+)
+def test_max_distance_at_extreme_scales(dtype, scales):
+    # A right triangle in the plane z = 0 and points above its inside at heights of 1e-3 to 1e3
+    # sizes: the distance is the height, exactly (analytic, whatever the arithmetic). A limit
+    # 0.1% above it finds the triangle, one 0.1% below finds nothing, at every scale: the limit's
+    # square (once taken in the mesh's dtype) would be inf or 0 at most of these.
+    for s in scales:
+        v = np.array([[0, 0, 0], [s, 0, 0], [0, s, 0]], dtype=dtype)
+        scene = bvhkit.TriangleMesh(v, [[0, 1, 2]], dtype=dtype)
+        for h in [1e-3, 1.0, 1e3]:
+            p = np.array([[0.25 * s, 0.25 * s, h * s]], dtype=dtype)
+            z = float(p[0, 2])
+            if z == 0 or not np.isfinite(z):
+                continue
+            found = scene.closest_point(p, max_distance=z * 1.001)
+            assert found.face[0] == 0, (s, h)
+            np.testing.assert_allclose(found.distance[0], z, rtol=4 * np.finfo(dtype).eps)
+            none = scene.closest_point(p, max_distance=z * 0.999)
+            assert none.face[0] == -1 and none.distance[0] == np.inf, (s, h)
+
+
+@pytest.mark.parametrize(
+    "dtype,distances",
+    [(np.float32, [1e10, 1e20, 1e30, 3e38]), (np.float64, [1e100, 1e160, 1e200, 1e300])],
+)
+def test_max_distance_from_far_points(dtype, distances):
+    # A unit triangle and points far above it: distance d (d - 0 rounds to d), found within 2 d
+    # and not within d / 2 (the squares of both limits are past float32's range from 1.8e19).
+    scene = bvhkit.TriangleMesh(
+        np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=dtype), [[0, 1, 2]], dtype=dtype
+    )
+    for d in distances:
+        p = np.array([[0.25, 0.25, d]], dtype=dtype)
+        z = float(p[0, 2])
+        assert scene.closest_point(p, max_distance=2 * z).face[0] == 0, d
+        assert scene.closest_point(p, max_distance=z / 2).face[0] == -1, d

@@ -76,7 +76,8 @@ class ClosestPointMesh {
     MeshPoint<T> closest_point(const Vec<T, 3>& p, NearestScratch<T>& scratch,
                                T max_distance_squared = std::numeric_limits<T>::infinity(),
                                Stats&& stats = {}) const {
-        return closest_point_from(p, invalid_index, scratch, max_distance_squared, stats);
+        return closest_point_from(p, invalid_index, scratch, Limit::squared(max_distance_squared),
+                                  stats);
     }
     /// The same answer as closest_point(p, scratch, max_distance_squared), found sooner when
     /// `near` is the answer for a point close to p (the previous point of a grid, or of a batch
@@ -90,30 +91,49 @@ class ClosestPointMesh {
                                         ? slot_of_triangle_[near.triangle]
                                         : invalid_index;
         NoStats stats;
-        return closest_point_from(p, start, scratch, max_distance_squared, stats);
+        return closest_point_from(p, start, scratch, Limit::squared(max_distance_squared), stats);
+    }
+    /// closest_point(p, near, scratch) within `max_distance` itself, not its square, given in the
+    /// wider type W (double for a float mesh: a limit from Python or a double computation is
+    /// taken as it is, not rounded to float). Judged on the squared distance in W against
+    /// max_distance^2 taken there, so any finite limit holds at any scale (its square in T would
+    /// be inf past 1.8e19 in float and 0 below 1e-23). Inclusive; a negative or NaN limit finds
+    /// nothing.
+    MeshPoint<T> closest_point_within(const Vec<T, 3>& p, AccurateScalar<T> max_distance,
+                                      const MeshPoint<T>& near, NearestScratch<T>& scratch) const {
+        const std::uint32_t start = near.triangle < slot_of_triangle_.size()
+                                        ? slot_of_triangle_[near.triangle]
+                                        : invalid_index;
+        NoStats stats;
+        return closest_point_from(p, start, scratch, Limit::distance(max_distance), stats);
     }
     MeshPoint<T> closest_point(const Vec<T, 3>& p) const {
         thread_local NearestScratch<T> scratch;
         return closest_point(p, scratch);
     }
 
-    /// The k nearest triangles (nearest first), each with its closest point.
+    /// The k nearest triangles (nearest first), each with its closest point. They are ranked as
+    /// closest_point ranks its candidates (in the wider type, far points by far_key), so the
+    /// order holds for squared distances past T's range (a point 2e19 from a float mesh, a mesh
+    /// 1e-25 across); of triangles with the same key the one in the lower leaf slot comes first.
     void k_nearest(const Vec<T, 3>& p, std::size_t k, std::vector<MeshPoint<T>>& out,
                    NearestScratch<T>& scratch) const {
-        thread_local std::vector<std::pair<T, std::uint32_t>> slots;
-        bvhkit::k_nearest(bvh_, p, k, distance(), scratch, slots);
+        thread_local std::vector<std::pair<AccurateScalar<T>, std::uint32_t>> slots;
+        bvhkit::k_nearest(bvh_, p, k, ranked_distance(p, true), scratch, slots);
         out.clear();
-        for (const auto& [d2, s] : slots) out.push_back(point_of(s, p));
+        for (const auto& [key, s] : slots) out.push_back(point_of(s, p));
     }
 
-    /// Every triangle within `radius` of p (inclusive, on the distances as rounded to T), in no
-    /// particular order. A negative or NaN radius finds nothing.
+    /// Every triangle within `radius` of p (inclusive: the squared distance, measured in the
+    /// wider type, against radius^2 taken there, exactly for float), in no particular order. A
+    /// negative or NaN radius finds nothing.
     void within_radius(const Vec<T, 3>& p, T radius, std::vector<MeshPoint<T>>& out) const {
         out.clear();
-        bvhkit::within_radius(bvh_, p, radius, distance(), [&](LeafSlot s, T) {
-            out.push_back(point_of(s.value, p));
-            return true;
-        });
+        bvhkit::within_radius(bvh_, p, radius, ranked_distance(p, false),
+                              [&](LeafSlot s, AccurateScalar<T>) {
+                                  out.push_back(point_of(s.value, p));
+                                  return true;
+                              });
     }
 
     /// closest_point for every point, on `threads` threads (0 = all; see exec/executor.hpp).
@@ -144,13 +164,43 @@ class ClosestPointMesh {
   private:
     friend struct serial_detail::ClosestPointMeshAccess;
 
+    /// A closest point's search limit: a squared distance in T, judged on the squared distance
+    /// rounded to T (closest_point's), or a distance, judged in W (closest_point_within's).
+    struct Limit {
+        using W = AccurateScalar<T>;
+        bool by_distance = false;
+        T squared_limit = std::numeric_limits<T>::infinity();
+        W distance_limit = 0, distance_limit2 = 0;  // by distance: the limit and its square in W
+        static Limit squared(T max2) { return {false, max2, 0, 0}; }
+        static Limit distance(W max) { return {true, 0, max, max * max}; }
+        bool none() const {
+            return by_distance ? !(distance_limit >= W(0)) : !(squared_limit >= T(0));
+        }
+        /// The limit squared and times scale^2, rounded up to T (inf past its range), to prune.
+        T scaled2(T scale) const {
+            if (!by_distance) return squared_limit * scale * scale;
+            const W s = distance_limit * W(scale);
+            return nearest_detail::round_up_key<T>(s * s);
+        }
+        bool admits(W d2) const {
+            if (!by_distance)  // (rounding to T: inf past its range)
+                return (d2 > W(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::infinity()
+                                                              : T(d2)) <= squared_limit;
+            // Where the square leaves W's normal range (W is double: a double limit past 1e154),
+            // the distances are compared instead.
+            if (distance_limit2 >= std::numeric_limits<W>::min() &&
+                distance_limit2 < std::numeric_limits<W>::infinity())
+                return d2 <= distance_limit2;
+            return std::sqrt(d2) <= distance_limit;
+        }
+    };
     // closest_point, its walk started from the triangle in leaf slot `start` when that is one.
     template <class Stats>
     MeshPoint<T> closest_point_from(const Vec<T, 3>& p, std::uint32_t start,
-                                    NearestScratch<T>& scratch, T max_distance_squared,
+                                    NearestScratch<T>& scratch, const Limit& limit,
                                     Stats&& stats) const {
         // No distance is within a negative or NaN limit (and the walk would still measure).
-        if (!is_finite(p) || !(max_distance_squared >= T(0))) return {};
+        if (!is_finite(p) || limit.none()) return {};
         using W = AccurateScalar<T>;
         NearestSlot<T> best;
         // Candidates are measured accurately, in W (closest_point_accurate), and compared there:
@@ -167,7 +217,7 @@ class ClosestPointMesh {
         T best_estimate = std::numeric_limits<T>::infinity();  // scaled
         auto& candidates = scratch.candidates;
         candidates.clear();
-        const T limit2 = widened_scaled(max_distance_squared * pack_scale_ * pack_scale_);
+        const T limit2 = widened_scaled(limit.scaled2(pack_scale_));
         T search2 = limit2;  // scaled
         const Vec<T, 3> ps = p * pack_scale_;
         // The pack formula squares lengths twice over: beyond 2^(max_exponent / 4) from the
@@ -197,12 +247,11 @@ class ClosestPointMesh {
                                                   : closest_point_accurate(t, frames_[s], p);
             const W d2 = c.distance_squared;
             const W key = far.far ? far_key(far, t, c) : d2;
-            // The limit is judged on the distance as returned (rounded to T). Of triangles with
-            // the same key the one in the lowest slot wins, whatever the order they were
-            // measured in: every triangle that ties with the best is measured (its estimate is
-            // within the slack), so the answer does not depend on where the walk started.
-            if ((key < best_key || (key == best_key && s < best.slot)) &&
-                T(d2) <= max_distance_squared)
+            // The limit is judged as Limit::admits says. Of triangles with the same key the one
+            // in the lowest slot wins, whatever the order they were measured in: every triangle
+            // that ties with the best is measured (its estimate is within the slack), so the
+            // answer does not depend on where the walk started.
+            if ((key < best_key || (key == best_key && s < best.slot)) && limit.admits(d2))
                 best = {s, T(d2)}, best2 = d2, best_key = key, best_point = c;
         };
         const auto tighten = [&] {
@@ -432,24 +481,60 @@ class ClosestPointMesh {
         const T slack = T(1024) * std::numeric_limits<T>::epsilon() * (r + longest_edge);
         return (r + slack) * (r + slack);
     }
-    /// The squared distance to the triangle in a leaf slot, for nearest().
-    struct SlotDistance {
+    /// The key of the triangle in a leaf slot, for k_nearest() and within_radius(): its squared
+    /// distance measured in W, or for a far point (ranking only) far_key, which keeps the order
+    /// where the squared distance's rounding would not.
+    struct RankedDistance {
+        using W = AccurateScalar<T>;
         const ClosestPointMesh* mesh;
-        const Triangle<T>* tris;
-        T operator()(std::uint32_t slot, const Vec<T, 3>& p, T bound) const {
-            const Triangle<T>& t = tris[slot];
+        FarFrame far;
+        W from_origin2 = 0;  // |p - o|^2, to turn a far key back into a squared distance
+        // The last bound widened: k_nearest asks again with the same bound for every triangle.
+        mutable W last_bound = std::numeric_limits<W>::quiet_NaN();
+        mutable T last_prune = 0;
+        W operator()(std::uint32_t slot, const Vec<T, 3>& p, W bound) const {
+            const Triangle<T>& t = mesh->tris_[slot];
             // The triangle's box is a cheap lower bound: most triangles of a leaf fail it.
-            const T box_d2 = box_distance_squared(t, p);
-            if (box_d2 > widen(p, bound)) return box_d2;
-            return T(distance_squared_accurate(t, p));
+            if (box_distance_squared(t, p) > widen(p, bound))
+                return std::numeric_limits<W>::infinity();
+            const AccurateClosestPoint<T> c = mesh->measure(slot, p);
+            return far.far ? mesh->far_key(far, t, c) : c.distance_squared;
         }
-        /// The bound the walks prune boxes with: see widened().
-        T widen(const Vec<T, 3>& /*p*/, T bound) const { return mesh->widened(bound); }
-        /// Asks for a leaf's first triangle ahead of time (nearest() calls it for leaves it will
-        /// open later).
-        void prefetch(std::uint32_t slot) const { __builtin_prefetch(tris + slot); }
+        /// The squared radius in T to prune boxes with (see widened_key), for a key.
+        T widen(const Vec<T, 3>& /*p*/, W bound) const {
+            if (bound == last_bound) return last_prune;
+            last_bound = bound;
+            // (A far key plus |p - o|^2 is the squared distance again, to its rounding, which
+            // the widening covers; rounding can take it below 0.)
+            return last_prune =
+                       mesh->widened_key(far.far ? std::max(bound + from_origin2, W(0)) : bound);
+        }
+        void prefetch(std::uint32_t slot) const { __builtin_prefetch(mesh->tris_.data() + slot); }
     };
-    SlotDistance distance() const { return {this, tris_.data()}; }
+    RankedDistance ranked_distance(const Vec<T, 3>& p, bool rank_far) const {
+        RankedDistance d{this, {}};
+        if (rank_far) d.far = far_frame(p);
+        if (d.far.far) d.from_origin2 = dot(d.far.from_origin, d.far.from_origin);
+        return d;
+    }
+    /// A triangle measured accurately, with its frame where there is one.
+    AccurateClosestPoint<T> measure(std::uint32_t slot, const Vec<T, 3>& p) const {
+        return frames_.empty() ? closest_point_accurate(tris_[slot], p)
+                               : closest_point_accurate(tris_[slot], frames_[slot], p);
+    }
+    /// widened() for a squared radius in W: computed there and rounded up to T, so it is inf
+    /// past T's range (no box is pruned: they are all within reach of a radius T cannot hold)
+    /// and never below 4 least normals, where the boxes' own rounding could drop one within
+    /// reach (a radius 1e-25 in float squares to 0).
+    T widened_key(AccurateScalar<T> radius2) const {
+        using W = AccurateScalar<T>;
+        if (radius2 != radius2) return std::numeric_limits<T>::quiet_NaN();
+        if (radius2 < W(0)) return T(-1);
+        const W r = std::sqrt(radius2);
+        const W slack = W(1024) * W(std::numeric_limits<T>::epsilon()) * (r + W(longest_edge_));
+        return std::max(nearest_detail::round_up_key<T>((r + slack) * (r + slack)),
+                        T(4) * std::numeric_limits<T>::min());
+    }
     /// Squared distance from p to the triangle's box. For float on x86 in SSE: each corner is one
     /// 4-float load (the fourth lane, the next coordinate, masked off), ~15 instructions where the
     /// scalar form takes ~100 (measured: a fifth of an N1 query).
@@ -480,7 +565,7 @@ class ClosestPointMesh {
         return d2;
     }
     MeshPoint<T> point_of(std::uint32_t slot, const Vec<T, 3>& p) const {
-        return point_of(slot, closest_point_accurate(tris_[slot], p));
+        return point_of(slot, measure(slot, p));
     }
     MeshPoint<T> point_of(std::uint32_t slot, const AccurateClosestPoint<T>& c) const {
         return {Vec<T, 3>(c.point),

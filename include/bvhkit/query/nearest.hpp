@@ -18,8 +18,20 @@
 // for triangles. A functor whose rounded distances can fall below the boxes' (Ericson's closest
 // point can land an ulp outside the triangle's box) offers widen(point, bound): the walks then
 // prune boxes against that larger bound, and accept primitives against the bound itself.
+//
+// Keys wider than T: squared distances leave T's range long before the distances do (a float
+// point 2e19 from a primitive, or primitives 1e-23 apart, give inf or 0 and every candidate
+// ties). k_nearest and within_radius therefore rank by whatever the functor returns, its key K
+// (double or long double for T = float, say, or a key that is not a squared distance at all, such
+// as ClosestPointMesh's for far points), compare and return keys in K and only prune boxes in T:
+// widen(point, key) turns a key into a squared radius in T that is no smaller than any box within
+// reach (inf where it is past T's range: the walk then opens every box it meets, which is slower
+// but never drops a primitive). Without widen, a key is taken for a squared distance and rounded
+// up to T. A functor returning T keeps T's range.
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "bvhkit/bvh/sibling_pair.hpp"
@@ -41,7 +53,6 @@ struct NearestEntry {
 template <class T>
 struct NearestScratch {
     std::vector<NearestEntry<T>> heap;
-    std::vector<std::pair<T, std::uint32_t>> best;        // k nearest: (squared distance, slot)
     std::vector<std::pair<T, std::uint32_t>> candidates;  // closest point: (float estimate, slot)
 };
 
@@ -56,13 +67,32 @@ struct NearestSlot {
 
 namespace nearest_detail {
 
-/// The squared radius to prune boxes with, for a search radius of `radius2`.
+/// The key a distance functor ranks by: the type it returns.
 template <class Distance, class T, std::size_t N>
-T prune_radius2(const Distance& distance, const Vec<T, N>& p, T radius2) {
+using key_of = std::decay_t<std::invoke_result_t<Distance&, std::uint32_t, const Vec<T, N>&, T>>;
+
+/// x rounded up to T: inf past T's largest value (and NaN for NaN).
+template <class T, class K>
+T round_up_key(K x) {
+    if constexpr (std::is_same_v<K, T>) {
+        return x;
+    } else {
+        if (x != x) return std::numeric_limits<T>::quiet_NaN();
+        if (x > K(std::numeric_limits<T>::max())) return std::numeric_limits<T>::infinity();
+        if (x < -K(std::numeric_limits<T>::max())) return -std::numeric_limits<T>::max();
+        T y = T(x);
+        if (K(y) < x) y = std::nextafter(y, std::numeric_limits<T>::infinity());
+        return y;
+    }
+}
+
+/// The squared radius in T to prune boxes with, for a search radius (a key) of `radius2`.
+template <class Distance, class T, std::size_t N, class K>
+T prune_radius2(const Distance& distance, const Vec<T, N>& p, K radius2) {
     if constexpr (requires { distance.widen(p, radius2); })
         return distance.widen(p, radius2);
     else
-        return radius2;
+        return round_up_key<T>(radius2);
 }
 
 /// The best-first walk. `radius2()` is the current squared search radius (it shrinks as
@@ -153,46 +183,56 @@ NearestSlot<T> nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, Distance&
     return best;
 }
 
-/// The k primitives nearest to `p` (fewer when the tree holds fewer), nearest first, as (squared
-/// distance, leaf slot) in `out`.
-template <class T, std::size_t N, class Distance, class Stats = NoStats>
+/// The k primitives nearest to `p` (fewer when the tree holds fewer), nearest first, as (key,
+/// leaf slot) in `out`; the key is what `distance` returns (K, a squared distance in T or wider:
+/// see the file's comment), and `out`'s key type must hold it. Of primitives with equal keys the
+/// one in the lower slot comes first.
+template <class T, std::size_t N, class Distance, class K, class Stats = NoStats>
 void k_nearest(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, std::size_t k, Distance&& distance,
-               NearestScratch<T>& scratch, std::vector<std::pair<T, std::uint32_t>>& out,
-               T max_distance_squared = std::numeric_limits<T>::infinity(), Stats&& stats = {}) {
+               NearestScratch<T>& scratch, std::vector<std::pair<K, std::uint32_t>>& out,
+               std::type_identity_t<K> max_key = std::numeric_limits<K>::infinity(),
+               Stats&& stats = {}) {
+    static_assert(std::is_convertible_v<nearest_detail::key_of<Distance, T, N>, K>,
+                  "k_nearest: out's key type must hold what the distance functor returns");
     out.clear();
     if (k == 0) return;
-    auto& best = scratch.best;  // a max-heap of the k best so far
-    best.clear();
-    T radius2 = max_distance_squared;
+    // `out` itself is the max-heap of the k best so far (the caller keeps it, so it stays grown).
+    auto& best = out;
+    K radius = max_key;
+    T prune2 = nearest_detail::prune_radius2(distance, p, radius);
     nearest_detail::best_first(
-        bvh, p, scratch, [&] { return nearest_detail::prune_radius2(distance, p, radius2); },
+        bvh, p, scratch, [&] { return prune2; },
         [&](std::uint32_t s) {
-            const T d2 = distance(s, p, radius2);
-            if (!(d2 <= radius2)) return;  // NaN included
+            const K key = distance(s, p, radius);
+            if (!(key <= radius)) return;  // NaN included
             if (best.size() == k) {
-                if (!(d2 < best.front().first)) return;
+                if (!(std::pair<K, std::uint32_t>(key, s) < best.front())) return;
                 std::pop_heap(best.begin(), best.end());
                 best.pop_back();
             }
-            best.emplace_back(d2, s);
+            best.emplace_back(key, s);
             std::push_heap(best.begin(), best.end());
-            if (best.size() == k) radius2 = std::min(radius2, best.front().first);
+            if (best.size() == k && best.front().first < radius) {
+                radius = best.front().first;
+                prune2 = nearest_detail::prune_radius2(distance, p, radius);
+            }
         },
         stats);
-    out.assign(best.begin(), best.end());
-    std::sort(out.begin(), out.end());
+    std::sort_heap(best.begin(), best.end());
 }
 
-/// Every primitive within `radius` of `p` (inclusive): on_found(LeafSlot, squared distance)
-/// returns true to go on, false to stop. Depth first (bvh/traverse.hpp; the order does not matter
-/// here). A negative or NaN radius holds nothing (no ball has it): no primitive is reported.
-/// (`distance` still takes the slot as a number: it is the functor nearest() and k_nearest()
-/// share.)
+/// Every primitive within `radius` of `p` (inclusive): on_found(LeafSlot, key) returns true to go
+/// on, false to stop; the key is what `distance` returns, compared with radius^2 taken in the
+/// key's type (for a float tree and a double key, exactly). Depth first (bvh/traverse.hpp; the
+/// order does not matter here). A negative or NaN radius holds nothing (no ball has it): no
+/// primitive is reported. (`distance` still takes the slot as a number: it is the functor
+/// nearest() and k_nearest() share.)
 template <class T, std::size_t N, class Distance, class OnFound, class Stats = NoStats>
 bool within_radius(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, T radius, Distance&& distance,
                    OnFound&& on_found, Stats&& stats = {}) {
     if (!(radius >= T(0))) return true;
-    const T r2 = radius * radius;
+    using K = nearest_detail::key_of<Distance, T, N>;
+    const K r2 = K(radius) * K(radius);
     const T prune2 = nearest_detail::prune_radius2(distance, p, r2);
     const auto enter = [&](std::uint32_t, const BvhNode<Aabb<T, N>>& node) {
         stats.node();
@@ -201,7 +241,7 @@ bool within_radius(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, T radius, Dis
     const auto on_leaf = [&](const BvhNode<Aabb<T, N>>& leaf) {
         for (const LeafSlot s : leaf_slots(leaf)) {
             stats.primitive();
-            const T d2 = distance(s.value, p, r2);
+            const K d2 = distance(s.value, p, r2);
             if (d2 <= r2 && !on_found(s, d2)) return false;
         }
         return true;
