@@ -15,7 +15,7 @@
 // - what it leaves is first scaled by one power of two that brings every coordinate into the
 //   expansions' exact range (exact: a determinant of degree 3 in the coordinates keeps its sign),
 //   which exists while the largest coordinate is within 2^688 of the lowest set bit of any
-//   (2^1034 for orient2d);
+//   (2^1027 for orient2d);
 // - beyond that (say 1e300 and 1e-10 in one call) the determinant is taken in exact integers
 //   (math/exact_integer.hpp), slow but exact.
 // A NaN or infinite coordinate has no sign: 0 (the expansions must never see one).
@@ -248,8 +248,9 @@ inline constexpr int orient3d_low = -358, orient3d_high = 330;
 inline constexpr int orient2d_low = -537, orient2d_high = 490;
 
 /// The exact sign for any double input the filter left (the header's steps after the filter).
-inline int orient3d_any(const Vec<double, 3>& a, const Vec<double, 3>& b, const Vec<double, 3>& c,
-                        const Vec<double, 3>& d) {
+/// Kept out of line: callers inline the filter, not this rare path.
+[[gnu::noinline]] inline int orient3d_any(const Vec<double, 3>& a, const Vec<double, 3>& b,
+                                          const Vec<double, 3>& c, const Vec<double, 3>& d) {
     BitSpan span;
     for (std::size_t k = 0; k < 3; ++k) {
         span.add(a[k]);
@@ -270,7 +271,8 @@ inline int orient3d_any(const Vec<double, 3>& a, const Vec<double, 3>& b, const 
     return orient3d_exact(scaled(a), scaled(b), scaled(c), scaled(d));
 }
 
-inline int orient2d_any(double ax, double ay, double bx, double by, double cx, double cy) {
+[[gnu::noinline]] inline int orient2d_any(double ax, double ay, double bx, double by, double cx,
+                                          double cy) {
     double x[6] = {ax, ay, bx, by, cx, cy};
     BitSpan span;
     for (const double v : x) span.add(v);

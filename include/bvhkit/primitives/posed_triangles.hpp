@@ -258,7 +258,8 @@ class PosedTriangles {
                 return {};
             case detail::Filtered::Crossing: {
                 TriangleIntersection<double> x = detail::crossing_segment(ra, rb);
-                if (k != 0) x.p = scaled(x.p, -k), x.q = scaled(x.q, -k);
+                if constexpr (!std::is_same_v<T, float>)
+                    if (k != 0) x.p = scaled(x.p, -k), x.q = scaled(x.q, -k);
                 return detail::rounded<T>(x);
             }
             case detail::Filtered::Undecided:
