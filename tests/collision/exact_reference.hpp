@@ -49,6 +49,15 @@ int exact_orient3d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, c
     return idot(icross(isub(p[1], p[0]), isub(p[2], p[0])), isub(p[3], p[0])).sign();
 }
 
+/// Sign of (b - a) x (c - a) in the plane of coordinates x and y, exactly.
+template <class T>
+int exact_orient2d(const Vec<T, 3>& a, const Vec<T, 3>& b, const Vec<T, 3>& c, std::size_t x,
+                   std::size_t y) {
+    const auto p = to_integers<T>({a, b, c});
+    const IVec u = isub(p[1], p[0]), v = isub(p[2], p[0]);
+    return (u[x] * v[y] - u[y] * v[x]).sign();
+}
+
 /// Whether closed triangles a and b (of any shape, zero area included) meet, exactly, given as
 /// integer corners q[0..2] (a) and q[3..5] (b) at one scale.
 inline bool exact_integer_triangles_meet(const std::vector<IVec>& q) {

@@ -135,6 +135,14 @@ void check_scales(int lo, int hi, int step, double far, std::size_t& meeting,
             ASSERT_EQ(collide_pairs(aa, ab, c.pose, true), want) << "10^" << k << " at " << away;
             ASSERT_EQ(collide_pairs(oa, ob, c.pose, false), want) << "10^" << k << " at " << away;
             ASSERT_EQ(collides(oa, ob, c.pose), !want.empty()) << "10^" << k << " at " << away;
+            // B's corners carried and rounded, at the identity pose: the exact decision on the
+            // coordinates themselves (no rounding bound).
+            std::vector<Triangle<T>> carried;
+            for (const auto& t : c.b) carried.push_back(transformed(t, c.pose));
+            const Transform<T> identity;
+            const PairSet here = exact_posed_pairs(c.a, carried, identity);
+            const CollisionModel<Obb<T>> oc(mesh_of(carried));
+            ASSERT_EQ(collide_pairs(oa, oc, identity, true), here) << "10^" << k << " at " << away;
         }
 }
 
@@ -148,30 +156,42 @@ TEST(PosedExact, FloatNearTouchingPairsMatchTheExactPoseAcrossScales) {
 
 TEST(PosedExact, DoubleNearTouchingPairsMatchTheExactPoseAcrossScales) {
     std::size_t meeting = 0, flipped = 0;
-    // Sizes 1e-90 to 1e90 (coordinates to 1e96): the predicates' double range, differences
-    // within 2^+-300; Aabb and Obb trees find every contact across it.
-    check_scales<double>(-90, 90, 15, 1e6, meeting, flipped);
+    // Sizes 1e-300 to 1e300 (coordinates to ~1e306): products of differences underflow and
+    // overflow double at the ends; Aabb and Obb trees find every contact across it.
+    check_scales<double>(-300, 300, 30, 1e6, meeting, flipped);
+    // Where products of three differences are subnormal: the filters' bounds sink below their
+    // rounding there.
+    check_scales<double>(-110, -100, 2, 1e6, meeting, flipped);
     EXPECT_GT(meeting, 0u);
     EXPECT_GT(flipped, 0u);
 }
 
-TEST(PosedExact, ExactPoseLevelsAgreeOnSingleTriangles) {
-    // The three levels of PosedTriangles give the exact answer pair by pair, segments included:
-    // each contact's segment lies within rounding of both triangles' boxes.
-    const auto c = near_touching<float>(scaled(200, 10), 1.0, 1e4, 7);
-    const PosedTriangles<float> posed(c.pose, 2e4f);
+/// The three levels of PosedTriangles give the exact answer pair by pair, segments included:
+/// each contact's segment lies within rounding of a's box (widened by 1% of the size s).
+template <class T>
+void check_levels(std::size_t count, double s, double origin, std::uint64_t seed) {
+    const auto c = near_touching<T>(count, s, origin, seed);
+    const PosedTriangles<T> posed(c.pose, T(2 * (std::fabs(origin) + 8 * s * double(count))));
     EXPECT_GT(posed.transform_error(), 0.0);
     for (std::size_t i = 0; i < c.a.size(); ++i) {
         const bool want = exact_posed_meet(c.a[i], c.b[i], c.pose);
-        ASSERT_EQ(posed.intersects(c.a[i], c.b[i]), want) << i;
+        ASSERT_EQ(posed.intersects(c.a[i], c.b[i]), want) << i << " at " << s;
         const auto x = posed.intersect(c.a[i], c.b[i]);
-        ASSERT_EQ(x.hit, want) << i;
+        ASSERT_EQ(x.hit, want) << i << " at " << s;
         if (!want) continue;
-        Aabb<float, 3> box = c.a[i].bounds();
-        box.min = box.min - Vec<float, 3>(0.01f);
-        box.max = box.max + Vec<float, 3>(0.01f);
-        EXPECT_TRUE(box.contains(x.p) && box.contains(x.q)) << i;
+        Aabb<T, 3> box = c.a[i].bounds();
+        box.min = box.min - Vec<T, 3>(T(0.01 * s));
+        box.max = box.max + Vec<T, 3>(T(0.01 * s));
+        EXPECT_TRUE(box.contains(x.p) && box.contains(x.q)) << i << " at " << s;
     }
+}
+
+TEST(PosedExact, ExactPoseLevelsAgreeOnSingleTriangles) {
+    check_levels<float>(scaled(200, 10), 1.0, 1e4, 7);
+    // Double at the ends of its range, where the double level runs on the pair scaled by a power
+    // of two and the segments are constructed on scaled corners.
+    for (const double s : {1e-300, 1e-105, 1.0, 1e300})
+        for (const double away : {0.0, 1e6}) check_levels<double>(scaled(100, 10), s, away * s, 8);
 }
 
 TEST(PosedExact, IdentityAndSignedPermutationsAreExactInDouble) {

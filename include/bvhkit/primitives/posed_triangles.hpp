@@ -18,11 +18,18 @@
 // The segment of a contact is then computed in double from the double corners and rounded to T, as
 // triangle_contact.hpp does; the decision never depends on it.
 //
-// Range: float input (model and pose) for every finite value; double input while the coordinate
-// differences met in the double evaluations lie in [2^-300, 2^300] (math/predicates.hpp's range;
-// outside it, overflowing bounds fall to the exact level, underflow is not covered).
+// Range: every finite input. Float models (coordinates and pose) never leave the range where the
+// double bounds hold. For double models a pair is first scaled by one power of two (exact: the
+// signs are homogeneous in the coordinates and the rounding bound scales with them) so that every
+// nonzero coordinate and the bound lie in [2^-250, 2^251), where no product of the bounds
+// underflows (a sunk product would make a bound too small) and none overflows; a pair spanning
+// more than 2^500 skips the double level (an overflowing bound only ever declines, and the exact
+// level takes every double).
+#include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
+#include <type_traits>
 
 #include "bvhkit/math/exact_integer.hpp"
 #include "bvhkit/math/transform.hpp"
@@ -116,6 +123,35 @@ inline bool orient3d_signs_within(const Vec<double, 3>& a, const Vec<double, 3>&
 
 enum class Filtered { None, Crossing, Undecided };
 
+/// The power of two 2^k that brings the pair's nonzero coordinates and e into [2^-250, 2^251)
+/// (the header's range for double models), k nearest 0; false when there is none.
+inline bool filter_shift(const Vec<double, 3>* u, const Vec<double, 3>* v, double e, int& k) {
+    int high = INT_MIN, low = INT_MAX;
+    bool finite = true;
+    const auto add = [&](double x) {
+        if (x == 0) return;
+        if (!std::isfinite(x)) {  // a corner carried past the largest double
+            finite = false;
+            return;
+        }
+        const int b = std::ilogb(x);
+        high = std::max(high, b);
+        low = std::min(low, b);
+    };
+    for (int i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) {
+            add(u[i][j]);
+            add(v[i][j]);
+        }
+    add(e);
+    if (!finite) return false;
+    if (high == INT_MIN) return true;  // all zero: k stays 0
+    if (low >= -250 && high <= 250) return true;
+    if (high - low > 500) return false;
+    k = std::clamp(0, -250 - low, 250 - high);
+    return true;
+}
+
 /// decide() (triangle_triangle.hpp) for exact corners u and corners v within e of b's exact
 /// ones, where the signs are certain; Undecided elsewhere (including every General case).
 inline Filtered decide_within(const Vec<double, 3>* u, const Vec<double, 3>* v, double e,
@@ -190,7 +226,8 @@ class PosedTriangles {
             return triangles_intersect(Triangle<double>{u[0], u[1], u[2]},
                                        Triangle<double>{v[0], v[1], v[2]});
         Vec3d ra[3], rb[3];
-        switch (detail::decide_within(u, v, error_, ra, rb)) {
+        int k = 0;
+        switch (filtered(u, v, ra, rb, k)) {
             case detail::Filtered::None:
                 return false;
             case detail::Filtered::Crossing:
@@ -215,11 +252,16 @@ class PosedTriangles {
             return detail::rounded<T>(intersect_triangles(Triangle<double>{u[0], u[1], u[2]},
                                                           Triangle<double>{v[0], v[1], v[2]}));
         Vec3d ra[3], rb[3];
-        switch (detail::decide_within(u, v, error_, ra, rb)) {
+        int k = 0;
+        switch (filtered(u, v, ra, rb, k)) {
             case detail::Filtered::None:
                 return {};
-            case detail::Filtered::Crossing:
-                return detail::rounded<T>(detail::crossing_segment(ra, rb));
+            case detail::Filtered::Crossing: {
+                TriangleIntersection<double> x = detail::crossing_segment(ra, rb);
+                if constexpr (!std::is_same_v<T, float>)
+                    if (k != 0) x.p = scaled(x.p, -k), x.q = scaled(x.q, -k);
+                return detail::rounded<T>(x);
+            }
             case detail::Filtered::Undecided:
                 break;
         }
@@ -232,6 +274,24 @@ class PosedTriangles {
     double transform_error() const { return error_; }
 
   private:
+    static Vec3d scaled(const Vec3d& p, int k) {
+        return {std::ldexp(p[0], k), std::ldexp(p[1], k), std::ldexp(p[2], k)};
+    }
+
+    /// The double level (decide_within) on a pair; for double models on the pair scaled by 2^k
+    /// (filter_shift), with ra, rb then scaled too. Undecided where no such k exists.
+    detail::Filtered filtered(const Vec3d* u, const Vec3d* v, Vec3d* ra, Vec3d* rb, int& k) const {
+        if constexpr (std::is_same_v<T, float>) {
+            return detail::decide_within(u, v, error_, ra, rb);
+        } else {
+            if (!detail::filter_shift(u, v, error_, k)) return detail::Filtered::Undecided;
+            if (k == 0) return detail::decide_within(u, v, error_, ra, rb);
+            const Vec3d us[3] = {scaled(u[0], k), scaled(u[1], k), scaled(u[2], k)};
+            const Vec3d vs[3] = {scaled(v[0], k), scaled(v[1], k), scaled(v[2], k)};
+            return detail::decide_within(us, vs, std::ldexp(error_, k), ra, rb);
+        }
+    }
+
     /// The exact level: the corners as integers at one scale 2^s (a's coordinates, t, and each
     /// product R_ij x_j are integers there), the decision on them. With `segment`, a contact's
     /// segment from the double corners u, v.
@@ -269,21 +329,13 @@ class PosedTriangles {
         const auto at = [&](const detail::ExactCorner& c) {
             return c.id < 3 ? u[c.id] : v[c.id - 3];
         };
-        if (m == detail::Meet::Crossing) {
-            const Vec3d ra[3] = {at(ea[0]), at(ea[1]), at(ea[2])};
-            const Vec3d rb[3] = {at(eb[0]), at(eb[1]), at(eb[2])};
-            *segment = detail::crossing_segment(ra, rb);
-            return true;
-        }
-        // Coplanar or zero-area (decided exactly): the segment from the double corners, which
-        // are within rounding of the exact ones; a point of them when they do not meet.
-        const std::size_t xu = detail::projection_axis(eu), xv = detail::projection_axis(ev);
-        if (xu != 3 && xv != 3) {
-            *segment = detail::coplanar_segment(u, v, xu);
-        } else {
-            const Vec3d p = detail::degenerate_contact(u, v);
-            *segment = {true, false, p, p};
-        }
+        // The segment from the double corners, which are within rounding of the exact ones.
+        Vec3d ra[3], rb[3];
+        for (int i = 0; i < 3; ++i) ra[i] = at(ea[i]), rb[i] = at(eb[i]);
+        if constexpr (std::is_same_v<T, float>)
+            *segment = detail::contact_segment(m, u, v, ra, rb, eu, ev);
+        else  // double models reach scales where the constructions need scaling
+            *segment = detail::contact_segment_scaled(m, u, v, ra, rb, eu, ev);
         return true;
     }
 

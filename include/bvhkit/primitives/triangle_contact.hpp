@@ -2,6 +2,8 @@
 // The intersection segment of two triangles already known to meet (triangle_triangle.hpp decides
 // that exactly). The points are interpolated in double and rounded to T; rounding may move them by
 // a few ulps of the coordinates, the decision is unaffected.
+#include <type_traits>
+
 #include "bvhkit/primitives/triangle_triangle.hpp"
 
 namespace bvhkit {
@@ -113,12 +115,83 @@ Vec3x degenerate_contact(const Vec<T, 3>* u, const Vec<T, 3>* v) {
     return Vec3x(u[0]);  // not reached when the triangles meet
 }
 
+/// For the segment of a double pair whose extent (largest coordinate difference) lies outside
+/// [2^-300, 2^300], where the constructions' products of differences overflow or sink: a k that
+/// brings the extent near 1, limited so that no coordinate passes 2^1000 (a pair more than 2^1000
+/// times smaller than its distance from the origin gets a rough point, never a non-finite one).
+inline bool segment_shift(const Vec3x* u, const Vec3x* v, int& k) {
+    double lo[3], hi[3], largest = 0;
+    for (std::size_t j = 0; j < 3; ++j) {
+        lo[j] = hi[j] = u[0][j];
+        for (int i = 0; i < 3; ++i) {
+            lo[j] = std::min({lo[j], u[i][j], v[i][j]});
+            hi[j] = std::max({hi[j], u[i][j], v[i][j]});
+        }
+        largest = std::max({largest, std::fabs(lo[j]), std::fabs(hi[j])});
+    }
+    double extent = 0;  // halved, so that the differences of any doubles stay finite
+    for (std::size_t j = 0; j < 3; ++j) extent = std::max(extent, hi[j] * 0.5 - lo[j] * 0.5);
+    if (!(extent > 0) || (extent >= 0x1p-301 && extent <= 0x1p299)) return false;
+    k = std::min(-std::ilogb(extent), 1000 - std::ilogb(largest));
+    return true;
+}
+
+inline Vec3x scaled(const Vec3x& p, int k) {
+    return {std::ldexp(p[0], k), std::ldexp(p[1], k), std::ldexp(p[2], k)};
+}
+
+/// The segment of triangles u and v known to meet (`m` from decide(), ra and rb its reordering),
+/// from their double corners.
+template <class P>
+TriangleIntersection<double> contact_segment(Meet m, const Vec3x* u, const Vec3x* v,
+                                             const Vec3x* ra, const Vec3x* rb, const P* eu,
+                                             const P* ev) {
+    if (m == Meet::Crossing) return crossing_segment(ra, rb);
+    const std::size_t au = projection_axis(eu), av = projection_axis(ev);
+    if (au != 3 && av != 3) return coplanar_segment(u, v, au);
+    const Vec3x p = degenerate_contact(u, v);
+    return {true, false, p, p};
+}
+
+/// contact_segment on the corners scaled by 2^k where segment_shift() asks for it (the decision
+/// m was taken on the exact corners eu, ev; the constructions only place the points).
+template <class P>
+TriangleIntersection<double> contact_segment_scaled(Meet m, const Vec3x* u, const Vec3x* v,
+                                                    const Vec3x* ra, const Vec3x* rb, const P* eu,
+                                                    const P* ev) {
+    int k = 0;
+    if (!segment_shift(u, v, k)) return contact_segment(m, u, v, ra, rb, eu, ev);
+    Vec3x w[12];
+    for (int i = 0; i < 3; ++i) {
+        w[i] = scaled(u[i], k);
+        w[3 + i] = scaled(v[i], k);
+        w[6 + i] = scaled(ra[i], k);
+        w[9 + i] = scaled(rb[i], k);
+    }
+    TriangleIntersection<double> x = contact_segment(m, w, w + 3, w + 6, w + 9, eu, ev);
+    x.p = scaled(x.p, -k);
+    x.q = scaled(x.q, -k);
+    return x;
+}
+
 }  // namespace detail
 
 /// Whether the closed triangles meet, and where (triangle_triangle.hpp's rules).
 template <class T>
 TriangleIntersection<T> intersect_triangles(const Triangle<T>& a, const Triangle<T>& b) {
     const Vec<T, 3> u[3] = {a.p0, a.p1, a.p2}, v[3] = {b.p0, b.p1, b.p2};
+    if constexpr (!std::is_same_v<T, float>) {  // segments at any scale
+        using detail::Vec3x;
+        const Vec3x du[3] = {Vec3x(u[0]), Vec3x(u[1]), Vec3x(u[2])},
+                    dv[3] = {Vec3x(v[0]), Vec3x(v[1]), Vec3x(v[2])};
+        Vec3x ra[3], rb[3];
+        const detail::Meet m = detail::decide(du, dv, ra, rb);
+        if (m == detail::Meet::None) return {};
+        if (m == detail::Meet::General && !detail::edges_meet(du, dv)) return {};
+        const TriangleIntersection<double> x =
+            detail::contact_segment_scaled(m, du, dv, ra, rb, du, dv);
+        return {true, x.coplanar, Vec<T, 3>(x.p), Vec<T, 3>(x.q)};
+    }
     Vec<T, 3> ra[3], rb[3];
     switch (detail::decide(u, v, ra, rb)) {
         case detail::Meet::None:
