@@ -20,6 +20,7 @@
 #include <limits>
 #include <vector>
 
+#include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/primitives/triangle_distance.hpp"
 #include "bvhkit/query/min_heap.hpp"
 #include "bvhkit/query/pairs_model.hpp"
@@ -44,18 +45,44 @@ struct DistanceResult {
 namespace detail {
 
 /// Whether triangle `u` lies wholly on one side of triangle t's plane, at least `gap` from it
-/// (then the triangles are at least `gap` apart). In double: float squares overflow past 1.8e19,
-/// which would reject pairs that are not beyond; an infinite gap rejects nothing.
+/// (then the triangles are at least `gap` apart). In double, comparing sixth powers of the
+/// coordinates: only a normal, finite `reach` and |n|^2 are trusted (an overflowing pair of sides,
+/// inf >= inf, or two that sank to zero would reject pairs that are not beyond; a subnormal one
+/// has lost its bits), and anything else rejects nothing.
 template <class T>
 bool beyond_plane(const Triangle<T>& t, const Triangle<T>& u, T gap) {
     using V = Vec<double, 3>;
     if (!(double(gap) < std::numeric_limits<double>::infinity())) return false;
     const V t0(t.p0), n = cross(V(t.p1) - t0, V(t.p2) - t0);
     const double d0 = dot(n, V(u.p0) - t0), d1 = dot(n, V(u.p1) - t0), d2 = dot(n, V(u.p2) - t0);
-    const double reach = double(gap) * double(gap) * length_squared(n);
+    const double nn = length_squared(n), reach = double(gap) * double(gap) * nn;
+    constexpr double normal = std::numeric_limits<double>::min();
+    if (!(nn >= normal && reach >= normal && reach <= std::numeric_limits<double>::max()))
+        return false;
     const double lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
     return (lo > 0 && lo * lo >= reach) || (hi < 0 && hi * hi >= reach);
 }
+
+/// A squared distance as s2 * 4^e: a pair measured at scale 2^-e (triangle_distance.hpp) keeps
+/// its square there, which double holds where the square itself would overflow or sink to zero.
+/// Pairs measured as given have e = 0 and compare as plain squares.
+struct ScaledSquare {
+    double s2 = std::numeric_limits<double>::infinity();
+    int e = 0;
+    /// Whether c2 * 4^ce is below this (any finite value is below the initial inf; an exponent
+    /// far apart settles it by the scaling's overflow to inf or underflow to 0).
+    bool exceeds(double c2, int ce) const {
+        if (ce == e) return c2 < s2;
+        if (!(s2 < std::numeric_limits<double>::infinity())) return c2 < s2;
+        return std::ldexp(c2, 2 * (ce - e)) < s2;
+    }
+    /// The distance, rounded to T (inf beyond T's range).
+    template <class T>
+    T root() const {
+        const double r = std::sqrt(s2);
+        return narrow_or_inf<T>(e == 0 ? r : std::ldexp(r, e));
+    }
+};
 
 }  // namespace detail
 
@@ -95,12 +122,13 @@ DistanceResult<typename V::Scalar> distance(
                         : std::numeric_limits<T>::infinity();
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
     const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
-    // The best squared distance is kept in double (finite for any finite float input: a float
-    // square overflows past 1.8e19); `best`, its root in T, feeds the volumes' bounds.
-    double best2 = std::numeric_limits<double>::infinity();
+    // The best squared distance, kept in double (finite for any finite float input: a float
+    // square overflows past 1.8e19) and scaled with its pair (detail::ScaledSquare); `best`, its
+    // root in T, feeds the volumes' bounds.
+    detail::ScaledSquare best2;
     T best = std::numeric_limits<T>::infinity();
     const auto hopeless = [&](T lb) {
-        if (!(best2 < std::numeric_limits<double>::infinity())) return false;
+        if (!(best2.s2 < std::numeric_limits<double>::infinity())) return false;
         const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
         return lb >= best - tol;
     };
@@ -152,16 +180,57 @@ DistanceResult<typename V::Scalar> distance(
         const auto& na = na_[e.a];
         const auto& nb = nb_[e.b];
         if (na.is_leaf() && nb.is_leaf()) {
+            const auto take = [&](double d2, int exponent, const Vec<double, 3>& p,
+                                  const Vec<double, 3>& q, std::uint32_t sa, std::uint32_t sb) {
+                if (!best2.exceeds(d2, exponent)) return;
+                best2 = {d2, exponent};
+                best = best2.root<T>();
+                result.distance = best;
+                result.point_a = Vec<T, 3>(p);
+                result.point_b = Vec<T, 3>(q);
+                result.triangle_a = a.triangle_id(sa);
+                result.triangle_b = b.triangle_id(sb);
+            };
             // B's triangle outside: carried into A's frame (in double) once for all of A's.
             for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
                 using D = Vec<double, 3>;
                 const D vb[3] = {posed.apply(tb[sb].p0), posed.apply(tb[sb].p1),
                                  posed.apply(tb[sb].p2)};
                 const Triangle<double> tri_b{vb[0], vb[1], vb[2]};
+                const double mb = detail::largest_coordinate(tri_b);
                 const double rb = std::sqrt(
                     std::max(length_squared(vb[1] - vb[0]), length_squared(vb[2] - vb[0])));
                 for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
                     const Triangle<double> tri_a{D(ta[sa].p0), D(ta[sa].p1), D(ta[sa].p2)};
+                    // Outside the window of triangle_distance.hpp the pair is tested and
+                    // measured at scale 2^-k (best scaled alike), where its powers stay finite
+                    // and normal.
+                    const int k =
+                        detail::pair_exponent(std::max(mb, detail::largest_coordinate(tri_a)));
+                    if (k != 0) [[unlikely]] {
+                        const Triangle<double> ua = detail::scaled_by(tri_a, -k),
+                                               ub = detail::scaled_by(tri_b, -k);
+                        const double gap = std::ldexp(double(best), -k);
+                        const double ra = std::sqrt(
+                            std::max(length_squared(ua.p1 - ua.p0), length_squared(ua.p2 - ua.p0)));
+                        const double rs = std::sqrt(
+                            std::max(length_squared(ub.p1 - ub.p0), length_squared(ub.p2 - ub.p0)));
+                        const double reach = gap + ra + rs;
+                        if (length_squared(ua.p0 - ub.p0) > reach * reach) continue;
+                        if (detail::beyond_plane(ua, ub, gap) || detail::beyond_plane(ub, ua, gap))
+                            continue;
+                        result.stats.primitive();
+                        const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
+                        if (x.hit) {
+                            take(0.0, 0, D(x.p), D(x.p), sa, sb);
+                        } else {
+                            const D u[3] = {ua.p0, ua.p1, ua.p2}, v[3] = {ub.p0, ub.p1, ub.p2};
+                            const detail::FeatureDistance f = detail::feature_distance(u, v);
+                            take(f.distance_squared, k, detail::scaled_by(f.p, k),
+                                 detail::scaled_by(f.q, k), sa, sb);
+                        }
+                        continue;
+                    }
                     // Cheap rejection by the triangles' spheres about their first corners.
                     const double ra = std::sqrt(std::max(length_squared(tri_a.p1 - tri_a.p0),
                                                          length_squared(tri_a.p2 - tri_a.p0)));
@@ -174,24 +243,16 @@ DistanceResult<typename V::Scalar> distance(
                         continue;
                     result.stats.primitive();
                     const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
-                    const auto d = x.hit ? TriangleDistanceResult<double>{0.0, D(x.p), D(x.p)}
-                                         : triangle_distance_apart(tri_a, tri_b);
-                    if (d.distance_squared < best2) {
-                        best2 = d.distance_squared;
-                        // Above T's range only for float corners near 3e38: +inf, not UB.
-                        const double root = std::sqrt(best2);
-                        best = root <= double(std::numeric_limits<T>::max())
-                                   ? T(root)
-                                   : std::numeric_limits<T>::infinity();
-                        result.distance = best;
-                        result.point_a = Vec<T, 3>(d.p);
-                        result.point_b = Vec<T, 3>(d.q);
-                        result.triangle_a = a.triangle_id(sa);
-                        result.triangle_b = b.triangle_id(sb);
+                    if (x.hit) {
+                        take(0.0, 0, D(x.p), D(x.p), sa, sb);
+                    } else {
+                        const D u[3] = {tri_a.p0, tri_a.p1, tri_a.p2};
+                        const detail::FeatureDistance f = detail::feature_distance(u, vb);
+                        take(f.distance_squared, 0, f.p, f.q, sa, sb);
                     }
                 }
             }
-            if (best2 == 0) break;
+            if (best2.s2 == 0) break;
             continue;
         }
         const DescentRule rule =
