@@ -11,8 +11,10 @@
 
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
+#include "bvhkit/volumes/kdop.hpp"
 #include "bvhkit/volumes/obb.hpp"
 #include "bvhkit/volumes/rss.hpp"
+#include "collision_support.hpp"
 #include "test_support.hpp"
 
 namespace bvhkit::test {
@@ -119,6 +121,64 @@ TEST(PosedDistanceScales, PlaneTestNeverDropsTheNearerTriangle) {
         check_near_after_far<Obb<double>>(s);
         check_near_after_far<Rss<double>>(s);
         check_near_after_far<Aabb<double, 3>>(s);
+    }
+}
+
+// Random soups scaled by 2^k where the volumes' squared lengths sink below T's normal range
+// (double near 1e-161, float near 1e-21): the distance must be the one at scale 1 (brute force
+// over every pair) times 2^k, the scaling being exact. A rooted subnormal square is off by up
+// to sqrt(denorm_min), a large part of such a model's size: without room for that in the slack,
+// bounds exceed the true distance and the closest pair is dropped.
+template <class V>
+void check_soups_scaled(int k) {
+    using T = typename V::Scalar;
+    std::mt19937_64 rng(k + 1000);
+    std::normal_distribution<double> normal;
+    std::uniform_real_distribution<double> shift(0, 1.2);
+    for (std::uint64_t seed = 0; seed < 2; ++seed) {
+        const auto ma = random_soup<T>(60, 0.08, 40 + seed),
+                   mb = random_soup<T>(50, 0.08, 50 + seed);
+        auto sa = ma, sb = mb;
+        for (auto* m : {&sa, &sb})
+            for (auto& v : m->vertices)
+                for (int i = 0; i < 3; ++i) v[i] = std::ldexp(v[i], k);
+        const CollisionModel<V> a(sa), b(sb);
+        const auto ta = mesh_triangles(ma), tb = mesh_triangles(mb);
+        for (int p = 0; p < 6; ++p) {
+            double q[4] = {normal(rng), normal(rng), normal(rng), normal(rng)};
+            const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+            const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+            Transform<T> pose;
+            pose.rotation.row[0] = {T(1 - 2 * (y * y + z * z)), T(2 * (x * y - w * z)),
+                                    T(2 * (x * z + w * y))};
+            pose.rotation.row[1] = {T(2 * (x * y + w * z)), T(1 - 2 * (x * x + z * z)),
+                                    T(2 * (y * z - w * x))};
+            pose.rotation.row[2] = {T(2 * (x * z - w * y)), T(2 * (y * z + w * x)),
+                                    T(1 - 2 * (x * x + y * y))};
+            pose.translation = {T(shift(rng)), T(shift(rng)), T(shift(rng))};
+            const double want = double(brute_force_distance(ta, tb, pose));
+            Transform<T> scaled = pose;
+            for (int i = 0; i < 3; ++i) scaled.translation[i] = std::ldexp(pose.translation[i], k);
+            const double got = std::ldexp(double(distance(a, b, scaled).distance), -k);
+            // The reference carries B's corners in T, the query in double: T's rounding of
+            // coordinates up to about 2.
+            const double tol = 1e-9 * want + 64 * double(std::numeric_limits<T>::epsilon());
+            EXPECT_NEAR(got, want, tol) << "2^" << k << " soup " << seed << " pose " << p;
+        }
+    }
+}
+
+TEST(PosedDistanceScales, SubnormalSquaresNeverDropTheClosestPair) {
+    for (const int k : {-530, -535, -545}) {
+        check_soups_scaled<Aabb<double, 3>>(k);
+        check_soups_scaled<Obb<double>>(k);
+        check_soups_scaled<Rss<double>>(k);
+        check_soups_scaled<Kdop<double, 18>>(k);
+    }
+    for (const int k : {-70, -75}) {
+        check_soups_scaled<Aabb<float, 3>>(k);
+        check_soups_scaled<Obb<float>>(k);
+        check_soups_scaled<Rss<float>>(k);
     }
 }
 

@@ -117,8 +117,14 @@ DistanceResult<typename V::Scalar> distance(
     const T extent =
         a.scale() + b.scale() +
         max_component(bvhkit::max(pose_of_b_in_a.translation, -pose_of_b_in_a.translation));
+    // At the other end the squares sink below T's normal range (models near 1e-154 in double,
+    // 1e-19 in float), and a length rooted from them may be off by up to sqrt(2.5 denorm_min):
+    // 16 sqrt(denorm_min) more slack keeps any bound made of a few such lengths below the true
+    // distance (at ordinary scales it vanishes in the slack's rounding; models far below, it
+    // turns pruning off as above).
     const T slack = std::isfinite(T(16) * extent * extent)
-                        ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a)
+                        ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a) +
+                              T(16) * std::sqrt(std::numeric_limits<T>::denorm_min())
                         : std::numeric_limits<T>::infinity();
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
     const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
