@@ -46,9 +46,10 @@ namespace detail {
 
 /// Whether triangle `u` lies wholly on one side of triangle t's plane, at least `gap` from it
 /// (then the triangles are at least `gap` apart). In double, comparing sixth powers of the
-/// coordinates: only a normal, finite `reach` and |n|^2 are trusted (an overflowing pair of sides,
-/// inf >= inf, or two that sank to zero would reject pairs that are not beyond; a subnormal one
-/// has lost its bits), and anything else rejects nothing.
+/// coordinates, which stay finite for coordinates within 2^150 (triangle_distance.hpp's window;
+/// distance() scales the pairs outside it): an infinite `reach` then rejects nothing, and only a
+/// normal `reach` and |n|^2 are trusted (two sides that sank to zero would reject pairs that are
+/// not beyond; a subnormal one has lost its bits).
 template <class T>
 bool beyond_plane(const Triangle<T>& t, const Triangle<T>& u, T gap) {
     using V = Vec<double, 3>;
@@ -56,11 +57,34 @@ bool beyond_plane(const Triangle<T>& t, const Triangle<T>& u, T gap) {
     const V t0(t.p0), n = cross(V(t.p1) - t0, V(t.p2) - t0);
     const double d0 = dot(n, V(u.p0) - t0), d1 = dot(n, V(u.p1) - t0), d2 = dot(n, V(u.p2) - t0);
     const double nn = length_squared(n), reach = double(gap) * double(gap) * nn;
-    constexpr double normal = std::numeric_limits<double>::min();
-    if (!(nn >= normal && reach >= normal && reach <= std::numeric_limits<double>::max()))
-        return false;
     const double lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
-    return (lo > 0 && lo * lo >= reach) || (hi < 0 && hi * hi >= reach);
+    return ((lo > 0 && lo * lo >= reach) || (hi < 0 && hi * hi >= reach)) &&
+           std::min(nn, reach) >= std::numeric_limits<double>::min();
+}
+
+/// For a triangle pair outside triangle_distance.hpp's window: whether distance()'s sphere or
+/// plane rejection drops it, both taken at scale 2^-k (`gap`, the best distance so far, scaled
+/// alike). Out of line: such pairs are rare, and the common loop stays as small as before.
+[[gnu::noinline]] inline bool rejected_at_scale(const Triangle<double>& a,
+                                                const Triangle<double>& b, int k, double gap) {
+    const Triangle<double> u = scaled_by(a, -k), v = scaled_by(b, -k);
+    const double g = std::ldexp(gap, -k);
+    const double ru = std::sqrt(std::max(length_squared(u.p1 - u.p0), length_squared(u.p2 - u.p0)));
+    const double rv = std::sqrt(std::max(length_squared(v.p1 - v.p0), length_squared(v.p2 - v.p0)));
+    const double reach = g + ru + rv;
+    return length_squared(u.p0 - v.p0) > reach * reach || beyond_plane(u, v, g) ||
+           beyond_plane(v, u, g);
+}
+
+/// feature_distance() of a pair at scale 2^-k: the squared distance at that scale (the true one
+/// times 4^-k), the points scaled back.
+[[gnu::noinline]] inline FeatureDistance feature_distance_at_scale(const Triangle<double>& a,
+                                                                   const Triangle<double>& b,
+                                                                   int k) {
+    const Triangle<double> u = scaled_by(a, -k), v = scaled_by(b, -k);
+    const Vec<double, 3> pu[3] = {u.p0, u.p1, u.p2}, pv[3] = {v.p0, v.p1, v.p2};
+    const FeatureDistance f = feature_distance(pu, pv);
+    return {f.distance_squared, scaled_by(f.p, k), scaled_by(f.q, k)};
 }
 
 /// A squared distance as s2 * 4^e: a pair measured at scale 2^-e (triangle_distance.hpp) keeps
@@ -86,15 +110,10 @@ struct ScaledSquare {
 
 }  // namespace detail
 
-// One function of some 150 lines, on purpose: every split tried took more instructions on the
-// placeable volumes (callgrind, 200 poses of a 5,120-triangle sphere about a 9,216-triangle torus,
-// query part only): its steps as members of a query class, Rss 94.3M -> 102.4M (+8.5%), Obb
-// 86.6M -> 89.1M (+2.8%), Aabb 168.9M -> 174.2M (+3.1%); the child opening below through one
-// function shared with pairs.hpp, Rss +8% here and +2.2% in for_each_overlapping_pair's collide
-// walk (823.7M -> 842.0M, that function forced inline); the leaf-pair loop alone as a function,
-// Rss and Obb unchanged but Aabb +1.3%. The opening is pairs.hpp's rule (detail::choose picks the
-// side, left child measured first here where that walk pushes the right one first): keep the two
-// in step.
+// One function, on purpose: every split tried took more instructions on the placeable volumes
+// (docs/benchmarks.md, "distance() in one piece"). The opening is pairs.hpp's rule
+// (detail::choose picks the side, left child measured first here where that walk pushes the right
+// one first): keep the two in step.
 template <BoundingVolume V>
 DistanceResult<typename V::Scalar> distance(
     const CollisionModel<V>& a, const CollisionModel<V>& b,
@@ -126,6 +145,9 @@ DistanceResult<typename V::Scalar> distance(
                         ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a) +
                               T(16) * std::sqrt(std::numeric_limits<T>::denorm_min())
                         : std::numeric_limits<T>::infinity();
+    // Whether every coordinate in A's frame is within 2^150: |R x + t| <= sqrt(3) |x| + |t| in
+    // the largest component, so twice the extent (rounding included) bounds them.
+    const bool window_top = 2 * double(extent) <= 0x1p150;
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
     const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
     // The best squared distance, kept in double (finite for any finite float input: a float
@@ -203,37 +225,30 @@ DistanceResult<typename V::Scalar> distance(
                 const D vb[3] = {posed.apply(tb[sb].p0), posed.apply(tb[sb].p1),
                                  posed.apply(tb[sb].p2)};
                 const Triangle<double> tri_b{vb[0], vb[1], vb[2]};
-                const double mb = detail::largest_coordinate(tri_b);
+                // Every pair with this triangle inside the window of triangle_distance.hpp
+                // (coordinates up to `window_top`, one of B's at least 2^-150): measured as
+                // given, with no per-pair look at the magnitudes.
+                const bool inside = window_top && max_component(abs(vb[0])) >= 0x1p-150;
                 const double rb = std::sqrt(
                     std::max(length_squared(vb[1] - vb[0]), length_squared(vb[2] - vb[0])));
                 for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
                     const Triangle<double> tri_a{D(ta[sa].p0), D(ta[sa].p1), D(ta[sa].p2)};
-                    // Outside the window of triangle_distance.hpp the pair is tested and
-                    // measured at scale 2^-k (best scaled alike), where its powers stay finite
-                    // and normal.
+                    // Outside the window the pair is tested and measured at scale 2^-k (best
+                    // scaled alike), where its powers stay finite and normal.
                     const int k =
-                        detail::pair_exponent(std::max(mb, detail::largest_coordinate(tri_a)));
+                        inside ? 0
+                               : detail::pair_exponent(std::max(detail::largest_coordinate(tri_b),
+                                                                detail::largest_coordinate(tri_a)));
                     if (k != 0) [[unlikely]] {
-                        const Triangle<double> ua = detail::scaled_by(tri_a, -k),
-                                               ub = detail::scaled_by(tri_b, -k);
-                        const double gap = std::ldexp(double(best), -k);
-                        const double ra = std::sqrt(
-                            std::max(length_squared(ua.p1 - ua.p0), length_squared(ua.p2 - ua.p0)));
-                        const double rs = std::sqrt(
-                            std::max(length_squared(ub.p1 - ub.p0), length_squared(ub.p2 - ub.p0)));
-                        const double reach = gap + ra + rs;
-                        if (length_squared(ua.p0 - ub.p0) > reach * reach) continue;
-                        if (detail::beyond_plane(ua, ub, gap) || detail::beyond_plane(ub, ua, gap))
-                            continue;
+                        if (detail::rejected_at_scale(tri_a, tri_b, k, double(best))) continue;
                         result.stats.primitive();
                         const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
                         if (x.hit) {
                             take(0.0, 0, D(x.p), D(x.p), sa, sb);
                         } else {
-                            const D u[3] = {ua.p0, ua.p1, ua.p2}, v[3] = {ub.p0, ub.p1, ub.p2};
-                            const detail::FeatureDistance f = detail::feature_distance(u, v);
-                            take(f.distance_squared, k, detail::scaled_by(f.p, k),
-                                 detail::scaled_by(f.q, k), sa, sb);
+                            const detail::FeatureDistance f =
+                                detail::feature_distance_at_scale(tri_a, tri_b, k);
+                            take(f.distance_squared, k, f.p, f.q, sa, sb);
                         }
                         continue;
                     }
