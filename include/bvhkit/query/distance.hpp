@@ -13,8 +13,8 @@
 // A zero-area triangle counts as the segment or point it is (triangle_triangle.hpp's rule).
 // B's corners are carried into A's frame in double; triangle pairs that meet for the pose as given
 // (exactly, as collide() decides: primitives/posed_triangles.hpp) are at distance 0 (the points
-// then lie on an intersection segment), the others are measured in double. An empty model gives
-// +infinity.
+// then lie on an intersection segment), the others are measured in double (a pair beyond
+// 2^+-150 at a power-of-two scale: triangle_distance.hpp). An empty model gives +infinity.
 #include <algorithm>
 #include <cmath>
 #include <limits>
