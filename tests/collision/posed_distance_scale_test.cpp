@@ -94,26 +94,30 @@ void check_near_after_far(double s) {
     BasicTriangleMesh<T> ma;
     ma.vertices = {{0, 0, 0}, {T(s), 0, 0}, {0, T(s), 0}};
     ma.triangles = {{0, 1, 2}};
-    for (const bool far_first : {true, false}) {
-        BasicTriangleMesh<T> mb;
-        for (const double z : far_first ? std::array{3 * s, s} : std::array{s, 3 * s})
-            for (const auto& c :
-                 {Vec<T, 3>{0, 0, T(z)}, Vec<T, 3>{T(s), 0, T(z)}, Vec<T, 3>{0, T(s), T(z)}})
-                mb.vertices.push_back(c);
-        mb.triangles = {{0, 1, 2}, {3, 4, 5}};
-        const CollisionModel<V> a(ma), b(mb);
-        // A turn about z (z carried exactly): the pose is not applied exactly, so contacts
-        // are decided on the exact integer level (posed_triangles.hpp).
-        Transform<T> pose;
-        const T c = T(std::cos(0.5)), sn = T(std::sin(0.5));
-        pose.rotation.row[0] = {c, -sn, 0};
-        pose.rotation.row[1] = {sn, c, 0};
-        const DistanceResult<T> r = distance(a, b, pose);
-        EXPECT_NEAR(double(r.distance) / s, 1.0, 1e-12) << s << (far_first ? " far first" : "");
-        EXPECT_EQ(r.triangle_b, far_first ? 1u : 0u) << s;
-        EXPECT_NEAR(double(r.point_b[2]) / s, 1.0, 1e-12) << s;
-        EXPECT_NEAR(double(r.point_a[2]) / s, 0.0, 1e-12) << s;
-    }
+    // B above and below A, each in both mesh orders: whichever order the builder keeps in the
+    // leaf, one of the cases meets the far triangle first.
+    for (const double side : {1.0, -1.0})
+        for (const bool far_first : {true, false}) {
+            BasicTriangleMesh<T> mb;
+            for (const double z : far_first ? std::array{3 * s, s} : std::array{s, 3 * s})
+                for (const auto& c : {Vec<T, 3>{0, 0, T(side * z)}, Vec<T, 3>{T(s), 0, T(side * z)},
+                                      Vec<T, 3>{0, T(s), T(side * z)}})
+                    mb.vertices.push_back(c);
+            mb.triangles = {{0, 1, 2}, {3, 4, 5}};
+            const CollisionModel<V> a(ma), b(mb);
+            // A turn about z (z carried exactly): the pose is not applied exactly, so contacts
+            // are decided on the exact integer level (posed_triangles.hpp).
+            Transform<T> pose;
+            const T c = T(std::cos(0.5)), sn = T(std::sin(0.5));
+            pose.rotation.row[0] = {c, -sn, 0};
+            pose.rotation.row[1] = {sn, c, 0};
+            const DistanceResult<T> r = distance(a, b, pose);
+            const char* order = far_first ? " far first" : " near first";
+            EXPECT_NEAR(double(r.distance) / s, 1.0, 1e-12) << s << order << " side " << side;
+            EXPECT_EQ(r.triangle_b, far_first ? 1u : 0u) << s << order << " side " << side;
+            EXPECT_NEAR(double(r.point_b[2]) / s, side, 1e-12) << s;
+            EXPECT_NEAR(double(r.point_a[2]) / s, 0.0, 1e-12) << s;
+        }
 }
 
 TEST(PosedDistanceScales, PlaneTestNeverDropsTheNearerTriangle) {
@@ -121,6 +125,23 @@ TEST(PosedDistanceScales, PlaneTestNeverDropsTheNearerTriangle) {
         check_near_after_far<Obb<double>>(s);
         check_near_after_far<Rss<double>>(s);
         check_near_after_far<Aabb<double, 3>>(s);
+    }
+}
+
+// The plane test itself, on coordinates as given: B's triangle at height s over A's plane is not
+// 3s beyond it, at any scale (its sixth powers overflow to inf >= inf from about 1e52 and sink to
+// 0 >= 0 below about 1e-52); where they stay normal it is s/2 beyond.
+TEST(PosedDistanceScales, PlaneTestNeverRejectsOnOverflowOrUnderflow) {
+    using V = Vec<double, 3>;
+    for (const double s : {1e-300, 1e-100, 1e-60, 1e-52, 1.0, 1e40, 1e52, 1e60, 1e100, 1e300}) {
+        const Triangle<double> a{V{0, 0, 0}, V{s, 0, 0}, V{0, s, 0}};
+        const Triangle<double> b{V{0, 0, s}, V{s, 0, s}, V{0, s, s}};
+        EXPECT_FALSE(detail::beyond_plane(a, b, 3 * s)) << s;
+        EXPECT_FALSE(detail::beyond_plane(b, a, 3 * s)) << s;
+        if (s >= 1e-40 && s <= 1e40) {
+            EXPECT_TRUE(detail::beyond_plane(a, b, s / 2)) << s;
+            EXPECT_TRUE(detail::beyond_plane(b, a, s / 2)) << s;
+        }
     }
 }
 

@@ -46,10 +46,10 @@ namespace detail {
 
 /// Whether triangle `u` lies wholly on one side of triangle t's plane, at least `gap` from it
 /// (then the triangles are at least `gap` apart). In double, comparing sixth powers of the
-/// coordinates, which stay finite for coordinates within 2^150 (triangle_distance.hpp's window;
-/// distance() scales the pairs outside it): an infinite `reach` then rejects nothing, and only a
-/// normal `reach` and |n|^2 are trusted (two sides that sank to zero would reject pairs that are
-/// not beyond; a subnormal one has lost its bits).
+/// coordinates: only a normal, finite `reach` and |n|^2 are trusted (two sides overflowing to
+/// inf >= inf, or sunk to 0 >= 0, would reject pairs that are not beyond; a subnormal one has lost
+/// its bits), and anything else rejects nothing. distance() scales the pairs whose coordinates
+/// leave 2^+-150 (triangle_distance.hpp), where it would reject nothing.
 template <class T>
 bool beyond_plane(const Triangle<T>& t, const Triangle<T>& u, T gap) {
     using V = Vec<double, 3>;
@@ -59,7 +59,8 @@ bool beyond_plane(const Triangle<T>& t, const Triangle<T>& u, T gap) {
     const double nn = length_squared(n), reach = double(gap) * double(gap) * nn;
     const double lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
     return ((lo > 0 && lo * lo >= reach) || (hi < 0 && hi * hi >= reach)) &&
-           std::min(nn, reach) >= std::numeric_limits<double>::min();
+           std::min(nn, reach) >= std::numeric_limits<double>::min() &&
+           reach <= std::numeric_limits<double>::max();
 }
 
 /// For a triangle pair outside triangle_distance.hpp's window: whether distance()'s sphere or
