@@ -7,7 +7,14 @@
 // Triangles that meet (triangle_triangle.hpp's rules, exact) are at distance 0, the points at the
 // start of their intersection segment. Everything is computed in double (float input converts
 // exactly): see docs/accuracy.md for the bound.
+//
+// Range: the segment step forms fourth powers of the coordinates and the plane test of
+// query/distance.hpp sixth powers, which leave double's range for coordinates past about 1e+-75
+// and 1e+-51. Every quantity is homogeneous in the coordinates, so a pair whose largest
+// |coordinate| lies outside [2^-150, 2^150] is measured after scaling by a power of two (exact)
+// that brings it to [1, 2), and the answer scaled back; pairs inside are measured as given.
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "bvhkit/math/select.hpp"
@@ -59,9 +66,12 @@ SegmentClosest<T> closest_points_segments(const Vec<T, 3>& p1, const Vec<T, 3>& 
 template <class T>
 struct TriangleDistanceResult {
     // In double for float and double triangles: finite for any finite float input (a float
-    // distance's square can overflow float), and free of float's cancellation on slivers.
+    // distance's square can overflow float), and free of float's cancellation on slivers. For
+    // double input the square leaves double's range (inf past 1.3e154, 0 or subnormal below
+    // 1e-154); `distance` does not.
     double distance_squared = std::numeric_limits<double>::infinity();
     Vec<T, 3> p{}, q{};  // on the first and on the second triangle (rounded to T)
+    double distance = std::numeric_limits<double>::infinity();
 };
 
 namespace detail {
@@ -81,7 +91,9 @@ inline Vec<double, 3> nearest_on_segment(const Vec<double, 3>& p, const Vec<doub
 inline Vec<double, 3> nearest_on_triangle(const Vec<double, 3>& p, const Vec<double, 3>* t) {
     const Vec<double, 3> n = cross(t[1] - t[0], t[2] - t[0]);
     const double nn = dot(n, n);
-    if (nn > 0 && dot(cross(t[1] - t[0], p - t[0]), n) >= 0 &&
+    // A subnormal nn has too few bits for the projection to land on the plane: such a triangle
+    // (area below 2^-511 of its squared size) is as near as its edges.
+    if (nn >= std::numeric_limits<double>::min() && dot(cross(t[1] - t[0], p - t[0]), n) >= 0 &&
         dot(cross(t[2] - t[1], p - t[1]), n) >= 0 && dot(cross(t[0] - t[2], p - t[2]), n) >= 0)
         return p - n * (dot(p - t[0], n) / nn);
     Vec<double, 3> best = nearest_on_segment(p, t[0], t[1]);
@@ -94,19 +106,15 @@ inline Vec<double, 3> nearest_on_triangle(const Vec<double, 3>& p, const Vec<dou
     return best;
 }
 
-}  // namespace detail
+struct FeatureDistance {
+    double distance_squared;
+    Vec<double, 3> p, q;
+};
 
-/// Distance between triangles a and b (zero-area ones are their segment or point), computed in
-/// double on the input coordinates; the points are rounded to T.
-template <class T>
-TriangleDistanceResult<T> triangle_distance(const Triangle<T>& a, const Triangle<T>& b);
-
-/// triangle_distance() for triangles already known not to meet (the least of the feature
-/// distances; 0 only where rounding makes it so).
-template <class T>
-TriangleDistanceResult<T> triangle_distance_apart(const Triangle<T>& a, const Triangle<T>& b) {
+/// The least of the 9 edge-edge and 6 corner-face distances of two triangles that do not meet,
+/// on the coordinates as given.
+inline FeatureDistance feature_distance(const Vec<double, 3>* u, const Vec<double, 3>* v) {
     using V = Vec<double, 3>;
-    const V u[3] = {V(a.p0), V(a.p1), V(a.p2)}, v[3] = {V(b.p0), V(b.p1), V(b.p2)};
     double best2 = std::numeric_limits<double>::infinity();
     V bp{}, bq{};
     const auto take = [&](const V& p, const V& q) {
@@ -119,16 +127,69 @@ TriangleDistanceResult<T> triangle_distance_apart(const Triangle<T>& a, const Tr
             take(s.p, s.q);
         }
     for (int i = 0; i < 3; ++i) {
-        take(u[i], detail::nearest_on_triangle(u[i], v));
-        take(detail::nearest_on_triangle(v[i], u), v[i]);
+        take(u[i], nearest_on_triangle(u[i], v));
+        take(nearest_on_triangle(v[i], u), v[i]);
     }
-    return {best2, Vec<T, 3>(bp), Vec<T, 3>(bq)};
+    return {best2, bp, bq};
+}
+
+/// The largest |coordinate| of a triangle.
+inline double largest_coordinate(const Triangle<double>& t) {
+    return max_component(bvhkit::max(bvhkit::max(abs(t.p0), abs(t.p1)), abs(t.p2)));
+}
+
+/// The power of two 2^k to divide a pair's coordinates by, m their largest magnitude: 0 (measured
+/// as given) inside [2^-150, 2^150], where the fourth powers of the segment step and the sixth
+/// powers of the plane test (m^6 times a few, up to 2^912) stay finite and coordinates of the
+/// pair's own size square to normal numbers; outside, the k that brings m to [1, 2). Also 0 for
+/// m zero or not finite (nothing to scale).
+inline int pair_exponent(double m) {
+    if (m >= 0x1p-150 && m <= 0x1p150) [[likely]]
+        return 0;
+    if (!(m > 0) || !(m < std::numeric_limits<double>::infinity())) return 0;
+    return std::ilogb(m);
+}
+
+inline Vec<double, 3> scaled_by(const Vec<double, 3>& v, int k) {
+    return {std::ldexp(v[0], k), std::ldexp(v[1], k), std::ldexp(v[2], k)};
+}
+
+inline Triangle<double> scaled_by(const Triangle<double>& t, int k) {
+    return {scaled_by(t.p0, k), scaled_by(t.p1, k), scaled_by(t.p2, k)};
+}
+
+}  // namespace detail
+
+/// Distance between triangles a and b (zero-area ones are their segment or point), computed in
+/// double on the input coordinates (scaled by a power of two outside [2^-150, 2^150]); the points
+/// are rounded to T.
+template <class T>
+TriangleDistanceResult<T> triangle_distance(const Triangle<T>& a, const Triangle<T>& b);
+
+/// triangle_distance() for triangles already known not to meet (the least of the feature
+/// distances; 0 only where rounding makes it so).
+template <class T>
+TriangleDistanceResult<T> triangle_distance_apart(const Triangle<T>& a, const Triangle<T>& b) {
+    using V = Vec<double, 3>;
+    const Triangle<double> ta{V(a.p0), V(a.p1), V(a.p2)}, tb{V(b.p0), V(b.p1), V(b.p2)};
+    const int k = detail::pair_exponent(
+        std::max(detail::largest_coordinate(ta), detail::largest_coordinate(tb)));
+    if (k == 0) {
+        const V u[3] = {ta.p0, ta.p1, ta.p2}, v[3] = {tb.p0, tb.p1, tb.p2};
+        const detail::FeatureDistance f = detail::feature_distance(u, v);
+        return {f.distance_squared, Vec<T, 3>(f.p), Vec<T, 3>(f.q), std::sqrt(f.distance_squared)};
+    }
+    const Triangle<double> sa = detail::scaled_by(ta, -k), sb = detail::scaled_by(tb, -k);
+    const V u[3] = {sa.p0, sa.p1, sa.p2}, v[3] = {sb.p0, sb.p1, sb.p2};
+    const detail::FeatureDistance f = detail::feature_distance(u, v);
+    return {std::ldexp(f.distance_squared, 2 * k), Vec<T, 3>(detail::scaled_by(f.p, k)),
+            Vec<T, 3>(detail::scaled_by(f.q, k)), std::ldexp(std::sqrt(f.distance_squared), k)};
 }
 
 template <class T>
 TriangleDistanceResult<T> triangle_distance(const Triangle<T>& a, const Triangle<T>& b) {
     const TriangleIntersection<T> x = intersect_triangles(a, b);
-    if (x.hit) return {0.0, x.p, x.p};
+    if (x.hit) return {0.0, x.p, x.p, 0.0};
     return triangle_distance_apart(a, b);
 }
 

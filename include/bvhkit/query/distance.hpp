@@ -13,13 +13,14 @@
 // A zero-area triangle counts as the segment or point it is (triangle_triangle.hpp's rule).
 // B's corners are carried into A's frame in double; triangle pairs that meet for the pose as given
 // (exactly, as collide() decides: primitives/posed_triangles.hpp) are at distance 0 (the points
-// then lie on an intersection segment), the others are measured in double. An empty model gives
-// +infinity.
+// then lie on an intersection segment), the others are measured in double (a pair beyond
+// 2^+-150 at a power-of-two scale: triangle_distance.hpp). An empty model gives +infinity.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
+#include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/primitives/triangle_distance.hpp"
 #include "bvhkit/query/min_heap.hpp"
 #include "bvhkit/query/pairs_model.hpp"
@@ -44,30 +45,76 @@ struct DistanceResult {
 namespace detail {
 
 /// Whether triangle `u` lies wholly on one side of triangle t's plane, at least `gap` from it
-/// (then the triangles are at least `gap` apart). In double: float squares overflow past 1.8e19,
-/// which would reject pairs that are not beyond; an infinite gap rejects nothing.
+/// (then the triangles are at least `gap` apart). In double, comparing sixth powers of the
+/// coordinates: only a normal, finite `reach` and |n|^2 are trusted (two sides overflowing to
+/// inf >= inf, or sunk to 0 >= 0, would reject pairs that are not beyond; a subnormal one has lost
+/// its bits), and anything else rejects nothing. distance() scales the pairs whose coordinates
+/// leave 2^+-150 (triangle_distance.hpp), where it would reject nothing.
 template <class T>
 bool beyond_plane(const Triangle<T>& t, const Triangle<T>& u, T gap) {
     using V = Vec<double, 3>;
     if (!(double(gap) < std::numeric_limits<double>::infinity())) return false;
     const V t0(t.p0), n = cross(V(t.p1) - t0, V(t.p2) - t0);
     const double d0 = dot(n, V(u.p0) - t0), d1 = dot(n, V(u.p1) - t0), d2 = dot(n, V(u.p2) - t0);
-    const double reach = double(gap) * double(gap) * length_squared(n);
+    const double nn = length_squared(n), reach = double(gap) * double(gap) * nn;
     const double lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
-    return (lo > 0 && lo * lo >= reach) || (hi < 0 && hi * hi >= reach);
+    return ((lo > 0 && lo * lo >= reach) || (hi < 0 && hi * hi >= reach)) &&
+           std::min(nn, reach) >= std::numeric_limits<double>::min() &&
+           reach <= std::numeric_limits<double>::max();
 }
+
+/// For a triangle pair outside triangle_distance.hpp's window: whether distance()'s sphere or
+/// plane rejection drops it, both taken at scale 2^-k (`gap`, the best distance so far, scaled
+/// alike). Out of line: such pairs are rare, and the common loop stays as small as before.
+[[gnu::noinline]] inline bool rejected_at_scale(const Triangle<double>& a,
+                                                const Triangle<double>& b, int k, double gap) {
+    const Triangle<double> u = scaled_by(a, -k), v = scaled_by(b, -k);
+    const double g = std::ldexp(gap, -k);
+    const double ru = std::sqrt(std::max(length_squared(u.p1 - u.p0), length_squared(u.p2 - u.p0)));
+    const double rv = std::sqrt(std::max(length_squared(v.p1 - v.p0), length_squared(v.p2 - v.p0)));
+    const double reach = g + ru + rv;
+    return length_squared(u.p0 - v.p0) > reach * reach || beyond_plane(u, v, g) ||
+           beyond_plane(v, u, g);
+}
+
+/// feature_distance() of a pair at scale 2^-k: the squared distance at that scale (the true one
+/// times 4^-k), the points scaled back.
+[[gnu::noinline]] inline FeatureDistance feature_distance_at_scale(const Triangle<double>& a,
+                                                                   const Triangle<double>& b,
+                                                                   int k) {
+    const Triangle<double> u = scaled_by(a, -k), v = scaled_by(b, -k);
+    const Vec<double, 3> pu[3] = {u.p0, u.p1, u.p2}, pv[3] = {v.p0, v.p1, v.p2};
+    const FeatureDistance f = feature_distance(pu, pv);
+    return {f.distance_squared, scaled_by(f.p, k), scaled_by(f.q, k)};
+}
+
+/// A squared distance as s2 * 4^e: a pair measured at scale 2^-e (triangle_distance.hpp) keeps
+/// its square there, which double holds where the square itself would overflow or sink to zero.
+/// Pairs measured as given have e = 0 and compare as plain squares.
+struct ScaledSquare {
+    double s2 = std::numeric_limits<double>::infinity();
+    int e = 0;
+    /// Whether c2 * 4^ce is below this (any finite value is below the initial inf; an exponent
+    /// far apart settles it by the scaling's overflow to inf or underflow to 0).
+    bool exceeds(double c2, int ce) const {
+        if (ce == e) return c2 < s2;
+        if (!(s2 < std::numeric_limits<double>::infinity())) return c2 < s2;
+        return std::ldexp(c2, 2 * (ce - e)) < s2;
+    }
+    /// The distance, rounded to T (inf beyond T's range).
+    template <class T>
+    T root() const {
+        const double r = std::sqrt(s2);
+        return narrow_or_inf<T>(e == 0 ? r : std::ldexp(r, e));
+    }
+};
 
 }  // namespace detail
 
-// One function of some 150 lines, on purpose: every split tried took more instructions on the
-// placeable volumes (callgrind, 200 poses of a 5,120-triangle sphere about a 9,216-triangle torus,
-// query part only): its steps as members of a query class, Rss 94.3M -> 102.4M (+8.5%), Obb
-// 86.6M -> 89.1M (+2.8%), Aabb 168.9M -> 174.2M (+3.1%); the child opening below through one
-// function shared with pairs.hpp, Rss +8% here and +2.2% in for_each_overlapping_pair's collide
-// walk (823.7M -> 842.0M, that function forced inline); the leaf-pair loop alone as a function,
-// Rss and Obb unchanged but Aabb +1.3%. The opening is pairs.hpp's rule (detail::choose picks the
-// side, left child measured first here where that walk pushes the right one first): keep the two
-// in step.
+// One function, on purpose: every split tried took more instructions on the placeable volumes
+// (docs/benchmarks.md, "distance() in one piece"). The opening is pairs.hpp's rule
+// (detail::choose picks the side, left child measured first here where that walk pushes the right
+// one first): keep the two in step.
 template <BoundingVolume V>
 DistanceResult<typename V::Scalar> distance(
     const CollisionModel<V>& a, const CollisionModel<V>& b,
@@ -90,17 +137,27 @@ DistanceResult<typename V::Scalar> distance(
     const T extent =
         a.scale() + b.scale() +
         max_component(bvhkit::max(pose_of_b_in_a.translation, -pose_of_b_in_a.translation));
+    // At the other end the squares sink below T's normal range (models near 1e-154 in double,
+    // 1e-19 in float), and a length rooted from them may be off by up to sqrt(2.5 denorm_min):
+    // 16 sqrt(denorm_min) more slack keeps any bound made of a few such lengths below the true
+    // distance (at ordinary scales it vanishes in the slack's rounding; models far below, it
+    // turns pruning off as above).
     const T slack = std::isfinite(T(16) * extent * extent)
-                        ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a)
+                        ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a) +
+                              T(16) * std::sqrt(std::numeric_limits<T>::denorm_min())
                         : std::numeric_limits<T>::infinity();
+    // Whether every coordinate in A's frame is within 2^150: |R x + t| <= sqrt(3) |x| + |t| in
+    // the largest component, so twice the extent (rounding included) bounds them.
+    const bool window_top = 2 * double(extent) <= 0x1p150;
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
     const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
-    // The best squared distance is kept in double (finite for any finite float input: a float
-    // square overflows past 1.8e19); `best`, its root in T, feeds the volumes' bounds.
-    double best2 = std::numeric_limits<double>::infinity();
+    // The best squared distance, kept in double (finite for any finite float input: a float
+    // square overflows past 1.8e19) and scaled with its pair (detail::ScaledSquare); `best`, its
+    // root in T, feeds the volumes' bounds.
+    detail::ScaledSquare best2;
     T best = std::numeric_limits<T>::infinity();
     const auto hopeless = [&](T lb) {
-        if (!(best2 < std::numeric_limits<double>::infinity())) return false;
+        if (!(best2.s2 < std::numeric_limits<double>::infinity())) return false;
         const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
         return lb >= best - tol;
     };
@@ -152,16 +209,50 @@ DistanceResult<typename V::Scalar> distance(
         const auto& na = na_[e.a];
         const auto& nb = nb_[e.b];
         if (na.is_leaf() && nb.is_leaf()) {
+            const auto take = [&](double d2, int exponent, const Vec<double, 3>& p,
+                                  const Vec<double, 3>& q, std::uint32_t sa, std::uint32_t sb) {
+                if (!best2.exceeds(d2, exponent)) return;
+                best2 = {d2, exponent};
+                best = best2.root<T>();
+                result.distance = best;
+                result.point_a = Vec<T, 3>(p);
+                result.point_b = Vec<T, 3>(q);
+                result.triangle_a = a.triangle_id(sa);
+                result.triangle_b = b.triangle_id(sb);
+            };
             // B's triangle outside: carried into A's frame (in double) once for all of A's.
             for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
                 using D = Vec<double, 3>;
                 const D vb[3] = {posed.apply(tb[sb].p0), posed.apply(tb[sb].p1),
                                  posed.apply(tb[sb].p2)};
                 const Triangle<double> tri_b{vb[0], vb[1], vb[2]};
+                // Every pair with this triangle inside the window of triangle_distance.hpp
+                // (coordinates up to `window_top`, one of B's at least 2^-150): measured as
+                // given, with no per-pair look at the magnitudes.
+                const bool inside = window_top && max_component(abs(vb[0])) >= 0x1p-150;
                 const double rb = std::sqrt(
                     std::max(length_squared(vb[1] - vb[0]), length_squared(vb[2] - vb[0])));
                 for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
                     const Triangle<double> tri_a{D(ta[sa].p0), D(ta[sa].p1), D(ta[sa].p2)};
+                    // Outside the window the pair is tested and measured at scale 2^-k (best
+                    // scaled alike), where its powers stay finite and normal.
+                    const int k =
+                        inside ? 0
+                               : detail::pair_exponent(std::max(detail::largest_coordinate(tri_b),
+                                                                detail::largest_coordinate(tri_a)));
+                    if (k != 0) [[unlikely]] {
+                        if (detail::rejected_at_scale(tri_a, tri_b, k, double(best))) continue;
+                        result.stats.primitive();
+                        const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
+                        if (x.hit) {
+                            take(0.0, 0, D(x.p), D(x.p), sa, sb);
+                        } else {
+                            const detail::FeatureDistance f =
+                                detail::feature_distance_at_scale(tri_a, tri_b, k);
+                            take(f.distance_squared, k, f.p, f.q, sa, sb);
+                        }
+                        continue;
+                    }
                     // Cheap rejection by the triangles' spheres about their first corners.
                     const double ra = std::sqrt(std::max(length_squared(tri_a.p1 - tri_a.p0),
                                                          length_squared(tri_a.p2 - tri_a.p0)));
@@ -174,24 +265,16 @@ DistanceResult<typename V::Scalar> distance(
                         continue;
                     result.stats.primitive();
                     const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
-                    const auto d = x.hit ? TriangleDistanceResult<double>{0.0, D(x.p), D(x.p)}
-                                         : triangle_distance_apart(tri_a, tri_b);
-                    if (d.distance_squared < best2) {
-                        best2 = d.distance_squared;
-                        // Above T's range only for float corners near 3e38: +inf, not UB.
-                        const double root = std::sqrt(best2);
-                        best = root <= double(std::numeric_limits<T>::max())
-                                   ? T(root)
-                                   : std::numeric_limits<T>::infinity();
-                        result.distance = best;
-                        result.point_a = Vec<T, 3>(d.p);
-                        result.point_b = Vec<T, 3>(d.q);
-                        result.triangle_a = a.triangle_id(sa);
-                        result.triangle_b = b.triangle_id(sb);
+                    if (x.hit) {
+                        take(0.0, 0, D(x.p), D(x.p), sa, sb);
+                    } else {
+                        const D u[3] = {tri_a.p0, tri_a.p1, tri_a.p2};
+                        const detail::FeatureDistance f = detail::feature_distance(u, vb);
+                        take(f.distance_squared, 0, f.p, f.q, sa, sb);
                     }
                 }
             }
-            if (best2 == 0) break;
+            if (best2.s2 == 0) break;
             continue;
         }
         const DescentRule rule =
