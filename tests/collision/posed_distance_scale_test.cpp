@@ -209,34 +209,41 @@ TEST(PosedDistanceScales, SubnormalSquaresNeverDropTheClosestPair) {
 // z = 0). The bound is docs/accuracy.md's, M the largest |coordinate|.
 TEST(TriangleDistanceScales, KnownAnswersAcrossDoubleRange) {
     using V = Vec<double, 3>;
-    for (const double s :
-         {1e-300, 1e-250, 1e-200, 1e-160, 1e-100, 1.0, 1e100, 1e160, 1e200, 1e250, 1e300}) {
+    for (const double s : {1e-300, 1e-250, 1e-200, 1e-160, 1e-140, 1e-100, 1.0, 1e100, 1e120, 1e140,
+                           1e160, 1e200, 1e250, 1e300}) {
         const double h = 0.375 * s;
         const Triangle<double> edges_a{V{-s, 0, 0}, V{s, 0, 0}, V{0, 0, -s}};
         const Triangle<double> edges_b{V{0, -s, h}, V{0, s, h}, V{0, 0, h + s}};
         const Triangle<double> face_a{V{0, 0, 0}, V{4 * s, 0, 0}, V{0, 4 * s, 0}};
         const Triangle<double> corner_b{V{s, s, h}, V{2 * s, s, h + s}, V{s, 2 * s, h + s}};
+        // A parallel copy of face_a h above it: every point of the overlap is a closest one, so
+        // only the distance is checked.
+        const Triangle<double> face_b{V{0, 0, h}, V{4 * s, 0, h}, V{0, 4 * s, h}};
         struct Case {
             const Triangle<double>&a, &b;
             V p, q;
             double m;
+            bool points = true;
         };
         for (const Case& c : {Case{edges_a, edges_b, V{0, 0, 0}, V{0, 0, h}, h + s},
-                              Case{face_a, corner_b, V{s, s, 0}, V{s, s, h}, 4 * s}}) {
+                              Case{face_a, corner_b, V{s, s, 0}, V{s, s, h}, 4 * s},
+                              Case{face_a, face_b, V{}, V{}, 4 * s, false}}) {
             for (const bool swap : {false, true}) {
-                // triangle_distance() first decides whether the two meet, exactly; that decision
-                // is another file's and is checked at the range's ends only.
-                const bool ends = s == 1e-300 || s == 1.0 || s == 1e300;
-                const auto d =
-                    ends   ? (swap ? triangle_distance(c.b, c.a) : triangle_distance(c.a, c.b))
-                    : swap ? triangle_distance_apart(c.b, c.a)
-                           : triangle_distance_apart(c.a, c.b);
-                const double bound = std::ldexp(c.m, -40) + std::ldexp(h, -48);
-                EXPECT_LE(std::fabs(d.distance - h), bound) << s;
-                const V p = swap ? d.q : d.p, q = swap ? d.p : d.q;
-                for (int i = 0; i < 3; ++i) {
-                    EXPECT_LE(std::fabs(p[i] - c.p[i]), 2 * bound) << s << " p" << i;
-                    EXPECT_LE(std::fabs(q[i] - c.q[i]), 2 * bound) << s << " q" << i;
+                // Both entry points: triangle_distance() first decides exactly whether the two
+                // meet (math/predicates.hpp, exact at every finite scale), then measures.
+                for (const bool decide : {false, true}) {
+                    const auto d =
+                        decide ? (swap ? triangle_distance(c.b, c.a) : triangle_distance(c.a, c.b))
+                               : (swap ? triangle_distance_apart(c.b, c.a)
+                                       : triangle_distance_apart(c.a, c.b));
+                    const double bound = std::ldexp(c.m, -40) + std::ldexp(h, -48);
+                    EXPECT_LE(std::fabs(d.distance - h), bound) << s;
+                    if (!c.points) continue;
+                    const V p = swap ? d.q : d.p, q = swap ? d.p : d.q;
+                    for (int i = 0; i < 3; ++i) {
+                        EXPECT_LE(std::fabs(p[i] - c.p[i]), 2 * bound) << s << " p" << i;
+                        EXPECT_LE(std::fabs(q[i] - c.q[i]), 2 * bound) << s << " q" << i;
+                    }
                 }
             }
         }
