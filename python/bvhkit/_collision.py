@@ -322,13 +322,16 @@ def distance(
     default) give the exact minimum up to rounding.
     """
     r, t, k = _poses(a, b, rotations, translations)
-    tol = []
-    for name, value in (("absolute_tolerance", absolute_tolerance),
-                        ("relative_tolerance", relative_tolerance)):
-        x = value if type(value) is float else _a.number(name, value)
-        if not 0 <= x < _a.INF:
-            raise ValueError(f"{name}: must be a finite number >= 0, not {value}")
-        tol.append(x)
+    tol = (absolute_tolerance, relative_tolerance)
+    if not (type(tol[0]) is float and type(tol[1]) is float and 0 <= tol[0] < _a.INF
+            and 0 <= tol[1] < _a.INF):
+        tol = []
+        for name, value in (("absolute_tolerance", absolute_tolerance),
+                            ("relative_tolerance", relative_tolerance)):
+            x = _a.number(name, value)
+            if not 0 <= x < _a.INF:
+                raise ValueError(f"{name}: must be a finite number >= 0, not {value}")
+            tol.append(x)
     n = threads if type(threads) is int and 0 <= threads <= _a.THREADS_MAX else _a.threads(threads)
     d = np.empty(k, a.dtype)
     pa = np.empty((k, 3), a.dtype)
