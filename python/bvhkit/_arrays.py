@@ -10,6 +10,7 @@ their choices from them, so the two cannot drift apart.
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 from typing import Any, Literal, Optional, get_args
@@ -60,14 +61,18 @@ def _as_array(name: str, value: Any) -> np.ndarray:
 
 def rows(name: str, value: Any, width: int, dtype: np.dtype, finite: bool = False) -> np.ndarray:
     """A C-contiguous (k, width) array of `dtype`; a single row of `width` becomes (1, width)."""
+    if (type(value) is np.ndarray and value.dtype is dtype and value.ndim == 2
+            and value.shape[1] == width and value.flags.c_contiguous and not finite):
+        return value  # already what the C++ calls take: no numpy work
     a = _as_array(name, value)
-    if a.dtype.kind not in "fiu" or a.dtype == np.bool_:
+    if a.dtype.kind not in "fiu":  # bool's kind is "b"
         raise TypeError(f"{name}: dtype must be a real number type, not {a.dtype}")
     if a.ndim == 1 and a.shape[0] == width:
         a = a.reshape(1, width)
     if a.ndim != 2 or a.shape[1] != width:
         raise ValueError(f"{name}: shape must be (k, {width}), not {a.shape}")
-    a = np.ascontiguousarray(a, dtype=dtype)
+    if a.dtype is not dtype or not a.flags.c_contiguous:
+        a = a.astype(dtype, order="C")
     if finite and not np.isfinite(a).all():
         bad = int(np.argwhere(~np.isfinite(a))[0][0])
         raise ValueError(f"{name}: row {bad} has a NaN or infinite coordinate")
@@ -110,6 +115,8 @@ def column(
             raise TypeError(f"{name}: must be a number or an array of numbers, not None")
         return np.full(count, none, dtype=dtype)
     if type(value) is float or type(value) is int:
+        if count == 1:
+            return _one(number(name, value), dtype)
         return np.full(count, number(name, value), dtype=dtype)
     a = _as_array(name, value)
     if a.dtype.kind not in "fiu" or a.dtype == np.bool_:
@@ -119,6 +126,15 @@ def column(
     if a.shape != (count,):
         raise ValueError(f"{name}: shape must be () or ({count},), not {a.shape}")
     return np.ascontiguousarray(a, dtype=dtype)
+
+
+@functools.lru_cache(maxsize=64)
+def _one(value: float, dtype: np.dtype) -> np.ndarray:
+    """A read-only (1,) array holding `value`: the array a one-ray call's scalar tmin or tmax
+    would otherwise allocate anew each call."""
+    a = np.full(1, value, dtype=dtype)
+    a.flags.writeable = False
+    return a
 
 
 def _kind(value: Any, a: np.ndarray) -> str:
@@ -209,10 +225,12 @@ def path(name: str, value: Any) -> Any:
         raise TypeError(f"{name}: must be a str or path, not {type(value).__name__}") from None
 
 
-def rotations(value: Any, dtype: np.dtype) -> np.ndarray:
+def rotations(value: Any, dtype: np.dtype, values: bool = True) -> np.ndarray:
     """Rotations: (k, 3, 3) (a single (3, 3) becomes (1, 3, 3)), finite, with max |R^T R - I| and
     |det R - 1| at most 1e-4 for float32 and float64 alike (the C++ check_rigid_pose's rule: a
-    rotation read from float32 data serves a float64 model; the pose is used as given)."""
+    rotation read from float32 data serves a float64 model; the pose is used as given).
+    ``values=False`` checks the type and shape alone, for a caller whose C++ call checks the
+    values as it reads them (collide and distance: python/src/collision.hpp)."""
     a = _as_array("rotations", value)
     if a.dtype.kind not in "fiu" or a.dtype == np.bool_:
         raise TypeError(f"rotations: dtype must be a real number type, not {a.dtype}")
@@ -221,6 +239,8 @@ def rotations(value: Any, dtype: np.dtype) -> np.ndarray:
     if a.ndim != 3 or a.shape[1:] != (3, 3):
         raise ValueError(f"rotations: shape must be (k, 3, 3), not {a.shape}")
     a = np.ascontiguousarray(a, dtype=dtype)
+    if not values:
+        return a
     if not np.isfinite(a).all():
         bad = int(np.argwhere(~np.isfinite(a))[0][0])
         raise ValueError(f"rotations: rotation {bad} has a NaN or infinite entry")

@@ -114,7 +114,8 @@ class CollisionModel:
         v = _a.vertices("vertices", vertices, self.dtype)
         f = _a.faces(faces, len(v))
         suffix = "f32" if self.dtype == np.float32 else "f64"
-        self._impl = getattr(_bvhkit, f"Model_{volume}_{suffix}")(v, f, n)
+        self._impl_type = getattr(_bvhkit, f"Model_{volume}_{suffix}")
+        self._impl = self._impl_type(v, f, n)
         self._vertex_count = len(v)
 
     # ------------------------------------------------------------------ saving and loading
@@ -154,10 +155,12 @@ class CollisionModel:
         global load_count
         dtype, volume, vertices, faces, model = _decode(data, what)
         suffix = "f32" if dtype == np.float32 else "f64"
+        impl_type = getattr(_bvhkit, f"Model_{volume}_{suffix}")
         try:
-            self._impl = getattr(_bvhkit, f"Model_{volume}_{suffix}")(vertices, faces, model)
+            self._impl = impl_type(vertices, faces, model)
         except ValueError as e:
             raise ValueError(f"{what}: {e}") from None
+        self._impl_type = impl_type
         self.volume = volume
         self.dtype = dtype
         self._vertex_count = len(vertices)
@@ -191,23 +194,44 @@ class CollisionModel:
         return f"CollisionModel(faces={self.face_count}, volume={self.volume!r}, dtype={self.dtype})"
 
 
+# The dtypes the C++ calls read poses in, whatever the model's (each value rounded to the model's
+# type as numpy's astype rounds it).
+_POSE_TYPES = (np.dtype(np.float32), np.dtype(np.float64))
+
+
 def _poses(a: Any, b: Any, rotations: Any, translations: Any):
-    for name, m in (("a", a), ("b", b)):
-        if not isinstance(m, CollisionModel):
-            raise TypeError(f"{name}: must be a CollisionModel, not {type(m).__name__}")
-    if a.volume != b.volume or a.dtype != b.dtype:
+    """(rotations or None, translations, pose count) as the C++ call takes them: shapes and types
+    checked here, values (finite, rigid) by the C++ call as it reads each pose, with the same
+    messages as _arrays.rotations and _arrays.rows(finite=True) give. A C-contiguous float32 or
+    float64 array in a right shape, or None, is passed on as it is, whatever the model's dtype: a
+    one-pose call pays no numpy work here."""
+    if type(a) is not CollisionModel and not isinstance(a, CollisionModel):
+        raise TypeError(f"a: must be a CollisionModel, not {type(a).__name__}")
+    if type(b) is not CollisionModel and not isinstance(b, CollisionModel):
+        raise TypeError(f"b: must be a CollisionModel, not {type(b).__name__}")
+    dt = a.dtype
+    if a._impl_type is not b._impl_type:
         raise TypeError(
             f"b: a has volume {a.volume!r} and dtype {a.dtype}, b has {b.volume!r} and {b.dtype}; "
             "both models must have the same volume and dtype"
         )
-    t = _a.rows("translations", translations, 3, a.dtype, finite=True)
-    if rotations is None:
-        r = np.ascontiguousarray(np.broadcast_to(np.eye(3, dtype=a.dtype), (len(t), 3, 3)))
+    t = translations
+    if (type(t) is np.ndarray and t.dtype in _POSE_TYPES and t.flags.c_contiguous
+            and (t.shape == (3,) or t.ndim == 2 and t.shape[1] == 3)):
+        k = 1 if t.ndim == 1 else t.shape[0]
     else:
-        r = _a.rotations(rotations, a.dtype)
-    if len(r) != len(t):
-        raise ValueError(f"translations: {len(t)} rows, rotations has {len(r)}")
-    return r, t
+        t = _a.rows("translations", t, 3, dt)
+        k = t.shape[0]
+    r = rotations
+    if r is None or (type(r) is np.ndarray and r.dtype in _POSE_TYPES and r.flags.c_contiguous
+                     and (r.shape == (3, 3) or r.ndim == 3 and r.shape[1:] == (3, 3))):
+        return r, t, k
+    try:
+        r = _a.rotations(r, dt, values=False)
+    except (TypeError, ValueError):
+        _a.rows("translations", t, 3, dt, finite=True)  # a bad translation is reported first
+        raise
+    return r, t, k
 
 
 @overload
@@ -255,15 +279,15 @@ def collide(
     the intersecting (face of a, face of b) pairs at each pose, sorted. Faces that only touch
     count as intersecting.
     """
-    want_contacts = _a.flag("contacts", contacts)
-    n = _a.threads(threads)
-    r, t = _poses(a, b, rotations, translations)
+    want_contacts = contacts if contacts is False else _a.flag("contacts", contacts)
+    n = threads if type(threads) is int and 0 <= threads <= _a.THREADS_MAX else _a.threads(threads)
+    r, t, k = _poses(a, b, rotations, translations)
     if not want_contacts:
-        out = np.empty(len(r), np.bool_)
+        out = np.empty(k, np.bool_)
         a._impl.collides(b._impl, r, t, out, n)
         return out
     pairs, offsets = a._impl.contacts(b._impl, r, t, n)
-    return [pairs[offsets[i] : offsets[i + 1]] for i in range(len(r))]
+    return [pairs[offsets[i] : offsets[i + 1]] for i in range(k)]
 
 
 class Distances(NamedTuple):
@@ -297,16 +321,18 @@ def distance(
     max(absolute_tolerance, relative_tolerance * distance), and is found faster; both 0 (the
     default) give the exact minimum up to rounding.
     """
-    r, t = _poses(a, b, rotations, translations)
-    tol = []
-    for name, value in (("absolute_tolerance", absolute_tolerance),
-                        ("relative_tolerance", relative_tolerance)):
-        x = _a.number(name, value)
-        if not 0 <= x < _a.INF:
-            raise ValueError(f"{name}: must be a finite number >= 0, not {value}")
-        tol.append(x)
-    n = _a.threads(threads)
-    k = len(r)
+    r, t, k = _poses(a, b, rotations, translations)
+    tol = (absolute_tolerance, relative_tolerance)
+    if not (type(tol[0]) is float and type(tol[1]) is float and 0 <= tol[0] < _a.INF
+            and 0 <= tol[1] < _a.INF):
+        tol = []
+        for name, value in (("absolute_tolerance", absolute_tolerance),
+                            ("relative_tolerance", relative_tolerance)):
+            x = _a.number(name, value)
+            if not 0 <= x < _a.INF:
+                raise ValueError(f"{name}: must be a finite number >= 0, not {value}")
+            tol.append(x)
+    n = threads if type(threads) is int and 0 <= threads <= _a.THREADS_MAX else _a.threads(threads)
     d = np.empty(k, a.dtype)
     pa = np.empty((k, 3), a.dtype)
     pb = np.empty((k, 3), a.dtype)

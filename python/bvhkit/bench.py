@@ -7,6 +7,9 @@ Workloads (sizes times --scale):
   P3  signed distance on a 128^3 grid, for a closed mesh and for one with holes; sign errors are
       counted against the exact winding number on a sample of the grid
   P4  1,000 random poses of collision (yes/no) and of distance between two copies of a mesh
+  P5  per-call cost: one-pose collide (and python-fcl's), one-point signed distance and one-ray
+      intersect, in microseconds per Python call; and collide on batches of 1, 10, 100 and 1,000
+      poses with threads=0 against threads=1 (the ratio: at most about 1 for small batches)
 
 A peer runs when it imports and sets up; a peer that fails is listed with the reason and the rest
 go on. Peers: Open3D (RaycastingScene), trimesh (with embreex for rays when present), libigl (igl),
@@ -404,6 +407,54 @@ def bool_(r):
     return np.asarray(r, dtype=bool)
 
 
+def _per_call(call: Callable[[], object], reps: int) -> float:
+    """Median over `reps` rounds of the mean time of one call (us), rounds of about 20 ms."""
+    call()
+    n = max(1, int(0.02 / max(1e-7, _timed(call))))
+    rounds = [_timed(lambda: [call() for _ in range(n)]) / n for _ in range(reps)]
+    return statistics.median(rounds) * 1e6
+
+
+def _timed(call: Callable[[], object]) -> float:
+    t = time.perf_counter()
+    call()
+    return time.perf_counter() - t
+
+
+def p5(v, f, reps, mods) -> List[str]:
+    model, scene = bvhkit.CollisionModel(v, f), bvhkit.TriangleMesh(v, f)
+    diag = float(np.linalg.norm(v.max(0) - v.min(0)))
+    eye, far = np.eye(3), np.array([2.0 * diag, 0, 0])
+    center = v.mean(0)
+    point = (center + (v[0] - center) * 1.05)[None]  # just outside the mesh, near a vertex
+    origin, up = (center - [0, 0, diag])[None], np.array([[0, 0, 1.0]])
+    calls = {
+        "bvhkit collide, 1 pose, apart": lambda: bvhkit.collide(model, model, eye, far),
+        "bvhkit signed_distance, 1 point": lambda: scene.signed_distance(point),
+        "bvhkit intersect, 1 ray": lambda: scene.intersect(origin, up),
+    }
+    if "fcl" in mods:
+        fcl = mods["fcl"]
+        m = fcl.BVHModel()
+        m.beginModel(len(v), len(f))
+        m.addSubModel(v.astype(np.float64), f.astype(np.int32))
+        m.endModel()
+        a = fcl.CollisionObject(m, fcl.Transform())
+        b = fcl.CollisionObject(m, fcl.Transform(eye, far))
+        request = fcl.CollisionRequest()
+        calls["python-fcl collide, 1 pose, apart"] = \
+            lambda: fcl.collide(a, b, request, fcl.CollisionResult())
+    rows = [f"P5        {k:38} {_per_call(c, reps):8.2f} us per call" for k, c in calls.items()]
+    rng = np.random.default_rng(6)
+    for k in (1, 10, 100, 1000):
+        rot, trans = _rotations(rng, k), rng.uniform(-0.5, 0.5, (k, 3)) * diag
+        t0, t1 = (_per_call(lambda n=n: bvhkit.collide(model, model, rot, trans, threads=n), reps)
+                  for n in (0, 1))
+        rows.append(f"P5        collide {k:>5} poses threads=0 {t0:10.1f} us, threads=1 "
+                    f"{t1:10.1f} us: {t0 / t1:.2f}x")
+    return rows
+
+
 def float_(r):
     return np.asarray(r, dtype=np.float64)
 
@@ -414,7 +465,7 @@ def main(argv=None) -> None:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scale", type=float, default=1.0, help="workload size factor (1 = full)")
     ap.add_argument("--reps", type=int, default=3, help="repetitions (median reported)")
-    ap.add_argument("--only", default="P1,P2,P3,P4", help="comma-separated workloads")
+    ap.add_argument("--only", default="P1,P2,P3,P4,P5", help="comma-separated workloads")
     ap.add_argument("--mesh", default="igea.ply", help="mesh file or spec for P1 and P2")
     ap.add_argument("--big-mesh", default="sphere:subdiv=8,displacement=0.2",
                     help="the large mesh of P1 (1.3M triangles by default); 'none' skips it")
@@ -459,6 +510,10 @@ def main(argv=None) -> None:
         cv, cf, name = _mesh(args.collision_mesh)
         print(f"P4: {name}, {len(cf)} triangles")
         show(p4(cv, cf, max(10, int(1000 * s)), args.reps, mods))
+    if "P5" in only:
+        cv, cf, name = _mesh(args.collision_mesh)
+        print(f"P5: {name}, {len(cf)} triangles")
+        show(p5(cv, cf, max(args.reps, 5), mods))
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <span>
 
@@ -23,10 +24,81 @@
 #include "bvhkit/volumes/sphere.hpp"
 #include "common.hpp"
 
+#include <nanobind/stl/optional.h>
+
 namespace bvhkit::python {
 
+/// Rotations ((k, 3, 3) or one (3, 3)) or translations ((k, 3) or one (3,)), float32 or float64
+/// whatever the model's type: a planner's float64 poses reach a float32 model without a numpy
+/// conversion per call.
+using PoseArray = nb::ndarray<nb::ro, nb::c_contig, Cpu>;
+
+/// A PoseArray's values as T, each rounded as numpy's astype would round it (the Python layer
+/// has checked the shape and the dtype, not the values).
 template <class T>
-using Rotations = nb::ndarray<const T, nb::shape<-1, 3, 3>, nb::c_contig, Cpu>;
+class PoseValues {
+  public:
+    PoseValues() = default;
+    PoseValues(const PoseArray& a, std::size_t dims)
+        : data_(a.data()),
+          f64_(a.dtype() == nb::dtype<double>()),
+          count_(a.ndim() == dims ? 1 : a.shape(0)) {
+        if (!f64_ && a.dtype() != nb::dtype<float>())
+            throw Error("poses: dtype must be float32 or float64");
+    }
+    explicit operator bool() const { return data_ != nullptr; }
+    std::size_t count() const { return count_; }
+    T operator[](std::size_t j) const {
+        return f64_ ? T(static_cast<const double*>(data_)[j])
+                    : T(static_cast<const float*>(data_)[j]);
+    }
+    Vec<T, 3> row(std::size_t j) const {
+        return {(*this)[3 * j], (*this)[3 * j + 1], (*this)[3 * j + 2]};
+    }
+    Mat3<T> matrix(std::size_t i) const {
+        Mat3<T> m;
+        for (std::size_t r = 0; r < 3; ++r) m.row[r] = row(3 * i + r);
+        return m;
+    }
+
+  private:
+    const void* data_ = nullptr;
+    bool f64_ = false;
+    std::size_t count_ = 0;
+};
+
+/// Whether the pose is finite and (when `check_rotation`) rigid by check_rigid_pose's rule (its
+/// tolerance is the 1e-4 the messages below state).
+template <class T>
+bool valid(const Transform<T>& pose, bool check_rotation) {
+    bool finite = true;
+    for (int a = 0; a < 3; ++a) finite = finite && std::isfinite(pose.translation[a]);
+    if (!check_rotation || !finite) return finite;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) finite = finite && std::isfinite(pose.rotation.row[i][j]);
+    return finite && rigid_deviation(pose.rotation) <= rigid_tolerance<T>();
+}
+
+/// Throws the Error the Python layer documents for the first bad value of the poses, in its
+/// order of checks: a non-finite translation, then a non-finite rotation entry, then a rotation
+/// that is not rigid (r is empty when no rotations were given).
+template <class T>
+void check_poses(const PoseValues<T>& r, const PoseValues<T>& t) {
+    for (std::size_t i = 0; i < 3 * t.count(); ++i)
+        if (!std::isfinite(t[i]))
+            throw Error("translations: row " + std::to_string(i / 3) +
+                        " has a NaN or infinite coordinate");
+    if (!r) return;
+    for (std::size_t i = 0; i < 9 * r.count(); ++i)
+        if (!std::isfinite(r[i]))
+            throw Error("rotations: rotation " + std::to_string(i / 9) +
+                        " has a NaN or infinite entry");
+    for (std::size_t i = 0; i < r.count(); ++i)
+        if (!(rigid_deviation(r.matrix(i)) <= rigid_tolerance<T>()))
+            throw Error("rotations: rotation " + std::to_string(i) +
+                        " is not a rotation matrix (R^T R must be the identity and det R = +1, "
+                        "to 1e-4)");
+}
 
 template <class V>
 class Model {
@@ -106,31 +178,44 @@ class Model {
     }
 
     /// Calls per_pose(i, pose) for every pose of B in A's frame (this is A), without the GIL.
+    /// `rotations` is (k, 3, 3) or None for the identity, `translations` (k, 3); a single pose
+    /// may also come as (3, 3) and (3,). Each pose is checked where it is used, so a batch reads
+    /// its poses once; a bad pose stops the batch, and the poses are then scanned in order for
+    /// the error bvhkit/_collision.py documents (check_poses).
     template <class PerPose>
-    void poses(const Model& b, const Rotations<T>& rotations, const Rows<T, 3>& translations,
-               unsigned threads, PerPose&& per_pose) const {
-        const std::size_t k = rotations.shape(0);
-        expect_rows(translations, k, "translations");
-        const T *r = rotations.data(), *t = translations.data();
+    void poses(const Model& b, const std::optional<PoseArray>& rotations,
+               const PoseArray& translations, unsigned threads, PerPose&& per_pose) const {
+        const PoseValues<T> t(translations, 1);
+        const PoseValues<T> r = rotations ? PoseValues<T>(*rotations, 2) : PoseValues<T>();
+        const std::size_t k = t.count();
+        if (r && r.count() != k) {
+            check_poses(r, t);
+            throw Error("translations: " + std::to_string(k) + " rows, rotations has " +
+                        std::to_string(r.count()));
+        }
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock_a(mutex_);
         std::shared_lock<std::shared_mutex> lock_b;
         if (&b != this) lock_b = std::shared_lock<std::shared_mutex>(b.mutex_);
+        std::atomic<bool> bad{false};
         run_batch(k, 1, threads, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i) {
-                Transform<T> pose;
-                for (int row = 0; row < 3; ++row)
-                    pose.rotation.row[row] = {r[9 * i + 3 * row], r[9 * i + 3 * row + 1],
-                                              r[9 * i + 3 * row + 2]};
-                pose.translation = {t[3 * i], t[3 * i + 1], t[3 * i + 2]};
+            for (std::size_t i = begin; i < end && !bad.load(std::memory_order_relaxed); ++i) {
+                Transform<T> pose;  // the identity rotation where none was given
+                if (r) pose.rotation = r.matrix(i);
+                pose.translation = t.row(i);
+                if (!valid(pose, bool(r))) {
+                    bad.store(true, std::memory_order_relaxed);
+                    return;
+                }
                 per_pose(i, pose);
             }
         });
+        if (bad.load()) check_poses(r, t);
     }
 
-    void collides(const Model& b, const Rotations<T>& rotations, const Rows<T, 3>& translations,
-                  OutColumn<bool> out, unsigned threads) const {
-        expect_rows(out, rotations.shape(0), "out");
+    void collides(const Model& b, const std::optional<PoseArray>& rotations,
+                  const PoseArray& translations, OutColumn<bool> out, unsigned threads) const {
+        expect_rows(out, PoseValues<T>(translations, 1).count(), "out");
         bool* o = out.data();
         poses(b, rotations, translations, threads, [&](std::size_t i, const Transform<T>& pose) {
             o[i] = bvhkit::collides(model_, b.model_, pose);
@@ -139,9 +224,9 @@ class Model {
 
     /// Every intersecting face pair at every pose: (pairs (p, 2), offsets (k + 1)); pose i's
     /// pairs are rows offsets[i] .. offsets[i + 1], sorted.
-    nb::tuple contacts(const Model& b, const Rotations<T>& rotations,
-                       const Rows<T, 3>& translations, unsigned threads) const {
-        const std::size_t k = rotations.shape(0);
+    nb::tuple contacts(const Model& b, const std::optional<PoseArray>& rotations,
+                       const PoseArray& translations, unsigned threads) const {
+        const std::size_t k = PoseValues<T>(translations, 1).count();
         std::vector<std::vector<std::array<std::int64_t, 2>>> per(k);
         poses(b, rotations, translations, threads, [&](std::size_t i, const Transform<T>& pose) {
             CollideResult<T> result;
@@ -161,11 +246,12 @@ class Model {
                               owned_array(std::move(offsets), k + 1, 0));
     }
 
-    void distance(const Model& b, const Rotations<T>& rotations, const Rows<T, 3>& translations,
-                  T absolute_tolerance, T relative_tolerance, OutColumn<T> dist,
-                  OutRows<T, 3> point_a, OutRows<T, 3> point_b, OutColumn<std::int64_t> face_a,
-                  OutColumn<std::int64_t> face_b, unsigned threads) const {
-        const std::size_t k = rotations.shape(0);
+    void distance(const Model& b, const std::optional<PoseArray>& rotations,
+                  const PoseArray& translations, T absolute_tolerance, T relative_tolerance,
+                  OutColumn<T> dist, OutRows<T, 3> point_a, OutRows<T, 3> point_b,
+                  OutColumn<std::int64_t> face_a, OutColumn<std::int64_t> face_b,
+                  unsigned threads) const {
+        const std::size_t k = PoseValues<T>(translations, 1).count();
         expect_rows(dist, k, "distance");
         expect_rows(point_a, k, "point_a");
         expect_rows(point_b, k, "point_b");
@@ -227,16 +313,16 @@ void bind_model(nb::module_& m, const char* name) {
              "Loads the model from the parts state() gave (nothing is rebuilt).")
         .def("state", &M::state, "The mesh and the model's file, for saving.")
         .def("refit", &M::refit, nb::arg("vertices"), "New vertex positions, same faces.")
-        .def("collides", &M::collides, nb::arg("b"), nb::arg("rotations"), nb::arg("translations"),
-             nb::arg("out"), nb::arg("threads"),
+        .def("collides", &M::collides, nb::arg("b"), nb::arg("rotations").none(),
+             nb::arg("translations"), nb::arg("out"), nb::arg("threads"),
              "Whether b, placed at each pose, intersects this model.")
-        .def("contacts", &M::contacts, nb::arg("b"), nb::arg("rotations"), nb::arg("translations"),
-             nb::arg("threads"),
+        .def("contacts", &M::contacts, nb::arg("b"), nb::arg("rotations").none(),
+             nb::arg("translations"), nb::arg("threads"),
              "(pairs (p, 2), offsets (k + 1)): the intersecting face pairs at each pose.")
-        .def("distance", &M::distance, nb::arg("b"), nb::arg("rotations"), nb::arg("translations"),
-             nb::arg("absolute_tolerance"), nb::arg("relative_tolerance"), nb::arg("distance"),
-             nb::arg("point_a"), nb::arg("point_b"), nb::arg("face_a"), nb::arg("face_b"),
-             nb::arg("threads"),
+        .def("distance", &M::distance, nb::arg("b"), nb::arg("rotations").none(),
+             nb::arg("translations"), nb::arg("absolute_tolerance"), nb::arg("relative_tolerance"),
+             nb::arg("distance"), nb::arg("point_a"), nb::arg("point_b"), nb::arg("face_a"),
+             nb::arg("face_b"), nb::arg("threads"),
              "Distance to b at each pose, with the closest points in this model's frame.")
         .def("self_intersections", &M::self_intersections,
              "Intersecting face pairs that share no vertex, (p, 2).")

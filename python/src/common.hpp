@@ -1,6 +1,6 @@
 #pragma once
 // What every part of the extension shares: the array types it accepts and returns, the mesh built
-// from numpy arrays, and run_batch, which spreads a batch over threads.
+// from numpy arrays, and run_batch (batch.hpp), which spreads a batch over threads.
 //
 // The Python layer (python/bvhkit/) checks shapes and dtypes, names the argument at fault and hands
 // over C-contiguous arrays of the scene's scalar type, so the functions here take them as they are
@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "batch.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 
@@ -73,50 +74,6 @@ BasicTriangleMesh<T> make_mesh(const Rows<T, 3>& vertices, const Faces& faces) {
     else
         throw Error("faces: dtype must be int32 or int64");
     return mesh;
-}
-
-/// The number of threads a batch of `count` items uses: `threads` (0 = every core), at most one
-/// per chunk.
-inline unsigned batch_threads(unsigned threads, std::size_t chunks) {
-    const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-    // A request beyond any real machine's core count only adds start-up cost.
-    const unsigned want = threads == 0 ? cores : std::min(threads, 1024u);
-    return unsigned(std::min<std::size_t>(want, std::max<std::size_t>(chunks, 1)));
-}
-
-/// Calls body(begin, end) on consecutive chunks of `grain` items of [0, count), on `threads`
-/// threads (0 = every core; the calling thread is one of them). Each item is handled by exactly
-/// one call, so a body that writes only its own items gives the same answers for every thread
-/// count. The first exception thrown by a body stops the batch and is rethrown here.
-template <class Body>
-void run_batch(std::size_t count, std::size_t grain, unsigned threads, Body&& body) {
-    if (count == 0) return;
-    grain = std::max<std::size_t>(grain, 1);
-    const std::size_t chunks = (count + grain - 1) / grain;
-    const unsigned n = batch_threads(threads, chunks);
-    if (n <= 1) {
-        body(std::size_t(0), count);
-        return;
-    }
-    std::atomic<std::size_t> next{0};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    const auto work = [&] {
-        try {
-            for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
-                body(c * grain, std::min(count, (c + 1) * grain));
-        } catch (...) {
-            const std::lock_guard<std::mutex> lock(error_mutex);
-            if (!error) error = std::current_exception();
-            next.store(chunks);
-        }
-    };
-    std::vector<std::thread> pool;
-    pool.reserve(n - 1);
-    for (unsigned i = 1; i < n; ++i) pool.emplace_back(work);
-    work();
-    for (std::thread& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
 }
 
 /// run_batch in the shape of an Executor's parallel_for, for the library's own parallel steps
