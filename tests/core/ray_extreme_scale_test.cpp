@@ -74,14 +74,9 @@ void rays_across_the_range(int lowest, int highest, int step, double offset_size
     const TriangleMesh unit = make_sphere(2);  // 320 triangles
     const std::size_t count = test::scaled(60, 4);
     std::uint64_t seed = 1;
-    for (int k = lowest; k <= highest; k += step) {
-        const double scale = std::pow(10.0, k);
-        for (const double offset : {0.0, offset_sizes * scale}) {
-            SCOPED_TRACE("scale 1e" + std::to_string(k) + " offset " + std::to_string(offset));
-            rays_at_scale<T>(unit, scale, offset, count, seed++);
-            if (testing::Test::HasFatalFailure()) return;
-        }
-    }
+    test::for_each_scale(lowest, highest, step, offset_sizes, [&](double scale, double offset) {
+        rays_at_scale<T>(unit, scale, offset, count, seed++);
+    });
 }
 
 TEST(RayExtremeScale, Float) {

@@ -90,14 +90,9 @@ void across_the_range(int lowest, int highest, int step, double offset_sizes) {
     const TriangleMesh unit = make_sphere(1);  // 80 triangles
     const std::size_t points = test::scaled(16, 4);
     std::uint64_t seed = 1;
-    for (int k = lowest; k <= highest; k += step) {
-        const double scale = std::pow(10.0, k);
-        for (const double offset : {0.0, offset_sizes * scale}) {
-            SCOPED_TRACE("scale 1e" + std::to_string(k) + " offset " + std::to_string(offset));
-            check_scale<T>(unit, scale, offset, points, seed++);
-            if (testing::Test::HasFailure()) return;
-        }
-    }
+    test::for_each_scale(lowest, highest, step, offset_sizes, [&](double scale, double offset) {
+        check_scale<T>(unit, scale, offset, points, seed++);
+    });
 }
 
 TEST(ExtremeScale, FloatClosestPointAndSign) {

@@ -120,14 +120,9 @@ void ranking_across_the_range(int lowest, int highest, int step, double offset_s
     const TriangleMesh unit = make_sphere(1);  // 80 triangles
     const std::size_t points = test::scaled(16, 8);
     std::uint64_t seed = 1;
-    for (int e = lowest; e <= highest; e += step) {
-        const double scale = std::pow(10.0, e);
-        for (const double offset : {0.0, offset_sizes * scale}) {
-            SCOPED_TRACE("scale 1e" + std::to_string(e) + " offset " + std::to_string(offset));
-            check_ranking_at_scale<T>(unit, scale, offset, points, seed++);
-            if (testing::Test::HasFailure()) return;
-        }
-    }
+    test::for_each_scale(lowest, highest, step, offset_sizes, [&](double scale, double offset) {
+        check_ranking_at_scale<T>(unit, scale, offset, points, seed++);
+    });
 }
 
 // Before: the float squares of a mesh 1e-25 across were all 0 and of one 1e20 across all inf, so

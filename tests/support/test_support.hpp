@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -66,6 +67,21 @@ struct MeshFileName {
         return n;
     }
 };
+
+/// The extreme-scale sweeps: check(scale, offset) for scale = 10^k, k = lowest..highest by step,
+/// at the origin and offset_sizes * scale from it; stops at the first failure (the scales after it
+/// would mostly repeat it).
+template <class F>
+void for_each_scale(int lowest, int highest, int step, double offset_sizes, F&& check) {
+    for (int k = lowest; k <= highest; k += step) {
+        const double scale = std::pow(10.0, k);
+        for (const double offset : {0.0, offset_sizes * scale}) {
+            SCOPED_TRACE("scale 1e" + std::to_string(k) + " offset " + std::to_string(offset));
+            check(scale, offset);
+            if (::testing::Test::HasFailure()) return;
+        }
+    }
+}
 
 }  // namespace bvhkit::test
 
