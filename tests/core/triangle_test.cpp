@@ -127,6 +127,20 @@ TEST(Watertight, DoubleHitsAtEveryScale) {
     EXPECT_GT(tested, 40000);
 }
 
+TEST(Watertight, DoubleSharedCornerScaledAlikeByBothTriangles) {
+    // A corner C near the ray (2^-801) shared by two triangles whose other corners are 2^249 and
+    // 2^261 out: scaled by each triangle's own power of two, C's coordinates sank into denormals
+    // differently in the two, and both missed a ray that hits T2 (its third edge function is
+    // +1.4e-170 exactly). Each corner is now scaled by its own power of two.
+    const Vec3d a{-0x1.97bdbe66b87e7p+248, 0x1.d5a9084a6ea9ep+249, 1};
+    const Vec3d b{0x1.d5a9084a6ea9ep+249, 0x1.97bdbe66b87e7p+248, 1};
+    const Vec3d c{-0x1.e2370fa70f8d5p-801, -0x1.a2959d4526a98p-802, 1};
+    const Vec3d d{0x1.97bdbe66b87e7p+260, -0x1.d5a9084a6ea9ep+261, 1};
+    const Triangled t1{a, b, c}, t2{c, b, d};
+    const Ray<double, 3> ray({0, 0, 0}, {0, 0, 1});
+    EXPECT_TRUE(t1.intersect_watertight(ray) || t2.intersect_watertight(ray));
+}
+
 TEST(Watertight, DoubleRaysThroughASharedEdgeAtEveryScale) {
     // As above in double, the quad scaled by 2^k across double's range, and one triangle's third
     // corner sometimes 2^f farther out, so that the two triangles of the shared edge take

@@ -124,19 +124,59 @@ template <class W>
     return true;
 }
 
-/// Whether double sheared corners can take the direct path: with every |x|, |y| and |z| and the
-/// direction's |d[kz]| in [2^-200, 2^200], the edge functions (products of two), t's numerator
-/// (of three) and det d[kz] neither overflow nor sink into denormals, so scaling could not change
-/// a bit.
-inline bool watertight_direct(double mxy, double mz, double dz) {
-    constexpr double lo = 0x1p-200, hi = 0x1p200;
-    const double az = std::fabs(dz);
-    return mxy >= lo && mxy <= hi && mz >= lo && mz <= hi && az >= lo && az <= hi;
+/// The power of two a double corner's sheared x and y are divided by before the edge functions: 0
+/// while the larger of |x| and |y| lies in [2^-200, 2^200] (or is 0), else its exponent. It depends
+/// on the corner alone, so every triangle that shares the corner uses the same scaled values, and
+/// a shared edge's two edge functions are the same products, negated: watertight whatever scale
+/// each triangle's other corners need, even where scaling rounds a small coordinate.
+inline int corner_exponent(double x, double y) {
+    const double m = std::max(std::fabs(x), std::fabs(y));
+    if (!(m > 0) || !std::isfinite(m) || (m >= 0x1p-200 && m <= 0x1p200)) return 0;
+    return std::ilogb(m);
+}
+
+/// Whether |x| lies in [2^-200, 2^200]: with every corner's exponent 0 and the largest |z| and
+/// |d[kz]| there, the edge functions (products of two), t's numerator (of three) and det d[kz]
+/// stay within double's range.
+inline bool in_direct_window(double x) {
+    const double a = std::fabs(x);
+    return a >= 0x1p-200 && a <= 0x1p200;
 }
 
 /// The exponent e with x = f 2^e, f in [1, 2); 0 for 0 (nothing to scale).
 inline int scale_exponent(double x) {
     return x > 0 && std::isfinite(x) ? std::ilogb(x) : 0;
+}
+
+/// watertight_finish's scaled path for double corners (see there): each corner's x and y scaled
+/// by its own power of two for the edge functions' signs, then the edge functions brought to the
+/// triangle's common scale (only ever down: exact, or sinking towards zero with their signs kept)
+/// for det, t and the barycentrics, z and d[kz] scaled apart.
+[[gnu::noinline]] inline bool watertight_solve_scaled(const int (&e)[3], const double (&x)[3],
+                                                      const double (&y)[3], const double (&z)[3],
+                                                      double dz, double& t, double& det,
+                                                      double& ev_out, double& ew_out) {
+    double xs[3], ys[3];
+    for (int k = 0; k < 3; ++k) xs[k] = std::ldexp(x[k], -e[k]), ys[k] = std::ldexp(y[k], -e[k]);
+    const double eu = opaque(xs[2] * ys[1]) - opaque(ys[2] * xs[1]);  // at 2^-(e1 + e2)
+    const double ev = opaque(xs[0] * ys[2]) - opaque(ys[0] * xs[2]);  // at 2^-(e2 + e0)
+    const double ew = opaque(xs[1] * ys[0]) - opaque(ys[1] * xs[0]);  // at 2^-(e0 + e1)
+    if ((eu < 0 || ev < 0 || ew < 0) && (eu > 0 || ev > 0 || ew > 0)) return false;
+    const int top = std::max({e[0], e[1], e[2]});
+    const double u = std::ldexp(eu, e[1] + e[2] - 2 * top),
+                 v = std::ldexp(ev, e[2] + e[0] - 2 * top),
+                 w = std::ldexp(ew, e[0] + e[1] - 2 * top);
+    det = u + v + w;
+    if (det == 0) return false;
+    const int ez = scale_exponent(std::max({std::fabs(z[0]), std::fabs(z[1]), std::fabs(z[2])})),
+              ed = scale_exponent(std::fabs(dz));
+    // t = (numerator 2^(2 top + ez)) / (det 2^(2 top) * d[kz] 2^ed): 2^(ez - ed) is left over.
+    const double num =
+        u * std::ldexp(z[0], -ez) + v * std::ldexp(z[1], -ez) + w * std::ldexp(z[2], -ez);
+    t = std::ldexp(num / (det * std::ldexp(dz, -ed)), ez - ed);
+    ev_out = v;
+    ew_out = w;
+    return true;
 }
 
 }  // namespace detail
@@ -146,38 +186,30 @@ inline int scale_exponent(double x) {
 /// and t in `Wide`. Shared by the scalar test below and the four-abreast one
 /// (primitives/triangle_group.hpp), which shears in SIMD and finishes here.
 ///
-/// Double corners or a direction outside [2^-200, 2^200] (meshes beyond about 1e+-60 across, or a
-/// ray far from them) are first scaled by powers of two, x and y by one, z by another, and the direction's
-/// component by a third: the products of two and three coordinates would otherwise leave double's
-/// range. Scaling by 2^k is exact and rounding is monotonic, so a scaled edge function has the
-/// unscaled one's sign or is zero, and the edge shared by two triangles still gets opposite (or
-/// zero) values from them whatever scale each triangle took: the test stays watertight. Float
-/// corners never need it: their products of three stay within double's range.
+/// Double corners, or a direction, outside [2^-200, 2^200] (meshes beyond about 1e+-60 across, or a
+/// ray far from them) take a scaled path: the products of two and three coordinates would otherwise
+/// leave double's range. Each corner's x and y are scaled by a power of two of its own
+/// (detail::corner_exponent), so a shared edge gets the same products, negated, from its two
+/// triangles (watertight); the edge functions are then brought to one scale per triangle, and z
+/// and d[kz] are scaled apart. Inside the window nothing is scaled and the bits are as before.
+/// Float corners never need it: their products of three stay within double's range.
 template <class T>
 inline bool watertight_finish(const WatertightRay<T>& r, T ax_, T ay_, T az, T bx_, T by_, T bz,
                               T cx_, T cy_, T cz, T tmin, T tmax, TriangleHit<T>& hit) {
     using W = typename WatertightRay<T>::Wide;
     W t_wide, det, ev, ew;
     if constexpr (std::is_same_v<T, double>) {
-        const double mxy = std::max({std::fabs(ax_), std::fabs(ay_), std::fabs(bx_), std::fabs(by_),
-                                     std::fabs(cx_), std::fabs(cy_)});
+        const int e[3] = {detail::corner_exponent(ax_, ay_), detail::corner_exponent(bx_, by_),
+                          detail::corner_exponent(cx_, cy_)};
         const double mz = std::max({std::fabs(az), std::fabs(bz), std::fabs(cz)});
-        if (detail::watertight_direct(mxy, mz, r.dz)) {
+        if ((e[0] | e[1] | e[2]) == 0 && detail::in_direct_window(mz) &&
+            detail::in_direct_window(r.dz)) {
             if (!detail::watertight_solve<W>(ax_, ay_, az, bx_, by_, bz, cx_, cy_, cz, r.dz, t_wide,
                                              det, ev, ew))
                 return false;
-        } else {
-            const int exy = detail::scale_exponent(mxy), ez = detail::scale_exponent(mz),
-                      ed = detail::scale_exponent(std::fabs(r.dz));
-            const auto xy = [exy](double x) { return std::ldexp(x, -exy); };
-            const auto z = [ez](double x) { return std::ldexp(x, -ez); };
-            // t = (scaled numerator 2^(2 exy + ez)) / (scaled det 2^(2 exy) * dz): the powers of
-            // 2 exy cancel, leaving 2^(ez - ed).
-            if (!detail::watertight_solve<W>(xy(ax_), xy(ay_), z(az), xy(bx_), xy(by_), z(bz),
-                                             xy(cx_), xy(cy_), z(cz), std::ldexp(r.dz, -ed), t_wide,
-                                             det, ev, ew))
-                return false;
-            t_wide = std::ldexp(t_wide, ez - ed);
+        } else if (!detail::watertight_solve_scaled(e, {ax_, bx_, cx_}, {ay_, by_, cy_},
+                                                    {az, bz, cz}, r.dz, t_wide, det, ev, ew)) {
+            return false;
         }
     } else {
         const W ax = ax_, ay = ay_, bx = bx_, by = by_, cx = cx_, cy = cy_;
