@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <type_traits>
 
@@ -150,19 +151,28 @@ inline int scale_exponent(double x) {
 
 /// watertight_finish's scaled path for double corners (see there): each corner's x and y scaled
 /// by its own power of two for the edge functions' signs, then the edge functions brought to the
-/// triangle's common scale (only ever down: exact, or sinking towards zero with their signs kept)
-/// for det, t and the barycentrics, z and d[kz] scaled apart.
+/// triangle's common scale for det, t and the barycentrics (exact, or sinking towards zero with
+/// their signs kept), z and d[kz] scaled apart.
 [[gnu::noinline]] inline bool watertight_solve_scaled(const int (&e)[3], const double (&x)[3],
                                                       const double (&y)[3], const double (&z)[3],
                                                       double dz, double& t, double& det,
                                                       double& ev_out, double& ew_out) {
+    // The common scale is that of the largest corner (its own exponent, whether or not the
+    // corner itself was scaled), so the largest edge functions land near 1 and the small ones
+    // keep what bits they can. A corner on the ray (x = y = 0) scales to 0 by any power and sets
+    // nothing.
+    int top = std::numeric_limits<int>::min();
+    for (int k = 0; k < 3; ++k) {
+        const double m = std::max(std::fabs(x[k]), std::fabs(y[k]));
+        if (m > 0) top = std::max(top, std::ilogb(m));
+    }
+    if (top == std::numeric_limits<int>::min()) return false;  // all three on the ray
     double xs[3], ys[3];
     for (int k = 0; k < 3; ++k) xs[k] = std::ldexp(x[k], -e[k]), ys[k] = std::ldexp(y[k], -e[k]);
     const double eu = opaque(xs[2] * ys[1]) - opaque(ys[2] * xs[1]);  // at 2^-(e1 + e2)
     const double ev = opaque(xs[0] * ys[2]) - opaque(ys[0] * xs[2]);  // at 2^-(e2 + e0)
     const double ew = opaque(xs[1] * ys[0]) - opaque(ys[1] * xs[0]);  // at 2^-(e0 + e1)
     if ((eu < 0 || ev < 0 || ew < 0) && (eu > 0 || ev > 0 || ew > 0)) return false;
-    const int top = std::max({e[0], e[1], e[2]});
     const double u = std::ldexp(eu, e[1] + e[2] - 2 * top),
                  v = std::ldexp(ev, e[2] + e[0] - 2 * top),
                  w = std::ldexp(ew, e[0] + e[1] - 2 * top);
