@@ -221,6 +221,29 @@ TEST(DynamicTree, RayWithZeroDirectionComponents) {
     EXPECT_EQ(hits({0.5f, 0.5f}, {0, 0}, 1), (std::vector<ProxyId>{a}));
 }
 
+TEST(DynamicTree, CastsNeverLengthenTheSegmentAndVisitNearerFirst) {
+    DynamicTree<float, 2> t;
+    std::vector<ProxyId> row;
+    for (int i = 0; i < 64; ++i) row.push_back(t.create(box2(float(2 * i), 0)));
+    // From x = -1 along +x: boxes at 2i, entry fraction (2i + 1) / 200. A callback asking for a
+    // longer segment than it has (0.9 from max 0.5) leaves it at 0.5: the boxes beyond 0.5 were
+    // dropped when their subtrees were clipped, and none is reported.
+    std::vector<ProxyId> seen;
+    t.ray_cast(Vec2f{-1, 0.5f}, Vec2f{200, 0}, 0.5f, [&](ProxyId id, float) {
+        seen.push_back(id);
+        return 0.9f;
+    });
+    ASSERT_FALSE(seen.empty());
+    for (const ProxyId id : seen) EXPECT_LT(id.index(), 50) << "beyond the segment";
+    // A closest-hit callback gets the nearest box first: the walk opens the nearer child first.
+    std::vector<ProxyId> first;
+    t.ray_cast(Vec2f{-1, 0.5f}, Vec2f{200, 0}, 1.0f, [&](ProxyId id, float) {
+        first.push_back(id);
+        return 0.0f;
+    });
+    EXPECT_EQ(first, (std::vector<ProxyId>{row[0]}));
+}
+
 TEST(DynamicTree, BoxCastAndStats) {
     DynamicTree<double, 3> t;
     const ProxyId a = t.create(Aabb3d({5, 0, 0}, {6, 1, 1}));

@@ -304,7 +304,8 @@ class DynamicTree {
     /// The segment origin + s * direction, s in [0, max_fraction], against the proxies' boxes.
     /// callback(ProxyId, T max_fraction) -> T, or callback(const CastInput<T, N>&, ProxyId) -> T to
     /// get the ray (origin, translation = direction, current max_fraction) for exact clipping:
-    /// < 0 ignore and go on, 0 stop, > 0 clip to that fraction.
+    /// < 0 ignore and go on, 0 stop, > 0 clip to that fraction (a larger one than the current
+    /// max fraction leaves it: the segment never grows). `stats` counts the node boxes tested.
     template <class F>
     void ray_cast(const VecT& origin, const VecT& direction, T max_fraction, F&& callback,
                   QueryStats* stats = nullptr) const {

@@ -103,7 +103,8 @@ struct Segment {
 /// expect:
 ///   < 0  ignore this proxy, go on with the same max fraction
 ///   == 0 stop the query
-///   > 0  go on, clipping the segment to this new max fraction
+///   > 0  go on, clipping the segment to this new max fraction (never lengthening it: a value
+///        above the current max fraction leaves it as it is)
 /// Children are clipped before they are pushed and the nearer one (by entry fraction) is walked
 /// first, so a callback that clips (closest hit) shortens the segment early and the farther
 /// subtrees are dropped when popped: their entry then lies beyond the new max fraction.
@@ -138,7 +139,8 @@ void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, CastInput<T, N> 
             else
                 value = callback(proxy_id(t, n.value()), max_fraction);
             if (value == T(0)) break;
-            if (value > T(0)) max_fraction = value;
+            // A value above the current max leaves it: subtrees beyond it were dropped at push.
+            if (value > T(0)) max_fraction = std::min(max_fraction, value);
             continue;
         }
         visited += 2;
