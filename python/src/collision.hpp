@@ -39,12 +39,22 @@ template <class T>
 class PoseValues {
   public:
     PoseValues() = default;
-    PoseValues(const PoseArray& a, std::size_t dims)
+    /// `dims`: 1 for translations ((k, 3) or (3,)), 2 for rotations ((k, 3, 3) or (3, 3)). The
+    /// Python layer hands over only those shapes; the checks here keep a direct call of the
+    /// extension from reading past the array.
+    PoseValues(const PoseArray& a, std::size_t dims, const char* name)
         : data_(a.data()),
           f64_(a.dtype() == nb::dtype<double>()),
-          count_(a.ndim() == dims ? 1 : a.shape(0)) {
+          count_(a.ndim() == dims  ? 1
+                 : a.ndim() > dims ? a.shape(0)
+                                   : 0) {
         if (!f64_ && a.dtype() != nb::dtype<float>())
-            throw Error("poses: dtype must be float32 or float64");
+            throw Error(std::string(name) + ": dtype must be float32 or float64");
+        bool shaped = a.ndim() == dims || a.ndim() == dims + 1;
+        for (std::size_t d = a.ndim() - dims; shaped && d < a.ndim(); ++d) shaped = a.shape(d) == 3;
+        if (!shaped)
+            throw Error(std::string(name) +
+                        (dims == 1 ? ": must be (k, 3) or (3,)" : ": must be (k, 3, 3) or (3, 3)"));
     }
     explicit operator bool() const { return data_ != nullptr; }
     std::size_t count() const { return count_; }
@@ -185,8 +195,9 @@ class Model {
     template <class PerPose>
     void poses(const Model& b, const std::optional<PoseArray>& rotations,
                const PoseArray& translations, unsigned threads, PerPose&& per_pose) const {
-        const PoseValues<T> t(translations, 1);
-        const PoseValues<T> r = rotations ? PoseValues<T>(*rotations, 2) : PoseValues<T>();
+        const PoseValues<T> t(translations, 1, "translations");
+        const PoseValues<T> r =
+            rotations ? PoseValues<T>(*rotations, 2, "rotations") : PoseValues<T>();
         const std::size_t k = t.count();
         if (r && r.count() != k) {
             check_poses(r, t);
@@ -210,12 +221,17 @@ class Model {
                 per_pose(i, pose);
             }
         });
-        if (bad.load()) check_poses(r, t);
+        if (bad.load()) {
+            check_poses(r, t);
+            // Only another thread writing the arrays during the call gets here: a pose read as
+            // bad was good when scanned again. The outputs are not whole, so the call fails.
+            throw Error("translations: the poses changed while the call read them");
+        }
     }
 
     void collides(const Model& b, const std::optional<PoseArray>& rotations,
                   const PoseArray& translations, OutColumn<bool> out, unsigned threads) const {
-        expect_rows(out, PoseValues<T>(translations, 1).count(), "out");
+        expect_rows(out, PoseValues<T>(translations, 1, "translations").count(), "out");
         bool* o = out.data();
         poses(b, rotations, translations, threads, [&](std::size_t i, const Transform<T>& pose) {
             o[i] = bvhkit::collides(model_, b.model_, pose);
@@ -226,7 +242,7 @@ class Model {
     /// pairs are rows offsets[i] .. offsets[i + 1], sorted.
     nb::tuple contacts(const Model& b, const std::optional<PoseArray>& rotations,
                        const PoseArray& translations, unsigned threads) const {
-        const std::size_t k = PoseValues<T>(translations, 1).count();
+        const std::size_t k = PoseValues<T>(translations, 1, "translations").count();
         std::vector<std::vector<std::array<std::int64_t, 2>>> per(k);
         poses(b, rotations, translations, threads, [&](std::size_t i, const Transform<T>& pose) {
             CollideResult<T> result;
@@ -251,7 +267,7 @@ class Model {
                   OutColumn<T> dist, OutRows<T, 3> point_a, OutRows<T, 3> point_b,
                   OutColumn<std::int64_t> face_a, OutColumn<std::int64_t> face_b,
                   unsigned threads) const {
-        const std::size_t k = PoseValues<T>(translations, 1).count();
+        const std::size_t k = PoseValues<T>(translations, 1, "translations").count();
         expect_rows(dist, k, "distance");
         expect_rows(point_a, k, "point_a");
         expect_rows(point_b, k, "point_b");

@@ -123,3 +123,20 @@ def test_refit_collision_model():
     assert not bvhkit.collide(a, b, None, [[2.5, 0, 0]])[0]
     b.refit(v * 1.5)
     assert bvhkit.collide(a, b, None, [[2.5, 0, 0]])[0]
+
+
+def test_the_extension_refuses_pose_arrays_of_the_wrong_shape():
+    # The Python layer only hands over (k, 3) / (k, 3, 3) poses; the extension checks the shapes
+    # itself too, so a direct call cannot make it read past an array.
+    v, f = bvhkit.load_mesh("sphere:subdiv=1")
+    m = bvhkit.CollisionModel(v, f)
+    out = np.empty(1, np.bool_)
+    for r, t in [
+        (None, np.zeros(2)),
+        (None, np.zeros((1, 4))),
+        (np.zeros((1, 9)), np.zeros((1, 3))),
+        (np.zeros((1, 3, 2)), np.zeros((1, 3))),
+        (None, np.zeros((1, 1, 3))),
+    ]:
+        with pytest.raises(ValueError, match="rotations|translations"):
+            m._impl.collides(m._impl, r, t, out, 1)
