@@ -11,6 +11,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
+#include <system_error>
 
 #include "batch.hpp"
 
@@ -25,7 +26,13 @@ class Pool {
         if (inside_batch) return false;
         std::unique_lock<std::mutex> busy(busy_, std::try_to_lock);
         if (!busy.owns_lock()) return false;
-        grow(helpers);
+        // Threads the system refuses to start (a process limit) are left out: the batch runs
+        // on those it has, at worst on the calling thread alone.
+        try {
+            grow(helpers);
+        } catch (const std::system_error&) {
+        }
+        helpers = std::min(helpers, workers_);
         {
             const std::lock_guard<std::mutex> lock(mutex_);
             work_ = work;

@@ -6,6 +6,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -76,7 +77,9 @@ void for_each_scale(int lowest, int highest, int step, double offset_sizes, F&& 
     for (int k = lowest; k <= highest; k += step) {
         const double scale = std::pow(10.0, k);
         for (const double offset : {0.0, offset_sizes * scale}) {
-            SCOPED_TRACE("scale 1e" + std::to_string(k) + " offset " + std::to_string(offset));
+            char offset_text[32];
+            std::snprintf(offset_text, sizeof offset_text, "%g", offset);
+            SCOPED_TRACE("scale 1e" + std::to_string(k) + " offset " + offset_text);
             check(scale, offset);
             if (::testing::Test::HasFailure()) return;
         }

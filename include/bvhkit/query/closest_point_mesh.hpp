@@ -19,7 +19,7 @@
 // to four children a node (bvh/wide_bvh.hpp), its leaves' triangles four abreast
 // (primitives/triangle_pack.hpp). A pack's SIMD distances only pick which triangles to measure
 // accurately, with a margin for rounding, so the answers are those of measuring every triangle;
-// against the binary walk this took ~40% less time per N1 query (docs/proximity.md).
+// it opens fewer nodes and measures fewer triangles than the binary walk (docs/proximity.md).
 // k_nearest and within_radius walk the binary tree.
 #include <span>
 
@@ -295,10 +295,10 @@ class ClosestPointMesh {
             }
         };
         if (start < triangle_slots_) {
-            // The nearest corner of the starting triangle bounds the distance from above, for
-            // twenty instructions (measuring the triangle itself bounds it tighter but cost
-            // more than it saved). The bound is widened twice, as a pack's estimate is: its
-            // rounding is a few ulps of the distance, far inside one widening.
+            // The nearest corner of the starting triangle bounds the distance from above, cheaply
+            // (measuring the triangle itself bounds it tighter but cost more than it saved). The
+            // bound is widened twice, as a pack's estimate is: its rounding is a few ulps of the
+            // distance, far inside one widening.
             const Triangle<T>& t = tris_[start];
             const auto scaled2 = [&](const Vec<T, 3>& corner) {
                 return length_squared((p - corner) * pack_scale_);
@@ -363,8 +363,7 @@ class ClosestPointMesh {
         // A float mesh keeps each triangle's accurate frame (80 bytes; a double mesh's, in long
         // double, would take 144, so it keeps them only where long double is double): a query
         // measures ~3 triangles in full, and the frame is two square roots and six divisions of
-        // each. One thread: a 128^3 grid around spot 1615-1640
-        // -> 1395-1408 ms, 1M random points around igea 4292-4304 -> 4049 ms.
+        // each (the timings are in docs/benchmarks.md, "Figures behind code comments").
         frames_.clear();
         if constexpr (sizeof(AccurateScalar<T>) == sizeof(double)) {
             frames_.reserve(triangle_slots_);
@@ -536,8 +535,8 @@ class ClosestPointMesh {
                         T(4) * std::numeric_limits<T>::min());
     }
     /// Squared distance from p to the triangle's box. For float on x86 in SSE: each corner is one
-    /// 4-float load (the fourth lane, the next coordinate, masked off), ~15 instructions where the
-    /// scalar form takes ~100 (measured: a fifth of an N1 query).
+    /// 4-float load (the fourth lane, the next coordinate, masked off), a fraction of the scalar
+    /// form's instructions on a path every N1 query takes often.
     static T box_distance_squared(const Triangle<T>& t, const Vec<T, 3>& p) {
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>) {
