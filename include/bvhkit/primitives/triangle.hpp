@@ -164,6 +164,8 @@ inline int scale_exponent(double x) {
     int top = std::numeric_limits<int>::min();
     for (int k = 0; k < 3; ++k) {
         const double m = std::max(std::fabs(x[k]), std::fabs(y[k]));
+        // Corners near DBL_MAX shear to inf or NaN: no sign can be told, the ray misses.
+        if (!std::isfinite(m)) return false;
         if (m > 0) top = std::max(top, std::ilogb(m));
     }
     if (top == std::numeric_limits<int>::min()) return false;  // all three on the ray
