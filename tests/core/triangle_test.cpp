@@ -113,8 +113,7 @@ TEST(Watertight, DoubleHitsAtEveryScale) {
         for (int b = -1000; b <= 1000; b += 50)
             for (int c = -1000; c <= 1000; c += 50) {
                 if (std::abs(b - c) > 1000) continue;  // t itself must be a normal double
-                const double L = std::ldexp(1.0, a), z = std::ldexp(1.0, b),
-                             m = std::ldexp(1.0, c);
+                const double L = std::ldexp(1.0, a), z = std::ldexp(1.0, b), m = std::ldexp(1.0, c);
                 const Triangled tri{{0, 0, z}, {L, 0, z}, {0, L, z}};
                 const Ray<double, 3> ray({L / 4, L / 4, 0}, {0, 0, m});
                 const auto h = tri.intersect_watertight(ray);

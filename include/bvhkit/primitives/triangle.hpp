@@ -101,9 +101,6 @@ template <class T>
 #endif
     return x;
 }
-}  // namespace detail
-
-namespace detail {
 
 /// The edge functions and t of the watertight test for sheared corners, in W: the arithmetic of
 /// watertight_finish's paths. Gives t (before any power of two of the scaled path), det and the
