@@ -2,7 +2,8 @@
 process: ``python -m bvhkit.bench [--scale S] [--reps R] [--only P1,P2,...]``.
 
 Workloads (sizes times --scale):
-  P1  rays: 1M random rays (closest hit) through a scanned mesh and a 1.3M-triangle sphere
+  P1  rays: 1M random rays (closest hit) through a scanned mesh and a 1.3M-triangle sphere, and
+      the camera rays of a 1024x1024 pinhole image of the scanned mesh, pixel by pixel
   P2  closest point for 1M points
   P3  signed distance on a 128^3 grid, for a closed mesh and for one with holes; sign errors are
       counted against the exact winding number on a sample of the grid
@@ -12,7 +13,8 @@ Workloads (sizes times --scale):
       poses with threads=0 against threads=1 (the ratio: at most about 1 for small batches)
 
 A peer runs when it imports and sets up; a peer that fails is listed with the reason and the rest
-go on. Peers: Open3D (RaycastingScene), trimesh (with embreex for rays when present), libigl (igl),
+go on. Peers: Open3D (RaycastingScene), Embree 4 through embreex (its scene's `run`, one
+`rtcIntersect1` a ray on one thread), trimesh (with embreex for rays when present), libigl (igl),
 fcpw, python-fcl (fcl) and coal. Each row says its threads: "1", "all" (every core) or "own" (the
 peer's default, which may use several). The ratio compares a row with bvhkit on as many threads
 (bvhkit's "1" for a "1" row, "all" otherwise): above 1 means bvhkit is faster. Times are medians of
@@ -133,8 +135,31 @@ def _check_hits(t, reference) -> str:
     return f"agree {same.mean() * 100:.3f}% of {len(t)} rays"
 
 
+def _camera_rays(v, side):
+    """A side x side pinhole camera looking at the mesh's centre from 1.5 box diagonals away, 60
+    degrees across, rays in pixel order (row by row): the coherent rays of a rendered image."""
+    lo, hi = v.min(0).astype(np.float64), v.max(0).astype(np.float64)
+    centre, diag = (lo + hi) / 2, np.linalg.norm(hi - lo)
+    eye = centre + diag * np.array([0.9, 0.6, 1.0]) / np.linalg.norm([0.9, 0.6, 1.0]) * 1.5
+    forward = (centre - eye) / np.linalg.norm(centre - eye)
+    right = np.cross(forward, [0.0, 1.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    s = np.tan(np.radians(30.0)) * (2 * (np.arange(side) + 0.5) / side - 1)
+    yy, xx = np.meshgrid(-s, s, indexing="ij")
+    d = forward + xx.reshape(-1, 1) * right + yy.reshape(-1, 1) * up
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    o = np.broadcast_to(eye, d.shape)
+    return np.ascontiguousarray(o, dtype=np.float32), d.astype(np.float32)
+
+
 def p1(v, f, n, reps, mods, label):
-    o, d = _rays(v, n, 1)
+    if label == "camera":
+        side = max(16, int(round(np.sqrt(n))))
+        o, d = _camera_rays(v, side)
+        n = side * side
+    else:
+        o, d = _rays(v, n, 1)
     w = Workload(f"P1 {label}", n)
     scene = bvhkit.TriangleMesh(v, f)
     fast = bvhkit.TriangleMesh(v, f, ray_test="fast")
@@ -153,6 +178,19 @@ def p1(v, f, n, reps, mods, label):
                   read)
             w.add("open3d cast_rays (all threads)", "all", lambda: rs.cast_rays(rays), read)
         w.peer("open3d cast_rays", setup_o3d)
+    embreex = mods.get("embreex")
+    if embreex:
+        def setup_embree():
+            from embreex.mesh_construction import TriangleMesh as EmbreeMesh
+            from embreex.rtcore_scene import EmbreeScene
+            es = EmbreeScene()
+            EmbreeMesh(es, v.astype(np.float32), f.astype(np.int32))
+            es.run(o[:1], d[:1], output=1)  # commits the scene (builds its tree) outside the timing
+            read = lambda r: np.where(r["geomID"] >= 0, r["tfar"], np.inf)
+            version = getattr(embreex, "__version__", "")
+            w.add(f"embree4 embreex {version} run".strip(), "1",
+                  lambda: es.run(o, d, output=1), read)
+        w.peer("embree4 embreex run", setup_embree)
     tm = mods.get("trimesh")
     if tm:
         def setup_trimesh():
@@ -472,7 +510,8 @@ def main(argv=None) -> None:
     ap.add_argument("--sdf-mesh", default="spot.obj", help="closed mesh for P3 (holes are cut)")
     ap.add_argument("--collision-mesh", default="stanford-bunny.obj", help="mesh for P4")
     args = ap.parse_args(argv)
-    mods = {m: _optional(m) for m in ("open3d", "trimesh", "igl", "fcpw", "fcl", "coal")}
+    mods = {m: _optional(m) for m in ("open3d", "embreex", "trimesh", "igl", "fcpw", "fcl",
+                                         "coal")}
     absent = {m: x for m, x in mods.items() if isinstance(x, Exception)}
     mods = {m: x for m, x in mods.items() if m not in absent}
     print(f"bvhkit {bvhkit.__version__}; cores {os.cpu_count()}; peers present: "
@@ -495,6 +534,8 @@ def main(argv=None) -> None:
             bv, bf, bname = _mesh(args.big_mesh)
             print(f"P1: {bname}, {len(bf)} triangles")
             show(p1(bv, bf, int(1_000_000 * s), args.reps, mods, "big"))
+        print(f"P1: {name}, camera rays")
+        show(p1(v, f, int(1024 * 1024 * s), args.reps, mods, "camera"))
     if "P2" in only:
         v, f, name = _mesh(args.mesh)
         print(f"P2: {name}, {len(f)} triangles")
