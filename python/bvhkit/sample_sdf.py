@@ -3,11 +3,25 @@
 Signed-distance samples for every mesh file (.obj, .ply, .stl) of MESH_DIR, written as
 DIR/NAME.npz (NAME: the file's name without its extension) with ``points`` float32 (N, 3),
 ``sdf`` float32 (N,), negative inside, and ``meta``, a JSON string recording what made them: the
-mesh file's name and SHA-256, N, SIGMA and the seed. The first N // 2 points are uniform in the
-mesh's bounding box grown by 5% of its size on every side (5% of the diagonal along an axis of
-zero extent); the rest lie near the surface: a point of the surface drawn by area, plus gaussian
-noise of SIGMA (0 to 1) times the box's diagonal. The sign comes from the generalized winding number
-(``sign="winding_number"``), so meshes with holes get sensible signs.
+mesh file's name and SHA-256, N, the near-surface noise, the seed and every option below that is
+not at its default. The first N // 2 points (a share U of them with ``--uniform U``) are uniform
+in the mesh's bounding box grown by 5% of its size on every side (5% of the diagonal along an axis
+of zero extent); the rest lie near the surface: a point of the surface drawn by area, plus gaussian
+noise of SIGMA (0 to 1) times the box's diagonal. ``--near-surface 0.005:0.4,0.05:0.1`` asks for
+several noise levels, each SIGMA:SHARE with SHARE the part of all N points (the shares and U sum to
+1; without shares the near part is split evenly), in that order after the uniform points. The sign
+comes from the generalized winding number (``sign="winding_number"``), so meshes with holes get
+sensible signs.
+
+Optional outputs (``--outputs occupancy,normals,closest``): ``occupancy`` uint8 (N,), 1 where the
+sdf's sign bit is set (inside: winding number above 1/2), as occupancy networks train on;
+``closest`` float32 (N, 3), each sample's closest point of the surface; ``normals`` float32 (N, 3),
+the unit normal of the triangle holding that closest point, from the triangle's winding (zero for a
+triangle of no area). ``--normalize sphere`` first maps the mesh into the unit sphere (its box's
+centre to the origin, its farthest vertex to distance 1), ``--normalize cube`` into the cube
+[-1/2, 1/2]^3 (the box's longest side to length 1, centred); every output is then in those
+coordinates, and ``offset`` float64 (3,) and ``scale`` float64 () record the map, normalized = (mesh
+- offset) * scale, in the file and in ``meta``.
 
 The samples depend only on the seed, the mesh file's name and its contents: any scheduler and any
 number of workers write the same bytes. With ``--scheduler`` the meshes are spread over Dask
@@ -60,24 +74,87 @@ def file_digest(path: str) -> str:
     return h.hexdigest()
 
 
-def record(file: str, digest: str, points: int, sigma: float, seed: int) -> str:
-    """The ``meta`` of an output: what made it, and no time, so a rerun writes the same bytes."""
+_OUTPUTS = ("occupancy", "normals", "closest")
+_NORMALIZE = ("none", "sphere", "cube")
+
+
+class Recipe:
+    """What to sample and write besides the points and the sdf. The defaults are the original
+    recipe, whose record has no key for them: outputs made before these options stay valid."""
+
+    def __init__(self, near=((0.01, 0.5),), uniform=0.5, outputs=(), normalize="none"):
+        self.near = tuple((float(s), float(w)) for s, w in near)  # (sigma, share of all N)
+        self.uniform = float(uniform)
+        self.outputs = tuple(o for o in _OUTPUTS if o in outputs)  # a fixed order
+        self.normalize = normalize
+
+    def counts(self, points: int) -> tuple[int, list[int]]:
+        """The uniform count, then one count per near-surface level; they sum to ``points``."""
+        n_uniform = points // 2 if self.uniform == 0.5 else int(np.floor(points * self.uniform))
+        rest = points - n_uniform
+        total = sum(w for _, w in self.near)
+        counts = [int(np.floor(rest * w / total)) if total > 0 else 0 for _, w in self.near[:-1]]
+        return n_uniform, counts + [rest - sum(counts)]
+
+    def fields(self) -> dict[str, Any]:
+        """The record's keys for this recipe (none for the default one)."""
+        out: dict[str, Any] = {}
+        if self.uniform != 0.5 or len(self.near) != 1:
+            out["near_surface"] = [list(level) for level in self.near]
+            out["uniform"] = self.uniform
+        else:
+            out["near_surface"] = self.near[0][0]
+        if self.outputs:
+            out["outputs"] = list(self.outputs)
+        if self.normalize != "none":
+            out["normalize"] = self.normalize
+        return out
+
+
+def record(file: str, digest: str, points: int, sigma: Any, seed: int,
+           recipe: Optional[Recipe] = None, transform: Optional[tuple] = None) -> str:
+    """The ``meta`` of an output: what made it, and no time, so a rerun writes the same bytes.
+    ``sigma`` is used when no recipe is given; ``transform`` is (offset, scale) of --normalize."""
+    fields = recipe.fields() if recipe is not None else {"near_surface": sigma}
+    if transform is not None:
+        fields["offset"], fields["scale"] = [float(x) for x in transform[0]], float(transform[1])
     return json.dumps(
         {"format": FORMAT, "mesh": file, "mesh_sha256": digest, "points": points,
-         "near_surface": sigma, "seed": seed},
+         "seed": seed, **fields},
         sort_keys=True,
     )
 
 
+def _normalization(v: np.ndarray, how: str) -> tuple[np.ndarray, float]:
+    """(offset, scale) mapping the vertices into the unit sphere or the cube [-1/2, 1/2]^3."""
+    v = v.astype(np.float64)
+    v = v[np.isfinite(v).all(axis=1)]
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    offset = (lo + hi) / 2
+    size = np.linalg.norm(v - offset, axis=1).max() if how == "sphere" else (hi - lo).max()
+    if not (size > 0 and np.isfinite(size) and np.isfinite(1.0 / size)):
+        raise ValueError(f"--normalize {how}: the mesh has no extent to scale")
+    return offset, 1.0 / size
+
+
 def sample(
-    path: str, name: str, points: int, sigma: float, seed: int, threads: int = 1
+    path: str, name: str, points: int, sigma: float, seed: int, threads: int = 1,
+    recipe: Optional[Recipe] = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The samples of one mesh file: ``(points float32 (N, 3), sdf float32 (N,))``; ``name``
     (with ``seed``) seeds the random numbers. ValueError if the mesh cannot be read, has no face
-    of positive area, or its samples or distances do not fit float32."""
+    of positive area, or its samples or distances do not fit float32. With a ``recipe``, sigma is
+    ignored and the answer is a dict of every array to write."""
     import bvhkit
 
     v, f = bvhkit.load_mesh(path)
+    plain = recipe is None
+    if plain:
+        recipe = Recipe(near=((sigma, 0.5),))
+    transform = None
+    if recipe.normalize != "none":
+        transform = _normalization(v, recipe.normalize)
+        v = ((v.astype(np.float64) - transform[0]) * transform[1]).astype(v.dtype)
     tri = v.astype(np.float64)[f]  # (m, 3, 3)
     tri = tri[np.isfinite(tri).all(axis=(1, 2))]
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
@@ -90,12 +167,13 @@ def sample(
     margin = 0.05 * np.where(extent > 0, extent, diagonal)
     if not np.all(np.abs(np.concatenate([lo - margin, hi + margin])) <= _F32_MAX):
         raise ValueError(f"{path}: the box grown by 5% does not fit float32 (samples are float32)")
-    scale = sigma * diagonal
-    if not np.isfinite(scale):
-        raise ValueError(f"{path}: --near-surface {sigma} times the diagonal is not finite")
+    sigmas = np.array([level[0] for level in recipe.near])
+    scales = sigmas * diagonal
+    if not np.isfinite(scales).all():
+        raise ValueError(f"{path}: --near-surface {sigmas.max()} times the diagonal is not finite")
     # zlib.crc32, not hash(): the same number in every process.
     rng = np.random.default_rng([seed, zlib.crc32(name.encode("utf-8"))])
-    n_uniform = points // 2
+    n_uniform, n_levels = recipe.counts(points)
     n_near = points - n_uniform
     uniform = rng.uniform(lo - margin, hi + margin, (n_uniform, 3))
     which = rng.choice(len(tri), n_near, p=area / total)
@@ -103,34 +181,55 @@ def sample(
     s = np.sqrt(r1)  # uniform over each triangle
     bary = np.stack([1 - s, s * (1 - r2), s * r2], axis=1)
     surface = np.einsum("ij,ijk->ik", bary, tri[which])
-    near = surface + rng.normal(scale=scale, size=(n_near, 3))
+    # One draw with a scale per sample: with one level this is the draw the recipe always made.
+    per_sample = np.repeat(scales, n_levels)[:, None]
+    near = surface + rng.normal(scale=per_sample, size=(n_near, 3))
     with np.errstate(over="ignore"):
         p = np.concatenate([uniform, near]).astype(np.float32)
     if not np.isfinite(p).all():
         raise ValueError(
-            f"{path}: --near-surface {sigma} times the diagonal ({scale:.3g}) puts samples beyond "
-            "float32's range"
+            f"{path}: --near-surface {sigmas.max()} times the diagonal ({scales.max():.3g}) puts "
+            "samples beyond float32's range"
         )
     scene = bvhkit.TriangleMesh(v, f)
     sdf = scene.signed_distance(p, sign="winding_number", threads=threads).astype(np.float32)
     if not np.isfinite(sdf).all():
         raise ValueError(f"{path}: signed distances beyond float32's range (the mesh is too large)")
-    return p, sdf
+    if plain:
+        return p, sdf
+    arrays: dict[str, np.ndarray] = {"points": p, "sdf": sdf}
+    if "occupancy" in recipe.outputs:
+        arrays["occupancy"] = np.signbit(sdf).astype(np.uint8)
+    if "normals" in recipe.outputs or "closest" in recipe.outputs:
+        _, closest, face, _ = scene.closest_point(p, threads=threads)
+        if "normals" in recipe.outputs:
+            t = v.astype(np.float64)[f[face]]
+            n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+            length = np.linalg.norm(n, axis=1, keepdims=True)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                n = np.where(length > 0, n / length, 0.0)
+            arrays["normals"] = n.astype(np.float32)
+        if "closest" in recipe.outputs:
+            arrays["closest"] = np.asarray(closest, dtype=np.float32)
+    if transform is not None:
+        arrays["offset"] = np.asarray(transform[0], dtype=np.float64)
+        arrays["scale"] = np.float64(transform[1])
+    return arrays
 
 
-def _task(path: str, name: str, points: int, sigma: float, seed: int) -> tuple:
+def _task(path: str, name: str, points: int, recipe: Recipe, seed: int) -> tuple:
     """One mesh on a worker: the arrays, the digest of the file they came from, and the seconds
     taken (the client writes the file)."""
     t = time.perf_counter()
     before = os.stat(path)
     digest = file_digest(path)
-    p, sdf = sample(path, name, points, sigma, seed)
+    arrays = sample(path, name, points, 0.0, seed, recipe=recipe)
     after = os.stat(path)
     if (before.st_size, before.st_mtime_ns, before.st_ino) != (
         after.st_size, after.st_mtime_ns, after.st_ino
     ):
         raise ValueError(f"{path}: the file changed while it was read")
-    return p, sdf, digest, time.perf_counter() - t
+    return arrays, digest, time.perf_counter() - t
 
 
 def write_npz(path: str, arrays: dict[str, np.ndarray]) -> None:
@@ -170,9 +269,14 @@ def _mismatch(path: str, expected: dict[str, Any]) -> Optional[str]:
         return "its record is not JSON"
     if not isinstance(got, dict):
         return "its record is not a JSON object"
-    options = {"points": "--points", "near_surface": "--near-surface", "seed": "--seed"}
+    options = {"points": "--points", "near_surface": "--near-surface", "seed": "--seed",
+               "uniform": "--uniform", "outputs": "--outputs", "normalize": "--normalize"}
     diffs, had, has = [], [], []
-    for key, want in expected.items():
+    # A key the record has and this run would not write is an option this run leaves at its
+    # default; offset and scale are results of --normalize, not options.
+    keys = list(expected) + [k for k in got if k not in expected and k not in ("offset", "scale")]
+    for key in keys:
+        want = expected.get(key)
         have = got.get(key)
         if have == want:
             continue
@@ -243,6 +347,65 @@ def _sigma(value: str) -> float:
     return x
 
 
+def _levels(value: str) -> list[tuple[float, Optional[float]]]:
+    """SIGMA or SIGMA:SHARE, comma-separated; every level gives a share or none does."""
+    levels: list[tuple[float, Optional[float]]] = []
+    for part in value.split(","):
+        sigma, _, share = part.strip().partition(":")
+        w = None
+        if share:
+            try:
+                w = float(share)
+            except ValueError:
+                w = float("nan")
+            if not 0 <= w <= 1:
+                raise argparse.ArgumentTypeError(
+                    f"a share must be a number from 0 to 1, not {share!r} in {value!r}")
+        levels.append((_sigma(sigma), w))
+    if len({w is None for _, w in levels}) > 1:
+        raise argparse.ArgumentTypeError(
+            f"give a share to every level or to none, not to some: {value!r}")
+    return levels
+
+
+def _share(value: str) -> float:
+    try:
+        x = float(value)
+    except ValueError:
+        x = float("nan")
+    if not 0 <= x <= 1:
+        raise argparse.ArgumentTypeError(f"must be a number from 0 to 1, not {value!r}")
+    return x
+
+
+def _outputs(value: str) -> tuple[str, ...]:
+    names = tuple(o.strip() for o in value.split(",") if o.strip())
+    wrong = [o for o in names if o not in _OUTPUTS]
+    if wrong:
+        raise argparse.ArgumentTypeError(
+            f"unknown output {wrong[0]!r}; choose from {', '.join(_OUTPUTS)}")
+    return names
+
+
+def _recipe(ap: argparse.ArgumentParser, args: argparse.Namespace) -> Recipe:
+    """The recipe of the options, with the shares checked to sum to 1."""
+    levels = args.near_surface
+    if levels[0][1] is None:  # no shares: the near part split evenly
+        uniform = 0.5 if args.uniform is None else args.uniform
+        near = [(sig, (1 - uniform) / len(levels)) for sig, _ in levels]
+    else:
+        near = [(sig, float(w)) for sig, w in levels]
+        named = sum(w for _, w in near)
+        uniform = 1 - named if args.uniform is None else args.uniform
+        if uniform < -1e-9 or abs(uniform + named - 1) > 1e-9:
+            ap.error(f"--near-surface shares ({named:g}) and --uniform ({uniform:g}) must sum "
+                     "to 1")
+        uniform = max(0.0, uniform)
+    if uniform < 1 and sum(w for _, w in near) <= 0:
+        ap.error("--near-surface: the shares are all 0 but --uniform leaves points to place")
+    return Recipe(near=near, uniform=uniform, outputs=args.outputs, normalize=args.normalize)
+
+
 class _Stop(Exception):
     """A write that the output folder refuses as a whole."""
 
@@ -275,8 +438,17 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--out", required=True, metavar="DIR", help="folder for the .npz files")
     ap.add_argument("--points", required=True, type=_positive_int, metavar="N",
                     help="samples per mesh")
-    ap.add_argument("--near-surface", type=_sigma, default=0.01, metavar="SIGMA",
-                    help="noise of the near-surface half, times the box diagonal, 0 to 1 (0.01)")
+    ap.add_argument("--near-surface", type=_levels, default=[(0.01, None)],
+                    metavar="SIGMA[:SHARE],...",
+                    help="noise of the near-surface points, times the box diagonal, 0 to 1; "
+                    "several levels with their shares of N, e.g. 0.005:0.4,0.05:0.1 (0.01)")
+    ap.add_argument("--uniform", type=_share, default=None, metavar="U",
+                    help="share of N uniform in the box (0.5, or what the shares leave)")
+    ap.add_argument("--outputs", type=_outputs, default=(), metavar="NAME,...",
+                    help="also write occupancy, normals and/or closest (none)")
+    ap.add_argument("--normalize", choices=_NORMALIZE, default="none",
+                    help="map the mesh into the unit sphere or the cube [-1/2, 1/2]^3 first "
+                    "(none)")
     ap.add_argument("--scheduler", type=_scheduler, default=None,
                     help="local:K (K worker processes) or a Dask scheduler's address")
     ap.add_argument("--seed", type=_seed, default=0, help="random seed, >= 0 (0)")
@@ -285,10 +457,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     args = ap.parse_args(argv)
     if not os.path.isdir(args.mesh_dir):
         ap.error(f"MESH_DIR: {args.mesh_dir!r} is not a folder")
+    recipe = _recipe(ap, args)
     _prepare_out(ap, args.out)
 
     def expected(file: str, digest: str) -> dict[str, Any]:
-        return json.loads(record(file, digest, args.points, args.near_surface, args.seed))
+        return json.loads(record(file, digest, args.points, None, args.seed, recipe))
 
     failed = 0
     todo: list[tuple[str, str]] = []
@@ -339,11 +512,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             print(f"[{done}/{total}] FAILED {file}: {type(error).__name__}: {error}",
                   file=sys.stderr, flush=True)
             return
-        p, sdf, digest, seconds = result
-        meta = record(file, digest, args.points, args.near_surface, args.seed)
+        arrays, digest, seconds = result
+        transform = (arrays["offset"], arrays["scale"]) if "offset" in arrays else None
+        meta = record(file, digest, args.points, None, args.seed, recipe, transform)
+        p, sdf = arrays["points"], arrays["sdf"]
         try:
-            write_npz(os.path.join(args.out, name + ".npz"),
-                      {"points": p, "sdf": sdf, "meta": np.array(meta)})
+            write_npz(os.path.join(args.out, name + ".npz"), {**arrays, "meta": np.array(meta)})
         except OSError as e:
             failed += 1
             print(f"[{done}/{total}] FAILED {file}: cannot write {name}.npz: "
@@ -358,7 +532,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
     def job(file: str, name: str) -> tuple:
         path = os.path.abspath(os.path.join(args.mesh_dir, file))
-        return (path, name, args.points, args.near_surface, args.seed)
+        return (path, name, args.points, recipe, args.seed)
 
     start = time.perf_counter()
     try:
