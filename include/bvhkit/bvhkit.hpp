@@ -32,6 +32,7 @@
 #include "bvhkit/query/ray.hpp"
 #include "bvhkit/query/self_collision.hpp"
 #include "bvhkit/query/signed_distance.hpp"
+#include "bvhkit/query/crossings.hpp"
 #include "bvhkit/query/winding_number.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "bvhkit/version.hpp"

@@ -272,8 +272,28 @@ class TriangleMesh:
         return out
 
     def contains(self, points: _npt.ArrayLike, threads: int = 0) -> _np.ndarray:
-        """Whether each point is inside the mesh (winding number above 1/2): (k,) bool."""
-        return self.winding_number(points, threads=threads) > 0.5
+        """Whether each point is inside the mesh (winding number above 1/2): (k,) bool.
+
+        Where the mesh is a closed oriented surface (:attr:`is_closed`), the winding number is an
+        integer that one ray's signed crossings give exactly (one ray a point); where that ray
+        meets an edge or a vertex exactly, grazes a face or starts on the surface, and on other
+        meshes (holes, flipped or non-manifold pieces), the fast winding number decides, as
+        :meth:`winding_number` with its default ``beta``. Points with a NaN or infinite
+        coordinate are outside.
+        """
+        p = self._points(points)
+        n = _a.threads(threads)
+        out = _np.empty(len(p), _np.bool_)
+        self._impl.contains(p, out, n)
+        return out
+
+    @property
+    def is_closed(self) -> bool:
+        """Whether :meth:`contains` decides by ray crossings: after welding corners at equal
+        positions, every edge of the faces in the tree is used as often in one direction as in
+        the other (a closed oriented surface: no holes, nothing open), and the ray test is the
+        watertight one. Found on first use (one sort of the edges) and after a refit."""
+        return bool(self._impl.is_closed())
 
     # ------------------------------------------------------------------ changes and measures
 

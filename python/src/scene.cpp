@@ -29,6 +29,8 @@
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/io/winding_number_mesh_file.hpp"
+#include "bvhkit/primitives/weld.hpp"
+#include "bvhkit/query/crossings.hpp"
 #include "bvhkit/query/point_order.hpp"
 #include "bvhkit/query/signed_distance.hpp"
 #include "bvhkit/query/winding_number.hpp"
@@ -217,8 +219,11 @@ class Scene {
         MeshPoint<T> previous;
     };
     /// Calls per_point(i, p, scratch) for each point, on `threads` threads, without the GIL.
+    /// Which point queries need the winding number tree: inside() on a closed surface asks the
+    /// ray tree instead.
+    enum class WindingTree { not_needed, needed, unless_closed };
     template <class PerPoint>
-    void points(const Rows<T, 3>& pts, unsigned threads, bool need_sdf, bool need_winding,
+    void points(const Rows<T, 3>& pts, unsigned threads, bool need_sdf, WindingTree need_winding,
                 PerPoint&& per_point) const {
         const T* p = pts.data();
         const std::size_t k = pts.shape(0);
@@ -245,26 +250,27 @@ class Scene {
         expect_rows(barycentric, k, "barycentric");
         T *dp = distance.data(), *cp = closest.data(), *bp = barycentric.data();
         std::int64_t* fp = face.data();
-        points(pts, threads, true, false, [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
-            // The limit itself, in double, not its square in T (inf past 1.8e19 in float32).
-            const MeshPoint<T> c = scratch.previous =
-                sdf_->closest_point_mesh().closest_point_within(p, max_distance, scratch.previous,
-                                                                scratch.nearest);
-            const T nan = std::numeric_limits<T>::quiet_NaN();
-            dp[i] = c ? c.distance : std::numeric_limits<T>::infinity();
-            for (int a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;
-            fp[i] = c ? std::int64_t(c.triangle) : -1;
-            bp[3 * i] = c ? T(1) - c.u - c.v : T(0);
-            bp[3 * i + 1] = c.u;
-            bp[3 * i + 2] = c.v;
-        });
+        points(pts, threads, true, WindingTree::not_needed,
+               [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
+                   // The limit itself, in double, not its square in T (inf past 1.8e19 in float32).
+                   const MeshPoint<T> c = scratch.previous =
+                       sdf_->closest_point_mesh().closest_point_within(
+                           p, max_distance, scratch.previous, scratch.nearest);
+                   const T nan = std::numeric_limits<T>::quiet_NaN();
+                   dp[i] = c ? c.distance : std::numeric_limits<T>::infinity();
+                   for (int a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;
+                   fp[i] = c ? std::int64_t(c.triangle) : -1;
+                   bp[3 * i] = c ? T(1) - c.u - c.v : T(0);
+                   bp[3 * i + 1] = c.u;
+                   bp[3 * i + 2] = c.v;
+               });
     }
     void signed_distance(const Rows<T, 3>& pts, const std::string& sign, OutColumn<T> out,
                          unsigned threads) const {
         expect_rows(out, pts.shape(0), "out");
         T* op = out.data();
         if (sign == "pseudonormal") {
-            points(pts, threads, true, false,
+            points(pts, threads, true, WindingTree::not_needed,
                    [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
                        const SignedDistance<T> r =
                            sdf_->signed_distance(p, scratch.previous, scratch.nearest);
@@ -272,12 +278,15 @@ class Scene {
                        op[i] = r.distance;
                    });
         } else if (sign == "winding_number") {
-            points(pts, threads, true, true, [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
-                const MeshPoint<T> c = scratch.previous =
-                    sdf_->closest_point_mesh().closest_point(p, scratch.previous, scratch.nearest);
-                const T d = c ? c.distance : std::numeric_limits<T>::infinity();
-                op[i] = winding_->inside(p) ? -d : d;
-            });
+            // On a closed surface the sign is contains()'s: one ray's crossings.
+            points(pts, threads, true, WindingTree::unless_closed,
+                   [&](std::size_t i, const Vec<T, 3>& p, auto& scratch) {
+                       const MeshPoint<T> c = scratch.previous =
+                           sdf_->closest_point_mesh().closest_point(p, scratch.previous,
+                                                                    scratch.nearest);
+                       const T d = c ? c.distance : std::numeric_limits<T>::infinity();
+                       op[i] = inside(p) ? -d : d;
+                   });
         } else {
             throw Error("sign: '" + sign + "' is not one of 'pseudonormal', 'winding_number'");
         }
@@ -286,9 +295,28 @@ class Scene {
                         unsigned threads) const {
         expect_rows(out, pts.shape(0), "out");
         T* op = out.data();
-        points(pts, threads, false, true, [&](std::size_t i, const Vec<T, 3>& p, auto&) {
-            op[i] = exact ? winding_->exact(p) : winding_->fast(p, beta);
-        });
+        points(pts, threads, false, WindingTree::needed,
+               [&](std::size_t i, const Vec<T, 3>& p, auto&) {
+                   op[i] = exact ? winding_->exact(p) : winding_->fast(p, beta);
+               });
+    }
+
+    /// Whether each point is inside (winding number above 1/2). On a closed oriented surface
+    /// traced by the watertight test (is_closed()), one ray's signed crossings give the winding
+    /// number (query/crossings.hpp); where they cannot decide, and on other meshes, the fast
+    /// winding number does.
+    void contains(const Rows<T, 3>& pts, OutColumn<bool> out, unsigned threads) const {
+        expect_rows(out, pts.shape(0), "out");
+        bool* op = out.data();
+        points(pts, threads, false, WindingTree::unless_closed,
+               [&](std::size_t i, const Vec<T, 3>& p, auto&) { op[i] = inside(p); });
+    }
+    /// Whether contains() decides by ray crossings: the faces of the ray tree form a closed
+    /// oriented surface and its ray test is watertight.
+    bool is_closed() const {
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        const std::lock_guard<std::mutex> build_lock(build_mutex_);
+        return closed_surface();
     }
 
     void refit(const Rows<T, 3>& vertices) {
@@ -303,6 +331,7 @@ class Scene {
         // ray tree (prepare()).
         sdf_.reset();
         winding_.reset();
+        closed_.reset();  // welding is by position, which the refit changed
     }
 
     nb::dict stats() const {
@@ -410,8 +439,10 @@ class Scene {
 
     /// Builds what a query needs, once (the caller holds the shared lock; builders take this one),
     /// over the ray tree's faces: those it left out stay out even if a refit made them finite.
-    void prepare(bool need_sdf, bool need_winding) const {
+    void prepare(bool need_sdf, WindingTree winding) const {
         const std::lock_guard<std::mutex> lock(build_mutex_);
+        const bool need_winding = winding == WindingTree::needed ||
+                                  (winding == WindingTree::unless_closed && !closed_surface());
         if ((!need_sdf || sdf_) && (!need_winding || winding_)) return;
         const auto build = [&](const auto& mesh) {
             if (need_sdf && !sdf_) sdf_ = std::make_unique<SignedDistanceMesh<T>>(mesh, options_);
@@ -424,12 +455,34 @@ class Scene {
             build(LeftOut<T>(mesh_, rays_.skipped()));
     }
 
+    /// is_closed(), found once (the caller holds the shared lock and build_mutex_).
+    bool closed_surface() const {
+        if (!closed_)
+            closed_ = rays_.triangle_test() == TriangleTest::Watertight &&
+                      is_closed_surface(mesh_, weld_vertices(mesh_),
+                                        std::vector<std::uint32_t>(rays_.skipped().begin(),
+                                                                   rays_.skipped().end()));
+        return *closed_;
+    }
+    /// Whether p is inside (winding number above 1/2): by ray crossings on a closed surface, by
+    /// the fast winding number where they cannot decide (rare, so its tree is built on the first
+    /// such point) and on other meshes (the caller has prepared the winding number tree then).
+    /// The caller holds the shared lock.
+    bool inside(const Vec<T, 3>& p) const {
+        if (*closed_) {  // set by prepare(), which points() called under this shared lock
+            if (const std::optional<int> w = crossing_winding_number(rays_, p)) return *w >= 1;
+            prepare(false, WindingTree::needed);
+        }
+        return winding_->inside(p);
+    }
+
     BasicTriangleMesh<T> mesh_;
     BuildOptions options_;
     TriangleBvh<T> rays_;
     bool spatial_splits_ = false;  // rays_ is the high-quality build (rebuilt on loading)
     mutable std::unique_ptr<SignedDistanceMesh<T>> sdf_;
     mutable std::unique_ptr<WindingNumberMesh<T>> winding_;
+    mutable std::optional<bool> closed_;
     mutable std::shared_mutex mutex_;
     mutable std::mutex build_mutex_;
 };
@@ -469,6 +522,10 @@ void bind_scene_type(nb::module_& m, const char* name) {
         .def("winding_number", &S::winding_number, nb::arg("points"), nb::arg("exact"),
              nb::arg("beta"), nb::arg("out"), nb::arg("threads"),
              "Generalized winding number of each point.")
+        .def("contains", &S::contains, nb::arg("points"), nb::arg("out"), nb::arg("threads"),
+             "Whether each point is inside (winding number above 1/2).")
+        .def("is_closed", &S::is_closed,
+             "Whether contains() decides by ray crossings (a closed oriented surface).")
         .def("refit", &S::refit, nb::arg("vertices"), "New vertex positions, same faces.")
         .def("stats", &S::stats, "Tree statistics of the ray tree.")
         .def("skipped", &S::skipped, "Faces left out for non-finite coordinates.")

@@ -20,6 +20,7 @@
 #include <span>
 #include <string>
 
+#include "bvhkit/primitives/weld.hpp"
 #include "bvhkit/query/closest_point_mesh.hpp"
 
 namespace bvhkit {
@@ -41,29 +42,8 @@ class SignedDistanceMesh {
     explicit SignedDistanceMesh(const M& mesh, const BuildOptions& options = {})
         : closest_(mesh, options) {
         const std::size_t nt = mesh.triangle_count();
-        // Weld corners by exact position: sort vertex ids by coordinates, give equal ones one id.
-        std::vector<std::uint32_t> by_position(mesh.vertex_count());
-        for (std::uint32_t i = 0; i < by_position.size(); ++i) by_position[i] = i;
-        // The key orders coordinates totally, NaN included (a NaN under operator< would make the
-        // sort undefined): IEEE bits made monotonic, -0 as +0, every NaN as one value.
-        const auto ordered = [](double x) {
-            if (std::isnan(x)) return std::numeric_limits<std::uint64_t>::max();
-            const auto b = std::bit_cast<std::uint64_t>(x == 0 ? 0.0 : x);
-            return (b >> 63) ? ~b : b | (std::uint64_t(1) << 63);
-        };
-        const auto key = [&](std::uint32_t i) {
-            const auto v = mesh.vertex(i);
-            return std::array<std::uint64_t, 3>{ordered(double(v[0])), ordered(double(v[1])),
-                                                ordered(double(v[2]))};
-        };
-        std::sort(by_position.begin(), by_position.end(),
-                  [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
-        std::vector<std::uint32_t> weld(mesh.vertex_count());
-        std::uint32_t ids = 0;
-        for (std::size_t k = 0; k < by_position.size(); ++k) {
-            if (k > 0 && key(by_position[k]) != key(by_position[k - 1])) ++ids;
-            weld[by_position[k]] = ids;
-        }
+        const std::vector<std::uint32_t> weld = weld_vertices(mesh);
+        const std::uint32_t ids = weld.empty() ? 0 : *std::max_element(weld.begin(), weld.end());
         vertex_normals_.assign((mesh.vertex_count() == 0) ? 0 : ids + 1, Vec<T, 3>{});
         face_normals_.resize(nt);
         corners_.resize(nt);
