@@ -163,6 +163,22 @@ class TriangleMesh:
         Returns :class:`RayHits` ``(t, face, barycentric)``: t = inf and face = -1 on a miss.
         Directions need not be unit length (t is in units of the direction given).
         """
+        dtype = self.dtype
+        if (
+            type(origins) is _np.ndarray and type(directions) is _np.ndarray
+            and origins.dtype is dtype and directions.dtype is dtype and origins.ndim == 2
+            and origins.shape[1] == 3 and directions.shape == origins.shape
+            and type(tmin) is float and type(tmax) is float
+            and type(threads) is int and 0 <= threads <= _a.THREADS_MAX
+        ):
+            # The one-ray call's usual arguments: one [tmin, tmax] for all, no array made for it
+            # (the C++ call converts a non-contiguous array as the general path would).
+            k = len(origins)
+            t = _np.empty(k, dtype)
+            face = _np.empty(k, _np.int64)
+            bary = _np.empty((k, 3), dtype)
+            self._impl.intersect_shared(origins, directions, tmin, tmax, t, face, bary, threads)
+            return RayHits(t, face, bary)
         o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
         k = len(o)
         t = _np.empty(k, self.dtype)

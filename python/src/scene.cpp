@@ -140,14 +140,31 @@ class Scene {
     /// Calls per_chunk(first, rays) for runs of up to ray_chunk rays, rays[j] the batch's ray
     /// first + j: the tree's stream calls walk several at once (query/ray_stream.hpp).
     static constexpr std::size_t ray_chunk = 256;
+    /// The rays' [tmin, tmax]: one array each, or one pair for every ray (the one-ray calls'
+    /// usual form, which then converts no array for them).
+    struct PerRayLimits {
+        const T *t0, *t1;
+        T tmin(std::size_t i) const { return t0[i]; }
+        T tmax(std::size_t i) const { return t1[i]; }
+    };
+    struct SharedLimits {
+        T t0, t1;
+        T tmin(std::size_t) const { return t0; }
+        T tmax(std::size_t) const { return t1; }
+    };
     template <class PerChunk>
     void ray_chunks(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
                     const Column<T>& tmax, unsigned threads, PerChunk&& per_chunk) const {
+        expect_rows(tmin, origins.shape(0), "tmin");
+        expect_rows(tmax, origins.shape(0), "tmax");
+        ray_chunks(origins, directions, PerRayLimits{tmin.data(), tmax.data()}, threads, per_chunk);
+    }
+    template <class Limits, class PerChunk>
+    void ray_chunks(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Limits& limits,
+                    unsigned threads, PerChunk&& per_chunk) const {
         const std::size_t k = origins.shape(0);
         expect_rows(directions, k, "directions");
-        expect_rows(tmin, k, "tmin");
-        expect_rows(tmax, k, "tmax");
-        const T *o = origins.data(), *d = directions.data(), *t0 = tmin.data(), *t1 = tmax.data();
+        const T *o = origins.data(), *d = directions.data();
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock(mutex_);
         run_batch(k, 1024, threads, [&](std::size_t b, std::size_t e) {
@@ -156,7 +173,7 @@ class Scene {
                 const std::size_t n = std::min(ray_chunk, e - first);
                 for (std::size_t j = 0; j < n; ++j) {
                     const std::size_t i = first + j;
-                    chunk[j] = Ray3(row(o, i), row(d, i), t0[i], t1[i]);
+                    chunk[j] = Ray3(row(o, i), row(d, i), limits.tmin(i), limits.tmax(i));
                 }
                 per_chunk(first, std::span<const Ray3>(chunk, n));
             }
@@ -166,12 +183,28 @@ class Scene {
     void intersect(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
                    const Column<T>& tmax, OutColumn<T> t, OutColumn<std::int64_t> face,
                    OutRows<T, 3> barycentric, unsigned threads) const {
+        expect_rows(tmin, origins.shape(0), "tmin");
+        expect_rows(tmax, origins.shape(0), "tmax");
+        intersect_within(origins, directions, PerRayLimits{tmin.data(), tmax.data()}, t, face,
+                         barycentric, threads);
+    }
+    /// intersect with one [tmin, tmax] for every ray.
+    void intersect_shared(const Rows<T, 3>& origins, const Rows<T, 3>& directions, T tmin, T tmax,
+                          OutColumn<T> t, OutColumn<std::int64_t> face, OutRows<T, 3> barycentric,
+                          unsigned threads) const {
+        intersect_within(origins, directions, SharedLimits{tmin, tmax}, t, face, barycentric,
+                         threads);
+    }
+    template <class Limits>
+    void intersect_within(const Rows<T, 3>& origins, const Rows<T, 3>& directions,
+                          const Limits& limits, OutColumn<T> t, OutColumn<std::int64_t> face,
+                          OutRows<T, 3> barycentric, unsigned threads) const {
         expect_rows(t, origins.shape(0), "t");
         expect_rows(face, origins.shape(0), "face");
         expect_rows(barycentric, origins.shape(0), "barycentric");
         T *tp = t.data(), *bp = barycentric.data();
         std::int64_t* fp = face.data();
-        ray_chunks(origins, directions, tmin, tmax, threads,
+        ray_chunks(origins, directions, limits, threads,
                    [&](std::size_t first, std::span<const Ray3> chunk) {
                        Hit<T> hits[ray_chunk];
                        rays_.trace_stream(chunk, std::span<Hit<T>>(hits, chunk.size()));
@@ -219,6 +252,8 @@ class Scene {
         MeshPoint<T> previous;
     };
     /// Calls per_point(i, p, scratch) for each point, on `threads` threads, without the GIL.
+    /// Batches of up to this many points run on the calling thread (see points()).
+    static constexpr std::size_t small_batch = 8;
     /// Which point queries need the winding number tree: inside() on a closed surface asks the
     /// ray tree instead.
     enum class WindingTree { not_needed, needed, unless_closed };
@@ -230,6 +265,15 @@ class Scene {
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock(mutex_);
         prepare(need_sdf, need_winding);
+        if (k <= small_batch) {
+            // A few points (a planner's one-point calls): no order to find, no batch to spread,
+            // and the calling thread's scratch, whose heap has grown already. The previous
+            // closest point is another call's (maybe another mesh's): never a start.
+            thread_local PointScratch scratch;
+            scratch.previous = {};
+            for (std::size_t i = 0; i < k; ++i) per_point(i, row(p, i), scratch);
+            return;
+        }
         // A large batch is answered in spatial order (bvhkit/query/point_order.hpp): neighbours
         // find the tree's nodes in cache. Each point's answer is its own, whatever the order.
         const std::vector<std::uint32_t> order = batch_order(
@@ -508,6 +552,10 @@ void bind_scene_type(nb::module_& m, const char* name) {
         .def("intersect", &S::intersect, nb::arg("origins"), nb::arg("directions"), nb::arg("tmin"),
              nb::arg("tmax"), nb::arg("t"), nb::arg("face"), nb::arg("barycentric"),
              nb::arg("threads"), "Closest hit of each ray into the output arrays.")
+        .def("intersect_shared", &S::intersect_shared, nb::arg("origins"), nb::arg("directions"),
+             nb::arg("tmin"), nb::arg("tmax"), nb::arg("t"), nb::arg("face"),
+             nb::arg("barycentric"), nb::arg("threads"),
+             "intersect with one [tmin, tmax] for every ray.")
         .def("occluded", &S::occluded, nb::arg("origins"), nb::arg("directions"), nb::arg("tmin"),
              nb::arg("tmax"), nb::arg("out"), nb::arg("threads"),
              "Whether each ray hits anything within [tmin, tmax].")

@@ -277,3 +277,25 @@ def test_float64_rays_at_extreme_scales(scale):
     both = clean & hit
     np.testing.assert_allclose(hits.t[both], best[both], rtol=1e-9)
     np.testing.assert_array_equal(scene.occluded(o * scale, d * scale)[clean], hit[clean])
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_shared_limits_answer_as_per_ray_limits(dtype):
+    """The one-[tmin, tmax]-for-all path (float limits, arrays of the mesh's dtype) gives the
+    bits of the per-ray path (array limits), and either spelling of the arguments reaches one."""
+    rng = np.random.default_rng(8)
+    v, f = random_soup(rng, 200)
+    scene = bvhkit.TriangleMesh(v, f, dtype=dtype)
+    o, d = (a.astype(dtype) for a in random_rays(rng, 3000))
+    for tmin, tmax in ((0.0, np.inf), (0.5, 2.0), (np.nan, 3.0), (1.0, 0.5)):
+        shared = scene.intersect(o, d, tmin=tmin, tmax=tmax)
+        k = len(o)
+        per_ray = scene.intersect(o, d, tmin=np.full(k, tmin), tmax=np.full(k, tmax))
+        for a, b in zip(shared, per_ray):
+            np.testing.assert_array_equal(a, b)
+        # One ray at a time, non-contiguous rows, and float64 rays for a float32 mesh alike.
+        for i in range(0, k, 500):
+            one = scene.intersect(o[i : i + 1], d[i : i + 1], tmin=tmin, tmax=tmax)
+            assert one.face[0] == shared.face[i] and np.array_equal(one.t[:1], shared.t[i : i + 1])
+        strided = scene.intersect(np.asfortranarray(o), d[:, :], tmin=tmin, tmax=tmax)
+        np.testing.assert_array_equal(strided.t, shared.t)
