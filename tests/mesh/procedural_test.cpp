@@ -12,6 +12,7 @@
 
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/mesh/procedural.hpp"
+#include "bvhkit/triangle_bvh.hpp"
 #include "test_support.hpp"
 
 using namespace bvhkit;
@@ -171,14 +172,17 @@ TEST(Soup, HasTheRequestedCountInsideTheUnitCube) {
 }
 
 TEST(Procedural, IsDeterministicAndSeedDependent) {
-    for (const char* spec : {"sphere:subdiv=3,displacement=0.2,seed=3", "terrain:n=16,seed=4",
-                             "room:objects=10,seed=5", "soup:n=100,seed=6", "torus:u=8,v=5"}) {
+    for (const char* spec :
+         {"sphere:subdiv=3,displacement=0.2,seed=3", "terrain:n=16,seed=4",
+          "room:objects=10,seed=5", "soup:n=100,seed=6", "torus:u=8,v=5", "city:blocks=2,seed=7"}) {
         const TriangleMesh a = make_procedural(spec), b = make_procedural(spec);
         EXPECT_EQ(a.vertices, b.vertices) << spec;
         EXPECT_EQ(a.triangles, b.triangles) << spec;
     }
     EXPECT_NE(make_procedural("soup:n=100,seed=6").vertices,
               make_procedural("soup:n=100,seed=7").vertices);
+    EXPECT_NE(make_procedural("city:blocks=2,seed=1").vertices,
+              make_procedural("city:blocks=2,seed=2").vertices);
     EXPECT_NE(make_procedural("terrain:n=16,seed=1").vertices,
               make_procedural("terrain:n=16,seed=2").vertices);
     EXPECT_NE(make_procedural("sphere:subdiv=2,displacement=0.1,seed=1").vertices,
@@ -193,6 +197,8 @@ TEST(Procedural, SpecsSelectTheGeneratorAndItsParameters) {
     EXPECT_EQ(make_procedural("torus").triangle_count(), 2u * 96 * 48);
     EXPECT_EQ(make_procedural("soup:n=1234,seed=7").triangle_count(), 1234u);
     EXPECT_EQ(make_procedural("room:objects=0").triangle_count(), 768u);
+    EXPECT_EQ(make_procedural("city").triangle_count(), make_city(8, 1).triangle_count());
+    EXPECT_EQ(make_procedural("city:blocks=3,seed=4").vertices, make_city(3, 4).vertices);
     EXPECT_EQ(make_procedural("room:objects=200").triangle_count(),
               make_room(200, 1).triangle_count());
 }
@@ -220,6 +226,9 @@ TEST(Procedural, BadSpecsAreErrorsListingWhatIsValid) {
                              "soup:n=100000000",
                              "room:objects=1e3",
                              "room:seed=1,",
+                             "city:blocks=0",
+                             "city:blocks=41",
+                             "city:n=3",
                              "torus:seed=1"}) {
         EXPECT_THROW(make_procedural(spec), Error) << spec;
     }
@@ -227,7 +236,7 @@ TEST(Procedural, BadSpecsAreErrorsListingWhatIsValid) {
         make_procedural("cube:n=3");
         FAIL();
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("sphere, torus, terrain, room, soup"),
+        EXPECT_NE(std::string(e.what()).find("sphere, torus, terrain, room, soup, city"),
                   std::string::npos)
             << e.what();
     }
@@ -287,3 +296,42 @@ TEST(Procedural, ReachesMillionsOfTrianglesWithTightMemory) {
 }
 
 }  // namespace
+
+TEST(Procedural, CityTrianglesSpanFourOrdersOfMagnitudeAndFaceOutwards) {
+    const TriangleMesh city = make_city(3, 2);
+    double smallest = 1e30, largest = 0;
+    for (const auto& t : city.triangles) {
+        const Vec3d a(city.vertices[t[0]]), b(city.vertices[t[1]]), c(city.vertices[t[2]]);
+        const Vec3d n = cross(b - a, c - a);
+        const double area = 0.5 * length(n);
+        ASSERT_GT(area, 0.0);
+        smallest = std::min(smallest, area);
+        largest = std::max(largest, area);
+        // Every face looks up or sideways, never down: the walls face away from their tower,
+        // the roofs, plinths and ground up.
+        ASSERT_GE(n[1], -1e-9 * length(n));
+    }
+    EXPECT_GT(largest / smallest, 1e4);
+    // The ground is the lowest thing and covers the blocks with their streets.
+    const Aabb3f box = city.bounds();
+    EXPECT_EQ(box.min[1], 0.0f);
+    EXPECT_EQ(box.min[0], -15.0f);
+    EXPECT_EQ(box.max[2], 3 * 75.0f + 15.0f);
+    // Rays from outside meet the front of whatever they hit first: from above, the roofs,
+    // plinths and ground; from the sides at 10 m up, the walls.
+    const TriangleBvh<float> tree(city);
+    int hits = 0;
+    for (int i = 0; i < 60; ++i)
+        for (int j = 0; j < 60; ++j) {
+            const float x = -10 + 235.0f * (i + 0.5f) / 60, z = -10 + 235.0f * (j + 0.5f) / 60;
+            for (const Ray3f& ray : {Ray3f({x, 1000, z}, {0.01f, -1, 0.02f}),
+                                     Ray3f({-100, 10, z}, {1, 0.001f, 0.0003f}),
+                                     Ray3f({x, 10, 400}, {0.0002f, 0.001f, -1})}) {
+                const Hit<float> h = tree.closest_hit(ray);
+                if (!h) continue;
+                ++hits;
+                ASSERT_LT(dot(h.normal, ray.direction), 0.0f) << x << " " << z;
+            }
+        }
+    EXPECT_GT(hits, 6000);  // every ray from above, most from the sides
+}

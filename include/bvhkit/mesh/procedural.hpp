@@ -47,6 +47,13 @@ TriangleMesh make_room(std::uint32_t object_count, std::uint64_t seed = 1);
 /// `triangle_count` unconnected triangles in the unit cube, sizes spread from 0.001 to 0.1.
 TriangleMesh make_soup(std::uint64_t triangle_count, std::uint64_t seed = 1);
 
+/// A city-like scene over [-15, 75 blocks + 15] in x and z, y up: a ground plane of two
+/// triangles, `blocks` x `blocks` blocks of 60 m (plinths between 15 m streets) holding towers of
+/// log-normal heights (4 to 400 m, some with setbacks), their walls cut into floors and bays of
+/// 1.5 m or 6 m. Triangle sizes range over four orders of magnitude. Towers and plinths have no
+/// bottom (they stand on the ground): an open surface facing outwards.
+TriangleMesh make_city(std::uint32_t blocks, std::uint64_t seed = 1);
+
 /// Generates the mesh a spec describes (see above).
 TriangleMesh make_procedural(std::string_view spec);
 /// True when the spec's kind (the text before any ':') is a generator's name.
