@@ -46,6 +46,10 @@ class InstanceId {
     std::string text() const { return proxy_.text(); }
     friend constexpr bool operator==(InstanceId, InstanceId) = default;
     friend constexpr auto operator<=>(InstanceId, InstanceId) = default;
+    template <class Os>
+    friend auto operator<<(Os& os, InstanceId id) -> decltype(os << std::string()) {
+        return os << id.text();
+    }
 
   private:
     ProxyId proxy_;
