@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <thread>
 #include <vector>
 
 #include "bvhkit/mesh/procedural.hpp"
@@ -160,6 +161,50 @@ TEST(Scene, WorldBoxesAreTheHullsExtent) {
     }
     scene.validate();
     EXPECT_LE(scene.bounds().max[0], 21.001f);
+}
+
+// The top level's best-first walk: boxes in increasing distance, a shrinking bound ends it, and a
+// walk started inside another's callback is independent of it.
+TEST(Scene, DynamicTreeQueryNearestIsBestFirst) {
+    SplitMix64 rng(3);
+    DynamicTree<float, 3> tree;
+    for (int i = 0; i < 200; ++i) {
+        const Vec3f c(float(rng.uniform(-50, 50)), float(rng.uniform(-50, 50)),
+                      float(rng.uniform(-50, 50)));
+        tree.create(Aabb<float, 3>(c - Vec3f(0.5f), c + Vec3f(0.5f)));
+    }
+    const Vec3f p(1, 2, 3);
+    std::vector<double> keys;
+    int nested_count = 0;
+    tree.query_nearest(p, [&](ProxyId id, double key) {
+        const Aabb<float, 3>& b = tree.box(id);
+        double expect = 0;
+        for (std::size_t a = 0; a < 3; ++a) {
+            const double g = std::max({double(b.min[a]) - p[a], double(p[a]) - b.max[a], 0.0});
+            expect += g * g;
+        }
+        EXPECT_DOUBLE_EQ(key, expect);
+        keys.push_back(key);
+        if (keys.size() == 3) {
+            tree.query_nearest(Vec3f(-40, 0, 0), [&](ProxyId, double) {
+                ++nested_count;
+                return INFINITY;
+            });
+        }
+        return INFINITY;
+    });
+    EXPECT_EQ(keys.size(), 200u);
+    EXPECT_EQ(nested_count, 200);
+    EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end()));
+    // A bound of the first box's distance squared plus 100 stops at the boxes within it.
+    std::size_t reported = 0;
+    tree.query_nearest(p, [&](ProxyId, double key) {
+        ++reported;
+        return keys[0] + 100.0 + 0 * key;
+    });
+    EXPECT_EQ(reported, std::size_t(std::upper_bound(keys.begin(), keys.end(), keys[0] + 100.0) -
+                                    keys.begin()));
+    EXPECT_THROW(tree.query_nearest(Vec3f(NAN, 0, 0), [](ProxyId, double) { return 0.0; }), Error);
 }
 
 /// A random scene: `count` instances of a few meshes scaled by `scale`, rotated at random and
@@ -393,6 +438,40 @@ TEST(SceneQueries, DoubleFarFromTheOrigin) {
     for (const Placement p : {Placement{1, 1e6}, Placement{1e-6, 1e5}, Placement{1e6, 1e6}}) {
         RandomScene<double> rs(p.scale, p.offset, 20, 21);
         check_queries(rs, 160, 100, 8);
+    }
+}
+
+// Const queries on many threads at once, on a scene whose bottom-level trees are not built yet
+// (the first queries build them, once): the answers are the serial ones.
+TEST(SceneQueries, ManyThreadsBuildTheTreesOnceAndAgree) {
+    RandomScene<float> rs(1, 0, 16, 31);
+    std::vector<Ray<float, 3>> rays;
+    std::vector<Vec3f> points;
+    SplitMix64 rng(2);
+    for (int i = 0; i < 200; ++i) {
+        const Vec3f o(float(rng.uniform(-6, 6)), float(rng.uniform(-6, 6)),
+                      float(rng.uniform(-6, 6)));
+        const Vec3d d = rng.unit_vector();
+        rays.push_back(Ray<float, 3>(o, Vec3f(float(d[0]), float(d[1]), float(d[2]))));
+        points.push_back(o);
+    }
+    std::vector<std::vector<SceneHit<float>>> hits(4, std::vector<SceneHit<float>>(rays.size()));
+    std::vector<std::vector<float>> distances(4, std::vector<float>(points.size()));
+    std::vector<std::thread> threads;
+    for (int k = 0; k < 4; ++k)
+        threads.emplace_back([&, k] {
+            closest_hits(rs.scene, std::span<const Ray<float, 3>>(rays), std::span(hits[k]));
+            for (std::size_t i = 0; i < points.size(); ++i)
+                distances[k][i] = closest_point(rs.scene, points[i]).distance;
+        });
+    for (auto& t : threads) t.join();
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const SceneHit<float> serial = closest_hit(rs.scene, rays[i]);
+        for (int k = 0; k < 4; ++k) {
+            EXPECT_EQ(hits[k][i].t, serial.t);
+            EXPECT_EQ(hits[k][i].face, serial.face);
+            EXPECT_EQ(distances[k][i], closest_point(rs.scene, points[i]).distance);
+        }
     }
 }
 

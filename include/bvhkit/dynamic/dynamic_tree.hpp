@@ -334,19 +334,31 @@ class DynamicTree {
             CastInput<T, N>{centre, translation, box.max * T(0.5) - box.min * T(0.5), max_fraction},
             callback, stats);
     }
-    /// Proxies best first from `p`: in increasing distance of their boxes, each whose tight box is
-    /// within the running bound (inclusive). callback(ProxyId, W box_distance_squared) -> W, the
-    /// new squared bound (kept when smaller; a negative value stops), with W =
+    /// Proxies best first from `p`: in increasing distance of their tight boxes, each while that
+    /// distance is within the running bound (inclusive). callback(ProxyId, W box_distance_squared)
+    /// -> W, the new squared bound (kept when smaller; a negative value stops), with W =
     /// NearestWalkScalar<T> (tree_nearest.hpp). For a caller that measures its own shapes (the
-    /// closest point over a scene). The walk's heap is one per thread and reused.
+    /// closest point over a scene).
     template <class F>
     void query_nearest(const VecT& p, F&& callback, QueryStats* stats = nullptr) const {
         using W = NearestWalkScalar<T>;
         dynamic_detail::check_not_nan(p, "p", "DynamicTree::query_nearest");
         const Guard guard(walks_);
-        thread_local std::vector<dynamic_detail::NearestEntry<W>> heap;
-        dynamic_detail::nearest_first(view(), p, std::numeric_limits<W>::infinity(), callback, heap,
-                                      stats);
+        // One heap per thread, kept between walks; a walk started from inside another's callback
+        // on the same thread gets its own.
+        thread_local std::vector<dynamic_detail::NearestEntry<W>> shared_heap;
+        thread_local bool shared_heap_busy = false;
+        std::vector<dynamic_detail::NearestEntry<W>> own_heap;
+        const bool nested = shared_heap_busy;
+        shared_heap_busy = true;
+        struct Release {
+            bool nested;
+            ~Release() {
+                if (!nested) shared_heap_busy = false;
+            }
+        } release{nested};
+        dynamic_detail::nearest_first(view(), p, std::numeric_limits<W>::infinity(), callback,
+                                      nested ? own_heap : shared_heap, stats);
     }
     /// Every pair (proxy of this tree, proxy of `other`) whose boxes overlap.
     /// callback(ProxyId mine, ProxyId theirs) -> bool, false stops.
