@@ -143,7 +143,7 @@ void check_spheres(double scale, double offset, std::uint64_t seed) {
                     m == T(0)
                         ? collides(geo.collision_model(), geo.collision_model(), rel)
                         : distance(geo.collision_model(), geo.collision_model(), rel).distance <= m;
-                EXPECT_EQ(reported, single) << "pair " << a << " " << b;
+                EXPECT_EQ(reported, single) << "pair " << a.text() << " " << b.text();
                 expected_count += single;
             }
         EXPECT_GT(sure, 400);

@@ -298,7 +298,7 @@ struct QueryChecker {
         EXPECT_EQ(scene.geometry_of(h.instance), h.geometry);
         const scene_test::RayCrossing c = scene_test::cross(ray, *tri, wob);
         ASSERT_NE(c.kind, scene_test::Crossing::Miss)
-            << "instance " << h.instance << " face " << h.face;
+            << "instance " << h.instance.text() << " face " << h.face;
         EXPECT_LE(std::fabs(LD(h.t) - c.t),
                   c.t_tolerance + 4 * std::numeric_limits<T>::epsilon() * c.t);
         if (any_sure) {
@@ -333,7 +333,7 @@ struct QueryChecker {
             bool found = false;
             for (const auto& h : all)
                 found = found || (h.instance == tri.instance && h.face == tri.face);
-            EXPECT_TRUE(found) << "all_hits left out instance " << tri.instance << " face "
+            EXPECT_TRUE(found) << "all_hits left out instance " << tri.instance.text() << " face "
                                << tri.face;
         }
         for (const auto& h : all) {
