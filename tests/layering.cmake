@@ -13,7 +13,7 @@
 #   5 build
 #   6 dynamic query
 #   7 triangle_bvh.hpp
-#   8 io mesh
+#   8 io mesh scene
 #   9 bvhkit.hpp
 cmake_policy(VERSION 3.25)  # a script has no project(): IN_LIST and the like need the policies set
 set(rank_error.hpp 0)
@@ -31,6 +31,7 @@ set(rank_query 6)
 set(rank_triangle_bvh.hpp 7)
 set(rank_io 8)
 set(rank_mesh 8)
+set(rank_scene 8)
 set(rank_bvhkit.hpp 9)
 # Includes across one layer that are allowed (the file or folder, then the folder it may include):
 # mesh loading reads mesh files through io (src/mesh/load_mesh.cpp). An entry that no include uses

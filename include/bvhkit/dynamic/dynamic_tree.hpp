@@ -7,7 +7,8 @@
 //   tree.move(id, new_box, displacement);                     // true when the tree had to change
 //   tree.find_pairs(pairs);                                   // overlapping pairs of the moved
 //   tree.query(box, [](ProxyId id) { return true; });         // also query_point, ray_cast,
-//   tree.destroy(id);                                         // box_cast, query_tree
+//   tree.destroy(id);                                         // box_cast, query_tree,
+//                                                             // query_nearest
 //
 // Two layers. The tree below is a LinkedTree (bvh/linked_tree.hpp): leaves with a fat box and a
 // proxy id, inserted next to the sibling that raises the SAH cost least and rotated on the way up.
@@ -34,6 +35,7 @@
 #include "bvhkit/bvh/linked_tree.hpp"
 #include "bvhkit/dynamic/fat_box.hpp"
 #include "bvhkit/dynamic/small_stack.hpp"
+#include "bvhkit/dynamic/tree_nearest.hpp"
 #include "bvhkit/dynamic/tree_pairs.hpp"
 #include "bvhkit/dynamic/tree_queries.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
@@ -331,6 +333,32 @@ class DynamicTree {
             view(), dynamic_detail::Segment<T, N>(centre, translation),
             CastInput<T, N>{centre, translation, box.max * T(0.5) - box.min * T(0.5), max_fraction},
             callback, stats);
+    }
+    /// Proxies best first from `p`: in increasing distance of their tight boxes, each while that
+    /// distance is within the running bound (inclusive). callback(ProxyId, W box_distance_squared)
+    /// -> W, the new squared bound (kept when smaller; a negative value stops), with W =
+    /// NearestWalkScalar<T> (tree_nearest.hpp). For a caller that measures its own shapes (the
+    /// closest point over a scene).
+    template <class F>
+    void query_nearest(const VecT& p, F&& callback, QueryStats* stats = nullptr) const {
+        using W = NearestWalkScalar<T>;
+        dynamic_detail::check_not_nan(p, "p", "DynamicTree::query_nearest");
+        const Guard guard(walks_);
+        // One heap per thread, kept between walks; a walk started from inside another's callback
+        // on the same thread gets its own.
+        thread_local std::vector<dynamic_detail::NearestEntry<W>> shared_heap;
+        thread_local bool shared_heap_busy = false;
+        std::vector<dynamic_detail::NearestEntry<W>> own_heap;
+        const bool nested = shared_heap_busy;
+        shared_heap_busy = true;
+        struct Release {
+            bool nested;
+            ~Release() {
+                if (!nested) shared_heap_busy = false;
+            }
+        } release{nested};
+        dynamic_detail::nearest_first(view(), p, std::numeric_limits<W>::infinity(), callback,
+                                      nested ? own_heap : shared_heap, stats);
     }
     /// Every pair (proxy of this tree, proxy of `other`) whose boxes overlap.
     /// callback(ProxyId mine, ProxyId theirs) -> bool, false stops.

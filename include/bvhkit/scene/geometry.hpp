@@ -1,0 +1,207 @@
+#pragma once
+// SceneGeometry<T>: one triangle mesh of a Scene (scene.hpp), shared by every instance of it. It
+// keeps a copy of the mesh, the vertices of the mesh's convex hull (computed once, for the
+// instances' world boxes) and the bottom-level trees, each built the first time a query family
+// needs it: a TriangleBvh for rays, a ClosestPointMesh for closest points, a CollisionModel for
+// collision. The lazy builds are guarded by std::call_once, so const queries on many threads may
+// trigger them at once; prepare() builds all three up front.
+//
+// World boxes: an instance's box is the box of its hull vertices under its pose, x' = R x + t
+// taken in the wider type W (double for float, long double for double) and rounded outward, then
+// padded by pose_pad() for the rounding of the queries' transforms. The hull's extent along each
+// axis is the geometry's (a linear map's extreme over a convex set is at a vertex), so a rotated
+// instance gets the tightest box there is, not the box of its rotated local box.
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "bvhkit/math/transform.hpp"
+#include "bvhkit/primitives/closest_point.hpp"
+#include "bvhkit/primitives/triangle_mesh.hpp"
+#include "bvhkit/query/closest_point_mesh.hpp"
+#include "bvhkit/query/collision_model.hpp"
+#include "bvhkit/triangle_bvh.hpp"
+#include "bvhkit/volumes/aabb_volume.hpp"
+#include "bvhkit/volumes/convex_hull.hpp"
+
+namespace bvhkit {
+
+namespace scene_detail {
+
+/// x rounded to T toward -inf (down) or +inf (up).
+template <class T, class W>
+T round_down(W x) {
+    T r = T(x);
+    if (W(r) > x) r = std::nextafter(r, -std::numeric_limits<T>::infinity());
+    return r;
+}
+template <class T, class W>
+T round_up(W x) {
+    T r = T(x);
+    if (W(r) < x) r = std::nextafter(r, std::numeric_limits<T>::infinity());
+    return r;
+}
+
+/// R x + t in W.
+template <class W, class T>
+Vec<W, 3> apply_wide(const Transform<T>& pose, const Vec<T, 3>& x) {
+    Vec<W, 3> r;
+    for (std::size_t i = 0; i < 3; ++i)
+        r[i] = W(pose.rotation[i][0]) * W(x[0]) + W(pose.rotation[i][1]) * W(x[1]) +
+               W(pose.rotation[i][2]) * W(x[2]) + W(pose.translation[i]);
+    return r;
+}
+
+/// R^T (x - t) in W, rounded to T once: a world point in the instance's frame.
+template <class W, class T>
+Vec<T, 3> to_local_point(const Transform<T>& pose, const Vec<T, 3>& x) {
+    const W d[3] = {W(x[0]) - W(pose.translation[0]), W(x[1]) - W(pose.translation[1]),
+                    W(x[2]) - W(pose.translation[2])};
+    Vec<T, 3> r;
+    for (std::size_t j = 0; j < 3; ++j)
+        r[j] = T(W(pose.rotation[0][j]) * d[0] + W(pose.rotation[1][j]) * d[1] +
+                 W(pose.rotation[2][j]) * d[2]);
+    return r;
+}
+
+/// R^T v in W, rounded to T once: a world direction in the instance's frame.
+template <class W, class T>
+Vec<T, 3> to_local_vector(const Transform<T>& pose, const Vec<T, 3>& v) {
+    Vec<T, 3> r;
+    for (std::size_t j = 0; j < 3; ++j)
+        r[j] = T(W(pose.rotation[0][j]) * W(v[0]) + W(pose.rotation[1][j]) * W(v[1]) +
+                 W(pose.rotation[2][j]) * W(v[2]));
+    return r;
+}
+
+/// R v in W, rounded to T once.
+template <class W, class T>
+Vec<T, 3> to_world_vector(const Transform<T>& pose, const Vec<T, 3>& v) {
+    Vec<T, 3> r;
+    for (std::size_t i = 0; i < 3; ++i)
+        r[i] = T(W(pose.rotation[i][0]) * W(v[0]) + W(pose.rotation[i][1]) * W(v[1]) +
+                 W(pose.rotation[i][2]) * W(v[2]));
+    return r;
+}
+
+/// The pose of b in a's frame, inverse(a) * b, in W and rounded to T once: R_a^T R_b and
+/// R_a^T (t_b - t_a). Two instances far from the origin and near each other get a relative
+/// translation as exact as their own.
+template <class W, class T>
+Transform<T> relative_pose(const Transform<T>& a, const Transform<T>& b) {
+    Transform<T> r;
+    for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j)
+            r.rotation[i][j] = T(W(a.rotation[0][i]) * W(b.rotation[0][j]) +
+                                 W(a.rotation[1][i]) * W(b.rotation[1][j]) +
+                                 W(a.rotation[2][i]) * W(b.rotation[2][j]));
+    r.translation = to_local_point<W>(a, b.translation);
+    return r;
+}
+
+}  // namespace scene_detail
+
+template <class T>
+class SceneGeometry {
+  public:
+    using W = AccurateScalar<T>;
+
+    template <IndexedTriangleMesh M>
+    explicit SceneGeometry(const M& mesh) {
+        check_triangle_indices(mesh);
+        mesh_.vertices.resize(mesh.vertex_count());
+        for (std::size_t k = 0; k < mesh.vertex_count(); ++k)
+            mesh_.vertices[k] = Vec<T, 3>(mesh.vertex(k));
+        mesh_.triangles.resize(mesh.triangle_count());
+        for (std::size_t i = 0; i < mesh.triangle_count(); ++i) {
+            const auto& ids = mesh.triangle(i);
+            mesh_.triangles[i] = {std::uint32_t(ids[0]), std::uint32_t(ids[1]),
+                                  std::uint32_t(ids[2])};
+        }
+        // The hull of the vertices that some triangle uses: a stray vertex bounds nothing.
+        std::vector<Vec<T, 3>> used;
+        used.reserve(3 * mesh_.triangles.size());
+        for (const auto& tri : mesh_.triangles)
+            for (const std::uint32_t k : tri) used.push_back(mesh_.vertices[k]);
+        used = hull_detail::sorted_unique(std::move(used));
+        if (!used.empty())
+            for (const std::uint32_t k : quickhull_vertices<T>(used)) hull_.push_back(used[k]);
+        for (const Vec<T, 3>& v : hull_)
+            for (std::size_t a = 0; a < 3; ++a) extent_ = std::max(extent_, W(std::fabs(W(v[a]))));
+    }
+    SceneGeometry(const SceneGeometry&) = delete;
+    SceneGeometry& operator=(const SceneGeometry&) = delete;
+
+    const BasicTriangleMesh<T>& mesh() const { return mesh_; }
+    std::size_t triangle_count() const { return mesh_.triangles.size(); }
+    /// The hull's vertices (empty when no triangle has finite corners).
+    const std::vector<Vec<T, 3>>& hull_vertices() const { return hull_; }
+    bool has_extent() const { return !hull_.empty(); }
+
+    /// The box of the geometry under `pose`, `pad` added on every side: rounded outward, never
+    /// smaller than the exact extent of R x + t over the hull. A geometry without finite
+    /// triangles gets the point box at t.
+    Aabb<T, 3> world_box(const Transform<T>& pose, W pad) const {
+        if (hull_.empty()) return Aabb<T, 3>(pose.translation, pose.translation);
+        Vec<W, 3> lo(std::numeric_limits<W>::infinity()), hi(-std::numeric_limits<W>::infinity());
+        for (const Vec<T, 3>& v : hull_) {
+            const Vec<W, 3> w = scene_detail::apply_wide<W>(pose, v);
+            for (std::size_t a = 0; a < 3; ++a)
+                lo[a] = std::min(lo[a], w[a]), hi[a] = std::max(hi[a], w[a]);
+        }
+        Aabb<T, 3> box;
+        for (std::size_t a = 0; a < 3; ++a) {
+            box.min[a] = scene_detail::round_down<T>(lo[a] - pad);
+            box.max[a] = scene_detail::round_up<T>(hi[a] + pad);
+        }
+        return box;
+    }
+
+    /// The pad for a pose: what the queries' roundings can move a point of the geometry by. A
+    /// query moves the world ray or point into the geometry's frame with R^T, rounding each
+    /// coordinate to T once (at most eps/2 of |x| each), and R may be up to rigid_tolerance() from
+    /// a rotation (then R^T is not exactly its inverse: a point moves by up to that deviation
+    /// times its distance from t). Eight epsilons of the geometry's and the translation's largest
+    /// coordinate cover the roundings with room to spare.
+    W pose_pad(const Transform<T>& pose) const {
+        W scale = extent_;
+        for (std::size_t a = 0; a < 3; ++a)
+            scale = std::max(scale, W(std::fabs(W(pose.translation[a]))));
+        const W eps = W(std::numeric_limits<T>::epsilon());
+        return (W(8) * eps + W(rigid_deviation(pose.rotation))) * (scale + extent_);
+    }
+
+    const TriangleBvh<T>& ray_tree() const {
+        std::call_once(rays_once_, [&] { rays_ = std::make_unique<TriangleBvh<T>>(mesh_); });
+        return *rays_;
+    }
+    const ClosestPointMesh<T>& closest_point_tree() const {
+        std::call_once(points_once_,
+                       [&] { points_ = std::make_unique<ClosestPointMesh<T>>(mesh_); });
+        return *points_;
+    }
+    const CollisionModel<Aabb<T, 3>>& collision_model() const {
+        std::call_once(collision_once_,
+                       [&] { collision_ = std::make_unique<CollisionModel<Aabb<T, 3>>>(mesh_); });
+        return *collision_;
+    }
+    /// Builds the three trees now rather than at the first query of each family.
+    void prepare() const {
+        (void)ray_tree();
+        (void)closest_point_tree();
+        (void)collision_model();
+    }
+
+  private:
+    BasicTriangleMesh<T> mesh_;
+    std::vector<Vec<T, 3>> hull_;
+    W extent_ = 0;  // the hull's largest |coordinate|
+    mutable std::once_flag rays_once_, points_once_, collision_once_;
+    mutable std::unique_ptr<TriangleBvh<T>> rays_;
+    mutable std::unique_ptr<ClosestPointMesh<T>> points_;
+    mutable std::unique_ptr<CollisionModel<Aabb<T, 3>>> collision_;
+};
+
+}  // namespace bvhkit
