@@ -336,15 +336,19 @@ def _seed(value: str) -> int:
     return _int(value, 0)  # numpy's seed sequences take no negative numbers
 
 
-def _sigma(value: str) -> float:
+def _share(value: str) -> float:
+    """A number from 0 to 1: a share of N, or a noise level (noise beyond the box's diagonal is
+    no longer near the surface)."""
     try:
         x = float(value)
     except ValueError:
         x = float("nan")
-    # Noise beyond the box's diagonal is no longer near the surface.
     if not 0 <= x <= 1:
         raise argparse.ArgumentTypeError(f"must be a number from 0 to 1, not {value!r}")
     return x
+
+
+_sigma = _share
 
 
 def _levels(value: str) -> list[tuple[float, Optional[float]]]:
@@ -366,16 +370,6 @@ def _levels(value: str) -> list[tuple[float, Optional[float]]]:
         raise argparse.ArgumentTypeError(
             f"give a share to every level or to none, not to some: {value!r}")
     return levels
-
-
-def _share(value: str) -> float:
-    try:
-        x = float(value)
-    except ValueError:
-        x = float("nan")
-    if not 0 <= x <= 1:
-        raise argparse.ArgumentTypeError(f"must be a number from 0 to 1, not {value!r}")
-    return x
 
 
 def _outputs(value: str) -> tuple[str, ...]:
