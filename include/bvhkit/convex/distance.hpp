@@ -107,6 +107,9 @@ GjkRun<T> run_gjk(const ShapePair<T>& p) {
     r.simplex.add(w0, a0);
     Vec<T, 3> v = w0;
     const T rel = gjk_relative_tolerance<T>(), tol = p.abs_tolerance;
+    // Whether some support value has proved the origin outside D: v.w > 0 for w = the support
+    // along -v puts all of D on the far side of a plane through the origin.
+    bool separated = false;
     for (; r.iterations < gjk_max_iterations; ++r.iterations) {
         const T v2 = length_squared(v);
         if (v2 <= tol * tol) {
@@ -114,15 +117,23 @@ GjkRun<T> run_gjk(const ShapePair<T>& p) {
             break;
         }
         const auto [w, a] = p.support(-v);
-        const T gap = v2 - dot(v, w);  // |v| (|v| - lower bound)
+        const T vw = dot(v, w);
+        const T gap = v2 - vw;  // |v| (|v| - lower bound)
+        separated |= vw > tol * std::sqrt(v2);
         if (gap <= rel * v2 + tol * std::sqrt(v2) || r.simplex.holds(w)) break;
         const GjkSimplex<T> before = r.simplex;
         r.simplex.add(w, a);
         bool inside = false;
         const Vec<T, 3> next = r.simplex.nearest(inside);
         if (inside) {
-            r.overlap = true;
             ++r.iterations;
+            // A nearly flat tetrahedron (points of a flat face of D) can hold the origin by
+            // rounding alone; a proof of separation overrules it and keeps the last simplex.
+            if (separated) {
+                r.simplex = before;
+                break;
+            }
+            r.overlap = true;
             break;
         }
         if (!(length_squared(next) < v2)) {  // no progress: rounding; keep the better simplex
