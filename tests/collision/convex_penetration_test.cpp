@@ -18,7 +18,7 @@
 #include "bvhkit/convex/penetration.hpp"
 #include "test_support.hpp"
 
-namespace {
+namespace convex_penetration_test {
 
 using bvhkit::ConvexPolytope;
 using bvhkit::ConvexShape;
@@ -240,4 +240,4 @@ TEST(ConvexPenetration, FloatHullsSeparate) {
     }
 }
 
-}  // namespace
+}  // namespace convex_penetration_test

@@ -15,7 +15,7 @@
 #include "bvhkit/convex/penetration.hpp"
 #include "test_support.hpp"
 
-namespace {
+namespace convex_shapes_test {
 
 using bvhkit::BoxShape;
 using bvhkit::CapsuleShape;
@@ -287,6 +287,13 @@ TEST(ConvexShapes, AxisAlignedBoxBox) {
         if (std::fabs(expected) > 1e-9) {
             EXPECT_EQ(d.overlap, expected < 0);
         }
+        if (d.overlap) {
+            // The point reported for meeting shapes lies in both boxes.
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_LE(std::fabs(d.point_a[k] - pa.translation[k]), ha[k] + 1e-12) << i;
+                EXPECT_LE(std::fabs(d.point_a[k] - pb.translation[k]), hb[k] + 1e-12) << i;
+            }
+        }
     }
     EXPECT_GT(overlapping, 200);
     EXPECT_LT(overlapping, 1800);
@@ -356,7 +363,7 @@ TEST(ConvexShapes, CylinderAndConeAgainstSphere) {
             EXPECT_NEAR(rc.signed_distance, double(cyl - rs), 1e-9) << i;
         } else {
             // The centre inside: EPA on a curved set approximates its boundary by a polytope.
-            EXPECT_NEAR(rc.signed_distance, double(cyl - rs), 2e-3) << i;
+            EXPECT_NEAR(rc.signed_distance, double(cyl - rs), 1e-5 * double(rs - cyl)) << i;
             EXPECT_LE(rc.signed_distance, double(cyl - rs) + 1e-9) << i;  // an upper bound of depth
         }
         expect_consistent(rc, 1e-9);
@@ -494,4 +501,4 @@ TEST(ConvexShapes, FloatAnswers) {
     EXPECT_TRUE(d.overlap);
 }
 
-}  // namespace
+}  // namespace convex_shapes_test
