@@ -203,6 +203,22 @@ TEST(ConvexShapes, DegenerateHullsAreValidSets) {
     const auto crossing = bvhkit::convex_signed_distance(c1, Transformd{}, c1, across);
     EXPECT_NEAR(crossing.signed_distance, 0.0, 1e-15);
     EXPECT_NEAR(std::fabs(crossing.normal[0]), 1.0, 1e-12);
+    // Coincident shapes: two equal boxes at one pose leave by their smallest full extent; two
+    // points at one place touch (0); every answer has a unit normal.
+    std::mt19937_64 rng(3);
+    for (int i = 0; i < 20; ++i) {
+        const Transformd pose = random_pose(rng, 2);
+        const ConvexShape<double> box{BoxShape<double>(Vec3d{0.3, 0.7, 0.5})};
+        const auto same = bvhkit::convex_signed_distance(box, pose, box, pose);
+        EXPECT_NEAR(same.signed_distance, -0.6, 1e-12);
+        expect_consistent(same, 1e-12);
+        const ConvexShape<double> dot{SphereShape<double>(0)},
+            flat{BoxShape<double>(Vec3d{0, 0, 0})};
+        const auto points = bvhkit::convex_signed_distance(dot, pose, flat, pose);
+        EXPECT_EQ(points.signed_distance, 0.0);
+        expect_consistent(points, 1e-12);
+        EXPECT_TRUE(bvhkit::convex_distance(dot, pose, flat, pose).overlap);
+    }
 }
 
 TEST(ConvexShapes, SphereSphereExact) {

@@ -131,6 +131,8 @@ class Epa {
                 r.witness_a = face_witness(face);
             }
             if (upper - face.distance <= rel * std::fabs(upper) + tol) break;
+            // A support point the face holds already: the bounds have met to rounding.
+            if (s_.w[face.v[0]] == w || s_.w[face.v[1]] == w || s_.w[face.v[2]] == w) break;
             if (s_.vertex_count == epa_max_vertices || !expand(f, w, a)) {
                 r.converged = false;
                 break;
@@ -309,8 +311,6 @@ class Epa {
     /// Adds w (a point of D beyond face f) and replaces the faces it sees by a cone to the
     /// horizon. False when rounding broke the polytope (the horizon is not one loop).
     bool expand(std::uint16_t f, const Vec<T, 3>& w, const Vec<T, 3>& a) {
-        for (const std::uint16_t i : s_.faces[f].v)
-            if (s_.w[i] == w) return false;  // no new point: EPA cannot improve
         const std::uint32_t round = ++s_.round;
         std::size_t stack_size = 0, visible_count = 0, horizon_count = 0;
         s_.stack[stack_size++] = f;
