@@ -44,7 +44,8 @@ LD dotted(const PointL& a, const PointL& b) {
 /// brute force.
 struct ReferencePolytope {
     std::vector<PointL> points;
-    std::vector<PointL> normals;
+    std::vector<PointL> normals;  // outward, unit
+    std::vector<LD> offsets;      // normal . x <= offset on the polytope
     std::vector<PointL> edges;
 };
 
@@ -73,13 +74,28 @@ ReferencePolytope reference(const std::vector<Vec3d>& local, const Transformd& p
                     below |= side < 0;
                 }
                 if (above && below) continue;
-                r.normals.push_back(normal);
+                const LD len = std::sqrt(dotted(normal, normal));
+                const LD sign = above ? -1 : 1;
+                const PointL unit{
+                    {normal.v[0] * sign / len, normal.v[1] * sign / len, normal.v[2] * sign / len}};
+                r.normals.push_back(unit);
+                r.offsets.push_back(dotted(unit, r.points[i]));
                 edges.insert({i, j});
                 edges.insert({j, k});
                 edges.insert({i, k});
             }
     for (const auto& [i, j] : edges) r.edges.push_back(minus(r.points[j], r.points[i]));
     return r;
+}
+
+/// The signed distance of p to the polytope's boundary when p is near it: max over the face
+/// planes of normal . p - offset (0 on the boundary).
+LD boundary_gap(const ReferencePolytope& poly, const Vec3d& p) {
+    const PointL q{{p[0], p[1], p[2]}};
+    LD worst = -std::numeric_limits<LD>::infinity();
+    for (std::size_t f = 0; f < poly.normals.size(); ++f)
+        worst = std::max(worst, dotted(poly.normals[f], q) - poly.offsets[f]);
+    return worst;
 }
 
 /// min over the candidate axes of the projections' overlap: the penetration depth when positive;
@@ -173,8 +189,12 @@ TEST(ConvexPenetration, RandomHullPairsMatchSeparatingAxes) {
         const Transformd pa = random_rotation_pose(rng, 0), pb = random_rotation_pose(rng, 1.6);
         const ConvexShape<double> a(ConvexPolytope<double>{std::span<const Vec3d>(la)});
         const ConvexShape<double> b(ConvexPolytope<double>{std::span<const Vec3d>(lb)});
-        const LD reference_depth = separating_axis_depth(reference(la, pa), reference(lb, pb));
+        const ReferencePolytope ra = reference(la, pa), rb = reference(lb, pb);
+        const LD reference_depth = separating_axis_depth(ra, rb);
         const auto r = bvhkit::convex_signed_distance(a, pa, b, pb);
+        // The witnesses lie on the boundaries (closest or deepest points alike).
+        EXPECT_NEAR(double(boundary_gap(ra, r.point_a)), 0.0, 1e-9) << i;
+        EXPECT_NEAR(double(boundary_gap(rb, r.point_b)), 0.0, 1e-9) << i;
         const int id = int(i);
         if (reference_depth > 1e-6L) {
             ++overlapping;

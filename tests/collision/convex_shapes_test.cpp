@@ -273,6 +273,10 @@ TEST(ConvexShapes, SphereBoxFaceEdgeCornerAndInside) {
         // EPA on a box and a point: exact to rounding as well (the polytope is the box).
         EXPECT_NEAR(r.signed_distance, expected, 1e-13) << i << " region " << outside_axes;
         expect_consistent(r, 1e-12);
+        // The witnesses lie on the boundaries: point_a on the box, point_b on the ball.
+        EXPECT_NEAR(double(box_point_signed(to_local_ld(pose, r.point_a), h)), 0.0, 1e-13) << i;
+        EXPECT_NEAR(double(len_ld(sub_ld(to_ld(r.point_b), to_ld(at.translation)))), 0.3, 1e-13)
+            << i;
     }
     for (int k = 0; k < 4; ++k) EXPECT_GT(regions[k], 50) << "region " << k;
 }
@@ -332,6 +336,16 @@ TEST(ConvexShapes, CapsuleCapsuleAgainstSegmentSearch) {
         if (core > 1e-9) {
             EXPECT_NEAR(r.signed_distance, double(expected), 1e-13) << i;
             overlapping += expected < 0;
+            // The witnesses lie on the capsules' boundaries: at their radius from the segments.
+            const V3L wa = to_ld(r.point_a), wb = to_ld(r.point_b);
+            EXPECT_NEAR(double(segment_segment_distance(wa, wa, to_world_ld(pa, {0, 0, -la}),
+                                                        to_world_ld(pa, {0, 0, la}))),
+                        ra, 1e-12)
+                << i;
+            EXPECT_NEAR(double(segment_segment_distance(wb, wb, to_world_ld(pb, {0, 0, -lb}),
+                                                        to_world_ld(pb, {0, 0, lb}))),
+                        rb, 1e-12)
+                << i;
         }
         expect_consistent(r, 1e-12);
     }

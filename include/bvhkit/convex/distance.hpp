@@ -105,7 +105,8 @@ GjkRun<T> run_gjk(const ShapePair<T>& p) {
     if (!(length_squared(dir) > T(0))) dir = {T(1), T(0), T(0)};
     const auto [w0, a0] = p.support(dir);
     r.simplex.add(w0, a0);
-    Vec<T, 3> v = w0;
+    bool single_point_inside = false;  // never set for one point; nearest() sets its weight
+    Vec<T, 3> v = r.simplex.nearest(single_point_inside);
     const T rel = gjk_relative_tolerance<T>(), tol = p.abs_tolerance;
     // Whether some support value has proved the origin outside D: v.w > 0 for w = the support
     // along -v puts all of D on the far side of a plane through the origin.

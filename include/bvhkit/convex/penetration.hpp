@@ -21,6 +21,7 @@
 // slightly more than the depth along the normal separates the shapes, by slightly less does not.
 //
 // Storage: a fixed-capacity polytope (EpaPolytope, ~25 KB on the stack), no allocation.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -96,8 +97,8 @@ template <class T>
 struct EpaResult {
     T depth = 0;
     Vec<T, 3> normal{};
-    Vec<T, 3>
-        witness_a{};  // a point of A's core; the core point of B is witness_a - depth * normal
+    // A point of A's core; the core point of B is witness_a - depth * normal.
+    Vec<T, 3> witness_a{};
     int iterations = 0;
     bool converged = true;
 };
@@ -281,9 +282,8 @@ class Epa {
         return best;
     }
 
-    /// The point of A behind the origin's projection on the face (barycentric weights).
-    Vec<T, 3> face_witness(const EpaFace<T>& face) const {
-        const Vec<T, 3> q = face.normal * face.distance;
+    /// The barycentric weights of q in face f's triangle (its plane), unclamped.
+    std::array<T, 3> weights_in(const EpaFace<T>& face, const Vec<T, 3>& q) const {
         const Vec<T, 3>& p0 = s_.w[face.v[0]];
         const Vec<T, 3> e1 = s_.w[face.v[1]] - p0, e2 = s_.w[face.v[2]] - p0, d = q - p0;
         const T d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2);
@@ -294,13 +294,37 @@ class Epa {
             l1 = (d22 * d1 - d12 * d2) / denominator;
             l2 = (d11 * d2 - d12 * d1) / denominator;
         }
-        T l0 = T(1) - l1 - l2;
+        return {T(1) - l1 - l2, l1, l2};
+    }
+
+    /// The point of A behind the origin's projection q on the face. Coplanar faces (a flat face
+    /// of D cut into triangles) tie for nearest, and q lies in one of them, not necessarily in
+    /// this one: outside it, the coplanar face holding q gives the weights.
+    Vec<T, 3> face_witness(const EpaFace<T>& face) const {
+        const Vec<T, 3> q = face.normal * face.distance;
+        const T slack = T(-64) * std::numeric_limits<T>::epsilon();
+        const EpaFace<T>* holder = &face;
+        std::array<T, 3> l = weights_in(face, q);
+        if (std::min({l[0], l[1], l[2]}) < slack) {
+            const T tol = p_.abs_tolerance;
+            for (std::size_t f = 0; f < s_.face_slots; ++f) {
+                const EpaFace<T>& other = s_.faces[f];
+                if (!other.alive || std::fabs(other.distance - face.distance) > tol ||
+                    dot(other.normal, face.normal) <
+                        T(1) - T(1e3) * std::numeric_limits<T>::epsilon())
+                    continue;
+                const std::array<T, 3> lo = weights_in(other, q);
+                if (std::min({lo[0], lo[1], lo[2]}) >= slack) {
+                    holder = &other;
+                    l = lo;
+                    break;
+                }
+            }
+        }
         // Rounding may put the projection just outside: clamp and renormalise.
-        l0 = std::max(l0, T(0));
-        l1 = std::max(l1, T(0));
-        l2 = std::max(l2, T(0));
-        const T total = l0 + l1 + l2;
-        return (s_.a[face.v[0]] * l0 + s_.a[face.v[1]] * l1 + s_.a[face.v[2]] * l2) *
+        for (T& x : l) x = std::max(x, T(0));
+        const T total = l[0] + l[1] + l[2];
+        return (s_.a[holder->v[0]] * l[0] + s_.a[holder->v[1]] * l[1] + s_.a[holder->v[2]] * l[2]) *
                (T(1) / total);
     }
 
