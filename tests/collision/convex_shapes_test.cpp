@@ -397,6 +397,14 @@ TEST(ConvexShapes, CylinderAndConeAgainstSphere) {
             EXPECT_LE(rc.signed_distance, double(cyl - rs) + 1e-9) << i;  // an upper bound of depth
         }
         expect_consistent(rc, 1e-9);
+        // The witnesses on the boundaries: point_a on the cylinder, point_b on the ball.
+        const double on_boundary = cyl > 0 ? 1e-9 : 1e-5;
+        EXPECT_NEAR(double(cylinder_point_signed(to_local_ld(pose, rc.point_a), r, h)), 0.0,
+                    on_boundary)
+            << i;
+        EXPECT_NEAR(double(len_ld(sub_ld(to_ld(rc.point_b), to_ld(at.translation)))), rs,
+                    on_boundary)
+            << i;
         const LD co = cone_point_distance(p, r, height);
         if (co > 0) {
             const auto d = bvhkit::convex_distance(cone, pose, ball, at);

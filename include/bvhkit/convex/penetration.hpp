@@ -129,11 +129,18 @@ class Epa {
                 best_upper = upper;
                 r.depth = upper;
                 r.normal = n;
-                r.witness_a = face_witness(face);
+                r.witness_a = on_support_plane(face_witness(face), n, a);
             }
-            if (upper - face.distance <= rel * std::fabs(upper) + tol) break;
-            // A support point the face holds already: the bounds have met to rounding.
-            if (s_.w[face.v[0]] == w || s_.w[face.v[1]] == w || s_.w[face.v[2]] == w) break;
+            // Converged: this face's answer, even when an earlier face's upper bound was lower
+            // (by less than the tolerance): an early, large face's witness may lie deep inside a
+            // curved shape, this one's lies within the tolerance of the boundary.
+            if (upper - face.distance <= rel * std::fabs(upper) + tol || s_.w[face.v[0]] == w ||
+                s_.w[face.v[1]] == w || s_.w[face.v[2]] == w) {
+                r.depth = upper;
+                r.normal = n;
+                r.witness_a = on_support_plane(face_witness(face), n, a);
+                break;
+            }
             if (s_.vertex_count == epa_max_vertices || !expand(f, w, a)) {
                 r.converged = false;
                 break;
@@ -282,6 +289,14 @@ class Epa {
         return best;
     }
 
+    /// The face's point of A moved along n onto A's supporting plane (through A's support point
+    /// `a_support`): a no-op on a flat part of A; on a curved one it lifts the point from the
+    /// polytope's chord to the tangent plane, and point_b (witness - depth * n) to B's.
+    static Vec<T, 3> on_support_plane(const Vec<T, 3>& witness, const Vec<T, 3>& n,
+                                      const Vec<T, 3>& a_support) {
+        return witness + n * dot(n, a_support - witness);
+    }
+
     /// The barycentric weights of q in face f's triangle (its plane), unclamped.
     std::array<T, 3> weights_in(const EpaFace<T>& face, const Vec<T, 3>& q) const {
         const Vec<T, 3>& p0 = s_.w[face.v[0]];
@@ -297,35 +312,32 @@ class Epa {
         return {T(1) - l1 - l2, l1, l2};
     }
 
-    /// The point of A behind the origin's projection q on the face. Coplanar faces (a flat face
-    /// of D cut into triangles) tie for nearest, and q lies in one of them, not necessarily in
-    /// this one: outside it, the coplanar face holding q gives the weights.
+    /// The point of A behind the origin's projection q on the face. Faces that nearly tie for
+    /// nearest (a flat or straight part of D cut into triangles, coplanar up to rounding or the
+    /// curvature between their corners) share q between them, and q may lie just outside this
+    /// one: then the point of those faces nearest q (Ericson's closest point on a triangle, by
+    /// GjkSimplex) gives the weights.
     Vec<T, 3> face_witness(const EpaFace<T>& face) const {
         const Vec<T, 3> q = face.normal * face.distance;
+        const std::array<T, 3> l = weights_in(face, q);
         const T slack = T(-64) * std::numeric_limits<T>::epsilon();
-        const EpaFace<T>* holder = &face;
-        std::array<T, 3> l = weights_in(face, q);
-        if (std::min({l[0], l[1], l[2]}) < slack) {
-            const T tol = p_.abs_tolerance;
-            for (std::size_t f = 0; f < s_.face_slots; ++f) {
-                const EpaFace<T>& other = s_.faces[f];
-                if (!other.alive || std::fabs(other.distance - face.distance) > tol ||
-                    dot(other.normal, face.normal) <
-                        T(1) - T(1e3) * std::numeric_limits<T>::epsilon())
-                    continue;
-                const std::array<T, 3> lo = weights_in(other, q);
-                if (std::min({lo[0], lo[1], lo[2]}) >= slack) {
-                    holder = &other;
-                    l = lo;
-                    break;
-                }
+        if (std::min({l[0], l[1], l[2]}) >= slack)
+            return s_.a[face.v[0]] * l[0] + s_.a[face.v[1]] * l[1] + s_.a[face.v[2]] * l[2];
+        T best = std::numeric_limits<T>::infinity();
+        Vec<T, 3> witness{};
+        for (std::size_t f = 0; f < s_.face_slots; ++f) {
+            const EpaFace<T>& other = s_.faces[f];
+            if (!other.alive || dot(other.normal, face.normal) < T(0.5)) continue;
+            GjkSimplex<T> triangle;
+            for (const std::uint16_t i : other.v) triangle.add(s_.w[i] - q, s_.a[i]);
+            bool unused = false;
+            const T gap = length_squared(triangle.nearest(unused));
+            if (gap < best) {
+                best = gap;
+                witness = triangle.witness_a();
             }
         }
-        // Rounding may put the projection just outside: clamp and renormalise.
-        for (T& x : l) x = std::max(x, T(0));
-        const T total = l[0] + l[1] + l[2];
-        return (s_.a[holder->v[0]] * l[0] + s_.a[holder->v[1]] * l[1] + s_.a[holder->v[2]] * l[2]) *
-               (T(1) / total);
+        return witness;
     }
 
     bool sees(const EpaFace<T>& face, const Vec<T, 3>& w) const {
