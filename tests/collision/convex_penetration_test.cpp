@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <set>
@@ -216,7 +217,9 @@ TEST(ConvexPenetration, RandomHullPairsMatchSeparatingAxes) {
     EXPECT_GT(overlapping, pairs / 4);
     EXPECT_GT(apart, pairs / 4);
     EXPECT_EQ(unconverged, 0u);
-    RecordProperty("worst_relative_depth_error", std::to_string(worst_relative));
+    char worst[32];
+    std::snprintf(worst, sizeof worst, "%.3g", worst_relative);
+    RecordProperty("worst_relative_depth_error", worst);
 }
 
 TEST(ConvexPenetration, MixedShapesSeparate) {
