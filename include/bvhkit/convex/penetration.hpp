@@ -14,8 +14,8 @@
 //
 // EPA runs on the cores, like GJK: the depth of (core + ball) is the core's depth plus the margins,
 // since h of a set swept by a ball of radius r is h + r. A core difference with no interior (two
-// sphere centres, two crossing capsule axes, flat hulls) has depth 0 along the normal of the
-// smallest flat it lies in; the margins give the whole depth then.
+// sphere centres, two crossing capsule axes, a flat hull and a sphere's centre) has depth 0 along
+// the normal of the smallest flat it lies in; the margins give the whole depth then.
 //
 // The depth returned is h_D along the normal returned (computed, so up to rounding): moving B by
 // slightly more than the depth along the normal separates the shapes, by slightly less does not.
