@@ -9,7 +9,7 @@
 #   1 math exec
 #   2 primitives
 #   3 volumes
-#   4 bvh bsp
+#   4 bvh bsp convex
 #   5 build
 #   6 dynamic query
 #   7 triangle_bvh.hpp
@@ -25,6 +25,7 @@ set(rank_primitives 2)
 set(rank_volumes 3)
 set(rank_bvh 4)
 set(rank_bsp 4)
+set(rank_convex 4)
 set(rank_build 5)
 set(rank_dynamic 6)
 set(rank_query 6)

@@ -1,8 +1,8 @@
 #pragma once
 // Everything in one include: the static trees and their builders, rays, proximity (closest point,
 // k nearest, radius, signed distance, winding number), collision and distance between meshes, the
-// dynamic tree, the BSP tree, the mesh readers and generators. The finer headers stay for those who
-// want less.
+// convex shapes' distance and penetration, the dynamic tree, the BSP tree, the mesh readers and
+// generators. The finer headers stay for those who want less.
 #include "bvhkit/bsp/bsp.hpp"
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/refit.hpp"
@@ -10,6 +10,7 @@
 #include "bvhkit/bvh/statistics.hpp"
 #include "bvhkit/bvh/validate.hpp"
 #include "bvhkit/bvh/wide_bvh.hpp"
+#include "bvhkit/convex/penetration.hpp"
 #include "bvhkit/dynamic/dynamic_tree.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/io/closest_point_mesh_file.hpp"

@@ -71,6 +71,8 @@ class GjkSimplex {
         return false;
     }
     const Vec<T, 3>& point_a(std::size_t i) const { return a_[i]; }
+    /// The simplex's i-th point of D (a - b).
+    const Vec<T, 3>& point(std::size_t i) const { return w_[i]; }
 
   private:
     /// Keeps the listed vertices, with their weights, in that order.
