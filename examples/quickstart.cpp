@@ -3,6 +3,7 @@
 // given as its argument.
 #include <bvhkit/bvhkit.hpp>
 #include <cstdio>
+#include <vector>
 
 #ifndef BVHKIT_EXAMPLE_MESH
 #define BVHKIT_EXAMPLE_MESH "data/spot.obj"
@@ -45,6 +46,25 @@ int tour(const char* mesh_spec) {
     const bvhkit::BvhStatistics s = bvhkit::statistics(bvh.bvh());
     std::printf("%zu triangles, %zu nodes, depth %u, SAH cost %.2f\n", mesh.triangle_count(),
                 s.node_count, s.depth, s.sah_cost);
+
+    // A scene: the mesh added once, placed five times along x (each a quarter turn further),
+    // for rays, closest points and collision over all of them.
+    bvhkit::Scene<float> scene;
+    const bvhkit::GeometryId shape = scene.add_mesh(mesh);
+    for (int i = 0; i < 5; ++i) {
+        bvhkit::Transform<float> pose;
+        pose.rotation = bvhkit::rotation_about(bvhkit::Vec3f(0, 1, 0), 1.5708f * float(i));
+        pose.translation = bvhkit::Vec3f(0.4f * diagonal * float(i), 0, 0);
+        scene.add_instance(shape, pose, {.user_data = std::uint64_t(i)});
+    }
+    const bvhkit::Ray3f along(centre - bvhkit::Vec3f(diagonal, 0, 0), {1, 0, 0});
+    if (const bvhkit::SceneHit<float> hit = bvhkit::closest_hit(scene, along))
+        std::printf("scene ray hits copy %llu, triangle %u at t = %.4f\n",
+                    static_cast<unsigned long long>(scene.user_data(hit.instance)), hit.face,
+                    hit.t);
+    std::vector<bvhkit::InstancePair> touching;
+    bvhkit::colliding_pairs(scene, touching);
+    std::printf("%zu instances, %zu colliding pairs\n", scene.instance_count(), touching.size());
     return 0;
 }
 
