@@ -106,9 +106,10 @@ void put(double* out, std::size_t i, const Vec<double, 3>& v) {
     for (int a = 0; a < 3; ++a) out[3 * i + a] = v[a];
 }
 
-void distance(const Convex& a, const Convex& b, const std::optional<PoseArray>& rotations,
-              const PoseArray& translations, OutColumn<double> dist, OutRows<double, 3> point_a,
-              OutRows<double, 3> point_b, OutRows<double, 3> normal, unsigned threads) {
+void distance_batch(const Convex& a, const Convex& b, const std::optional<PoseArray>& rotations,
+                    const PoseArray& translations, OutColumn<double> dist,
+                    OutRows<double, 3> point_a, OutRows<double, 3> point_b,
+                    OutRows<double, 3> normal, unsigned threads) {
     const std::size_t k = PoseValues<double>(translations, 1, "translations").count();
     expect_rows(dist, k, "distance");
     expect_rows(point_a, k, "point_a");
@@ -125,10 +126,11 @@ void distance(const Convex& a, const Convex& b, const std::optional<PoseArray>& 
     });
 }
 
-void signed_distance(const Convex& a, const Convex& b, const std::optional<PoseArray>& rotations,
-                     const PoseArray& translations, OutColumn<double> dist,
-                     OutRows<double, 3> point_a, OutRows<double, 3> point_b,
-                     OutRows<double, 3> normal, OutColumn<bool> converged, unsigned threads) {
+void signed_distance_batch(const Convex& a, const Convex& b,
+                           const std::optional<PoseArray>& rotations, const PoseArray& translations,
+                           OutColumn<double> dist, OutRows<double, 3> point_a,
+                           OutRows<double, 3> point_b, OutRows<double, 3> normal,
+                           OutColumn<bool> converged, unsigned threads) {
     const std::size_t k = PoseValues<double>(translations, 1, "translations").count();
     expect_rows(dist, k, "signed_distance");
     expect_rows(point_a, k, "point_a");
@@ -165,11 +167,11 @@ void bind_convex(nb::module_& m) {
         .def_prop_ro("bounding_radius", &Convex::bounding_radius,
                      "The largest distance of a point of the shape from its origin.")
         .def("vertices", &Convex::vertices, "A hull's vertices (n, 3); (0, 3) otherwise.");
-    m.def("convex_distance", &distance, nb::arg("a"), nb::arg("b"), nb::arg("rotations").none(),
-          nb::arg("translations"), nb::arg("distance"), nb::arg("point_a"), nb::arg("point_b"),
-          nb::arg("normal"), nb::arg("threads"),
+    m.def("convex_distance", &distance_batch, nb::arg("a"), nb::arg("b"),
+          nb::arg("rotations").none(), nb::arg("translations"), nb::arg("distance"),
+          nb::arg("point_a"), nb::arg("point_b"), nb::arg("normal"), nb::arg("threads"),
           "GJK distance of b at each pose (in a's frame) from a, into the given arrays.");
-    m.def("convex_signed_distance", &signed_distance, nb::arg("a"), nb::arg("b"),
+    m.def("convex_signed_distance", &signed_distance_batch, nb::arg("a"), nb::arg("b"),
           nb::arg("rotations").none(), nb::arg("translations"), nb::arg("signed_distance"),
           nb::arg("point_a"), nb::arg("point_b"), nb::arg("normal"), nb::arg("converged"),
           nb::arg("threads"),
