@@ -5,6 +5,8 @@
   winding numbers and inside/outside on one triangle mesh.
 - :class:`CollisionModel` with :func:`collide`, :func:`distance` and :func:`self_intersections`:
   mesh against mesh over batches of rigid poses.
+- :class:`Sphere`, :class:`Box`, :class:`Capsule`, :class:`Cylinder`, :class:`Cone` and
+  :class:`ConvexHull` with :func:`convex_distance` (GJK) and :func:`convex_signed_distance` (EPA).
 - :class:`DynamicTree2D` and :class:`DynamicTree3D`: a dynamic AABB tree for moving boxes.
 
 Arrays go in and come out as numpy arrays. Inputs that are C-contiguous and of the object's scalar
@@ -37,6 +39,17 @@ __all__ = [
     "distance",
     "Distances",
     "self_intersections",
+    "ConvexShape",
+    "Sphere",
+    "Box",
+    "Capsule",
+    "Cylinder",
+    "Cone",
+    "ConvexHull",
+    "convex_distance",
+    "ConvexDistances",
+    "convex_signed_distance",
+    "ConvexSignedDistances",
     "DynamicTree2D",
     "DynamicTree3D",
     "MissingFileError",
@@ -422,5 +435,18 @@ from ._collision import (  # noqa: E402
     collide,
     distance,
     self_intersections,
+)
+from ._convex import (  # noqa: E402
+    Box,
+    Capsule,
+    Cone,
+    ConvexDistances,
+    ConvexHull,
+    ConvexShape,
+    ConvexSignedDistances,
+    Cylinder,
+    Sphere,
+    convex_distance,
+    convex_signed_distance,
 )
 from ._dynamic import DynamicTree2D, DynamicTree3D  # noqa: E402

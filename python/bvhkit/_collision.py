@@ -209,12 +209,17 @@ def _poses(a: Any, b: Any, rotations: Any, translations: Any):
         raise TypeError(f"a: must be a CollisionModel, not {type(a).__name__}")
     if type(b) is not CollisionModel and not isinstance(b, CollisionModel):
         raise TypeError(f"b: must be a CollisionModel, not {type(b).__name__}")
-    dt = a.dtype
     if a._impl_type is not b._impl_type:
         raise TypeError(
             f"b: a has volume {a.volume!r} and dtype {a.dtype}, b has {b.volume!r} and {b.dtype}; "
             "both models must have the same volume and dtype"
         )
+    return _pose_arrays(rotations, translations, a.dtype)
+
+
+def _pose_arrays(rotations: Any, translations: Any, dt: np.dtype):
+    """_poses' pose part, for any caller whose C++ call reads poses as collision.hpp's
+    PoseValues does (convex_distance too); `dt` is the type other input is converted to."""
     t = translations
     if (type(t) is np.ndarray and t.dtype in _POSE_TYPES and t.flags.c_contiguous
             and (t.shape == (3,) or t.ndim == 2 and t.shape[1] == 3)):

@@ -114,6 +114,7 @@ void refit_vertices(std::vector<Vec<T, 3>>& vertices, const T* rows, Refit&& ref
 }
 
 void bind_scene(nb::module_& m);
+void bind_convex(nb::module_& m);
 void bind_collision32(nb::module_& m);
 void bind_collision64(nb::module_& m);
 void bind_dynamic(nb::module_& m);

@@ -79,6 +79,7 @@ NB_MODULE(_bvhkit, m) {
         "Reads an OBJ, PLY or STL file, or generates a mesh from a spec such as "
         "'sphere:subdiv=6'; returns (vertices float32 (n, 3), faces int64 (m, 3)).");
     m.attr("version") = bvhkit::version_string;
+    bind_convex(m);  // convex shapes, GJK distance and EPA depth (convex.cpp)
     bind_scene(m);
     bind_collision32(m);
     bind_collision64(m);
