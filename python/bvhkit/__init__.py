@@ -6,6 +6,8 @@
 - :class:`CollisionModel` with :func:`collide`, :func:`distance` and :func:`self_intersections`:
   mesh against mesh over batches of rigid poses.
 - :class:`DynamicTree2D` and :class:`DynamicTree3D`: a dynamic AABB tree for moving boxes.
+- :class:`Scene`: many posed instances of shared meshes, for rays, closest points and collision
+  (with :func:`pinhole_rays` for a camera's rays).
 
 Arrays go in and come out as numpy arrays. Inputs that are C-contiguous and of the object's scalar
 type are used in place; anything else is converted once. Every batch query releases the GIL and
@@ -39,6 +41,11 @@ __all__ = [
     "self_intersections",
     "DynamicTree2D",
     "DynamicTree3D",
+    "Scene",
+    "SceneHits",
+    "SceneIntersections",
+    "SceneClosest",
+    "pinhole_rays",
     "MissingFileError",
 ]
 
@@ -424,3 +431,10 @@ from ._collision import (  # noqa: E402
     self_intersections,
 )
 from ._dynamic import DynamicTree2D, DynamicTree3D  # noqa: E402
+from ._instances import (  # noqa: E402
+    Scene,
+    SceneClosest,
+    SceneHits,
+    SceneIntersections,
+    pinhole_rays,
+)
