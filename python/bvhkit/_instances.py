@@ -210,8 +210,8 @@ class Scene:
         r, t = _one_rotation(rotation), _one_translation(translation)
         if r is None and t is None:
             t = np.zeros(3)
-        return int(self.add_instances(geometry, r, t, user_data=user_data,
-                                      group=group, mask=mask, margin=margin, _names=True)[0])
+        return int(self._add(geometry, r, t, user_data, group, mask, margin, "rotation",
+                             "translation")[0])
 
     def add_instances(
         self,
@@ -223,13 +223,16 @@ class Scene:
         group: Any = 1,
         mask: Any = 0xFFFFFFFF,
         margin: Any = 0.0,
-        _names: bool = False,
     ) -> np.ndarray:
         """:meth:`add_instance` for k instances at once: ``rotations`` (k, 3, 3) or None,
         ``translations`` (k, 3) or None (one of them gives k), ``geometry`` and the options an
         int (a number) or a (k,) array. Returns the (k,) int64 ids. Everything is checked before
         the first is added: an error adds none."""
-        rn, tn = ("rotation", "translation") if _names else ("rotations", "translations")
+        return self._add(geometry, rotations, translations, user_data, group, mask, margin,
+                         "rotations", "translations")
+
+    def _add(self, geometry: Any, rotations: Any, translations: Any, user_data: Any, group: Any,
+             mask: Any, margin: Any, rn: str, tn: str) -> np.ndarray:
         if rotations is None and translations is None:
             raise ValueError(f"{tn}: give translations or rotations (or both)")
         r = None if rotations is None else _rotations(rn, rotations, None, self.dtype)

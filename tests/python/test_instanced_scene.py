@@ -149,7 +149,7 @@ def brute_pairs(m):
     return np.array(out, np.int64).reshape(-1, 2)
 
 
-def random_scene(seed, dtype, offset=0.0, scale=1.0, count=12):
+def random_scene(seed, dtype, offset=0.0, scale=1.0, count=16):
     rng = np.random.default_rng(seed)
     meshes = [random_soup(rng, n, size=0.3, scale=scale) for n in (10, 16, 7)]
     meshes.append(tuple(x * scale if i == 0 else x for i, x in enumerate(box_mesh([-.4] * 3,
@@ -157,13 +157,13 @@ def random_scene(seed, dtype, offset=0.0, scale=1.0, count=12):
     m = Mirror(dtype, meshes)
     for j in range(count):
         m.add(j % len(meshes), rotations(rng, 1)[0],
-              offset + scale * rng.uniform(-2.5, 2.5, 3), user_data=1000 + j)
+              offset + scale * rng.uniform(-1.5, 1.5, 3), user_data=1000 + j)
     return m, rng
 
 
 def random_rays(rng, k, offset, scale):
     origins = offset + scale * rng.uniform(-6, 6, (k, 3))
-    targets = offset + scale * rng.uniform(-2.5, 2.5, (k, 3))
+    targets = offset + scale * rng.uniform(-1.5, 1.5, (k, 3))
     return origins, targets - origins
 
 
@@ -186,7 +186,8 @@ def test_queries_match_the_world_mesh(dtype, offset, scale):
 
     # New poses for half of them, in one call: no answer is stale.
     ids = np.array(sorted(m.poses))[::2]
-    m.set_poses(ids, rotations(rng, len(ids)), offset + scale * rng.uniform(-2, 2, (len(ids), 3)))
+    m.set_poses(ids, rotations(rng, len(ids)),
+                offset + scale * rng.uniform(-1.5, 1.5, (len(ids), 3)))
     assert check_rays(m, o, d, tol, scale) > 100
     check_closest(m, points, tol, scale)
     assert np.array_equal(m.scene.colliding_pairs(), brute_pairs(m))
