@@ -368,8 +368,25 @@ class Scene:
         Returns :class:`SceneHits` ``(t, instance, geometry, face, barycentric, normal)``;
         instance = -1 on a miss. Rays with a NaN or infinite component or a zero direction miss.
         """
+        dt = self.dtype
+        if (
+            type(origins) is np.ndarray and type(directions) is np.ndarray
+            and origins.dtype is dt and directions.dtype is dt and origins.ndim == 2
+            and origins.shape[1] == 3 and directions.shape == origins.shape
+            and type(tmin) is float and type(tmax) is float
+            and type(threads) is int and 0 <= threads <= _a.THREADS_MAX
+        ):
+            # The one-ray call's usual arguments: one [tmin, tmax] for all, no array made for it
+            # (the C++ call converts a non-contiguous array as the general path would).
+            k = len(origins)
+            t = np.empty(k, dt)
+            inst, geom, face = np.empty(k, np.int64), np.empty(k, np.int64), np.empty(k, np.int64)
+            bary, normal = np.empty((k, 3), dt), np.empty((k, 3), dt)
+            self._impl.intersect_shared(origins, directions, tmin, tmax, t, inst, geom, face,
+                                        bary, normal, threads)
+            return SceneHits(t, inst, geom, face, bary, normal)
         o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
-        k, dt = len(o), self.dtype
+        k = len(o)
         t = np.empty(k, dt)
         inst, geom, face = np.empty(k, np.int64), np.empty(k, np.int64), np.empty(k, np.int64)
         bary, normal = np.empty((k, 3), dt), np.empty((k, 3), dt)

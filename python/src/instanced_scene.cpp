@@ -210,24 +210,44 @@ class InstancedScene {
 
     // ---------------------------------------------------------------- rays
 
-    /// per_ray(i, ray) for each ray, over the pool, without the GIL, under the shared lock.
-    template <class PerRay>
-    void rays(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
-              const Column<T>& tmax, unsigned threads, PerRay&& per_ray) const {
-        const std::size_t k = origins.shape(0);
-        expect_rows(directions, k, "directions");
+    /// The rays' [tmin, tmax]: one array each, or one pair for every ray (the one-ray call's
+    /// usual form, which then converts no array for them).
+    struct PerRayLimits {
+        const T *t0, *t1;
+        T tmin(std::size_t i) const { return t0[i]; }
+        T tmax(std::size_t i) const { return t1[i]; }
+    };
+    struct SharedLimits {
+        T t0, t1;
+        T tmin(std::size_t) const { return t0; }
+        T tmax(std::size_t) const { return t1; }
+    };
+    static PerRayLimits limits(const Column<T>& tmin, const Column<T>& tmax, std::size_t k) {
         expect_rows(tmin, k, "tmin");
         expect_rows(tmax, k, "tmax");
-        const T *o = origins.data(), *d = directions.data(), *t0 = tmin.data(), *t1 = tmax.data();
         for (std::size_t i = 0; i < k; ++i)
-            if (t0[i] < T(0))
+            if (tmin.data()[i] < T(0))
                 throw Error("tmin: row " + std::to_string(i) +
                             " is negative; scene rays start at tmin >= 0");
+        return {tmin.data(), tmax.data()};
+    }
+    static SharedLimits limits(T tmin, T tmax) {
+        if (tmin < T(0)) throw Error("tmin: negative; scene rays start at tmin >= 0");
+        return {tmin, tmax};
+    }
+
+    /// per_ray(i, ray) for each ray, over the pool, without the GIL, under the shared lock.
+    template <class Limits, class PerRay>
+    void rays(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Limits& limits,
+              unsigned threads, PerRay&& per_ray) const {
+        const std::size_t k = origins.shape(0);
+        expect_rows(directions, k, "directions");
+        const T *o = origins.data(), *d = directions.data();
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock(mutex_);
         run_batch(k, 256, threads, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i)
-                per_ray(i, Ray<T, 3>(at(o, i), at(d, i), t0[i], t1[i]));
+                per_ray(i, Ray<T, 3>(at(o, i), at(d, i), limits.tmin(i), limits.tmax(i)));
         });
     }
 
@@ -235,6 +255,22 @@ class InstancedScene {
                    const Column<T>& tmax, OutColumn<T> t, OutColumn<std::int64_t> instance,
                    OutColumn<std::int64_t> geometry, OutColumn<std::int64_t> face,
                    OutRows<T, 3> barycentric, OutRows<T, 3> normal, unsigned threads) const {
+        intersect_within(origins, directions, limits(tmin, tmax, origins.shape(0)), t, instance,
+                         geometry, face, barycentric, normal, threads);
+    }
+    /// intersect with one [tmin, tmax] for every ray.
+    void intersect_shared(const Rows<T, 3>& origins, const Rows<T, 3>& directions, T tmin, T tmax,
+                          OutColumn<T> t, OutColumn<std::int64_t> instance,
+                          OutColumn<std::int64_t> geometry, OutColumn<std::int64_t> face,
+                          OutRows<T, 3> barycentric, OutRows<T, 3> normal, unsigned threads) const {
+        intersect_within(origins, directions, limits(tmin, tmax), t, instance, geometry, face,
+                         barycentric, normal, threads);
+    }
+    template <class Limits>
+    void intersect_within(const Rows<T, 3>& origins, const Rows<T, 3>& directions,
+                          const Limits& limits, OutColumn<T> t, OutColumn<std::int64_t> instance,
+                          OutColumn<std::int64_t> geometry, OutColumn<std::int64_t> face,
+                          OutRows<T, 3> barycentric, OutRows<T, 3> normal, unsigned threads) const {
         const std::size_t k = origins.shape(0);
         for (const auto* c : {&instance, &geometry, &face}) expect_rows(*c, k, "out");
         expect_rows(t, k, "t");
@@ -242,7 +278,7 @@ class InstancedScene {
         expect_rows(normal, k, "normal");
         T *tp = t.data(), *bp = barycentric.data(), *np_ = normal.data();
         std::int64_t *ip = instance.data(), *gp = geometry.data(), *fp = face.data();
-        rays(origins, directions, tmin, tmax, threads, [&](std::size_t i, const Ray<T, 3>& ray) {
+        rays(origins, directions, limits, threads, [&](std::size_t i, const Ray<T, 3>& ray) {
             const SceneHit<T> h = closest_hit(scene_, ray);
             tp[i] = h.t;
             ip[i] = h ? bits_of(h.instance) : -1;
@@ -260,7 +296,7 @@ class InstancedScene {
                   const Column<T>& tmax, OutColumn<bool> out, unsigned threads) const {
         expect_rows(out, origins.shape(0), "out");
         bool* op = out.data();
-        rays(origins, directions, tmin, tmax, threads,
+        rays(origins, directions, limits(tmin, tmax, origins.shape(0)), threads,
              [&](std::size_t i, const Ray<T, 3>& ray) { op[i] = any_hit(scene_, ray); });
     }
 
@@ -275,13 +311,14 @@ class InstancedScene {
         // parts need no lock, and joined in order they are sorted by ray.
         std::vector<std::vector<SceneHit<T>>> parts((k + grain - 1) / grain);
         std::vector<std::int64_t> splits(k + 1, 0);
-        rays(origins, directions, tmin, tmax, threads, [&](std::size_t i, const Ray<T, 3>& ray) {
-            thread_local std::vector<SceneHit<T>> hits;
-            all_hits(scene_, ray, hits);
-            auto& part = parts[i / grain];
-            part.insert(part.end(), hits.begin(), hits.end());
-            splits[i + 1] = std::int64_t(hits.size());
-        });
+        rays(origins, directions, limits(tmin, tmax, origins.shape(0)), threads,
+             [&](std::size_t i, const Ray<T, 3>& ray) {
+                 thread_local std::vector<SceneHit<T>> hits;
+                 all_hits(scene_, ray, hits);
+                 auto& part = parts[i / grain];
+                 part.insert(part.end(), hits.begin(), hits.end());
+                 splits[i + 1] = std::int64_t(hits.size());
+             });
         for (std::size_t i = 0; i < k; ++i) splits[i + 1] += splits[i];
         const std::size_t n = std::size_t(splits[k]);
         std::vector<std::int64_t> ray(n), instance(n), geometry(n), face(n);
@@ -455,6 +492,10 @@ void bind_instanced_type(nb::module_& m, const char* name) {
         .def("intersect", &S::intersect, nb::arg("origins"), nb::arg("directions"), nb::arg("tmin"),
              nb::arg("tmax"), nb::arg("t"), nb::arg("instance"), nb::arg("geometry"),
              nb::arg("face"), nb::arg("barycentric"), nb::arg("normal"), nb::arg("threads"))
+        .def("intersect_shared", &S::intersect_shared, nb::arg("origins"), nb::arg("directions"),
+             nb::arg("tmin"), nb::arg("tmax"), nb::arg("t"), nb::arg("instance"),
+             nb::arg("geometry"), nb::arg("face"), nb::arg("barycentric"), nb::arg("normal"),
+             nb::arg("threads"))
         .def("occluded", &S::occluded, nb::arg("origins"), nb::arg("directions"), nb::arg("tmin"),
              nb::arg("tmax"), nb::arg("out"), nb::arg("threads"))
         .def("list_intersections", &S::list_intersections, nb::arg("origins"),

@@ -277,8 +277,14 @@ def test_threads_give_the_same_answers():
     o, d = random_rays(rng, 3000, 0.0, 1.0)
     one = m.scene.intersect(o, d, threads=1)
     many = m.scene.intersect(o, d, threads=4)
-    for x, y in zip(one, many):
-        assert np.array_equal(x, y)
+    # One [tmin, tmax] for all (the one-ray fast path) or an array each: the same bits.
+    o32, d32 = o.astype(np.float32), d.astype(np.float32)
+    shared = m.scene.intersect(o32, d32, 0.0, np.inf)
+    per_ray = m.scene.intersect(o32, d32, np.zeros(len(o)), np.full(len(o), np.inf))
+    for x, y, z, w in zip(one, many, shared, per_ray):
+        assert np.array_equal(x, y) and np.array_equal(x, z) and np.array_equal(x, w)
+    with pytest.raises(ValueError, match="tmin"):
+        m.scene.intersect(o32, d32, -1.0, np.inf)
     p = rng.uniform(-4, 4, (2000, 3))
     for x, y in zip(m.scene.closest_point(p, threads=1), m.scene.closest_point(p, threads=0)):
         assert np.array_equal(x, y, equal_nan=True)
