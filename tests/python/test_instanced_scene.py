@@ -293,6 +293,51 @@ def test_threads_give_the_same_answers():
         assert np.array_equal(x, y)
 
 
+def test_queries_while_another_thread_changes_the_scene():
+    """Queries hold a shared lock, changes an exclusive one: Python threads may mix them freely
+    and every answer is of some whole state of the scene."""
+    import threading
+
+    m, rng = random_scene(5, np.float64, count=20)
+    s, ids = m.scene, m.scene.ids()
+    o, d = random_rays(rng, 400, 0.0, 1.0)
+    errors, stop = [], threading.Event()
+
+    def query():
+        try:
+            while not stop.is_set():
+                h = s.intersect(o, d, threads=2)
+                assert np.isfinite(h.t[h.instance >= 0]).all()
+                s.closest_point(o[:50], threads=2)
+                s.colliding_pairs()
+        except Exception as e:  # reported by the main thread
+            errors.append(e)
+
+    def change():
+        try:
+            local = np.random.default_rng(1)
+            for _ in range(20):
+                k = len(ids)
+                s.set_poses(ids, rotations(local, k), local.uniform(-1.5, 1.5, (k, 3)))
+                s.remove(s.add_instances(0, None, local.uniform(-1, 1, (5, 3))))
+        except Exception as e:
+            errors.append(e)
+
+    workers = [threading.Thread(target=query) for _ in range(2)]
+    for w in workers:
+        w.start()
+    mover = threading.Thread(target=change)
+    mover.start()
+    mover.join()
+    stop.set()
+    for w in workers:
+        w.join()
+    assert not errors, errors
+    s.validate()
+    m.set_poses(ids, rotations(rng, len(ids)), rng.uniform(-1.5, 1.5, (len(ids), 3)))
+    assert check_rays(m, o[:150], d[:150], 1e3 * np.finfo(float).eps, 1.0) > 100
+
+
 def test_user_data_ids_and_batches():
     s = bvhkit.Scene(dtype=np.float64)
     g = s.add_mesh(*box_mesh([-1, -1, -1], [1, 1, 1]))
