@@ -461,9 +461,10 @@ def test_docs_examples_run_as_written():
         exec(compile(robot, str(doc), "exec"), {})
     shown = [line[2:] for line in robot.splitlines() if line.startswith("# [")]
     assert out.getvalue().splitlines() == shown
-    namespace = {}
-    with contextlib.redirect_stdout(io.StringIO()):
+    namespace, out = {}, io.StringIO()
+    with contextlib.redirect_stdout(out):
         exec(compile(renderer, str(doc), "exec"), namespace)
+    assert out.getvalue().startswith("rock 44 at depth 39.0")  # the rock at (12, 0, 12)
     hits = namespace["hits"]
     assert (hits.instance >= 0).mean() > 0.2
     hit = hits.instance >= 0
