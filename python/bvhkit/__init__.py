@@ -436,5 +436,5 @@ from ._instances import (  # noqa: E402
     SceneClosest,
     SceneHits,
     SceneIntersections,
-    pinhole_rays,
 )
+from ._camera import pinhole_rays  # noqa: E402

@@ -275,6 +275,29 @@ class Scene:
                 raise ValueError("id" + str(e)[len("ids[0]"):]) from None
             raise
 
+    def set_options(
+        self,
+        ids: npt.ArrayLike,
+        *,
+        user_data: Any = None,
+        group: Any = None,
+        mask: Any = None,
+        margin: Any = None,
+    ) -> None:
+        """New options for instances ``ids`` (an id or (k,) ids): each given option an int (a
+        number) or a (k,) array; those not given (None) stay as they are. Everything is checked
+        before anything changes (a gripper that takes hold of a part: the part's mask, so that
+        the pair no longer counts)."""
+        i = _ids("ids", ids)
+        k = len(i)
+        ud = _integers("user_data", 0 if user_data is None else user_data, k, _U64, np.uint64)
+        gr = _integers("group", 0 if group is None else group, k, _U32, np.uint32)
+        ma = _integers("mask", 0 if mask is None else mask, k, _U32, np.uint32)
+        mg = _margins(0.0 if margin is None else margin, k, self.dtype)
+        given = sum(bit for bit, x in ((1, user_data), (2, group), (4, mask), (8, margin))
+                    if x is not None)
+        self._impl.set_options(i, ud, gr, ma, mg, given)
+
     def remove(self, ids: npt.ArrayLike) -> None:
         """Removes instances (an id or an array of ids; all checked first). Their ids are stale
         from now on."""
@@ -526,48 +549,3 @@ def _one_translation(value: Any) -> Any:
     if a.shape != (3,):
         raise ValueError(f"translation: shape must be (3,), not {a.shape}")
     return a
-
-
-def pinhole_rays(
-    width: int,
-    height: int,
-    fov_deg: float,
-    eye: npt.ArrayLike,
-    center: npt.ArrayLike,
-    up: npt.ArrayLike,
-    dtype: npt.DTypeLike = np.float32,
-) -> Tuple[np.ndarray, np.ndarray]:
-    """The rays of a pinhole camera at ``eye`` looking at ``center``, ``up`` giving the image's
-    up direction, ``fov_deg`` the horizontal field of view (0 < fov_deg < 180) and square pixels:
-    (origins, directions), each (height * width, 3) of ``dtype``, one ray through each pixel's
-    centre, row by row from the top left (``t.reshape(height, width)`` is the depth image). The
-    directions are unit length, so t is the distance from the eye."""
-    dt = _a.scalar_type(dtype)
-    w = _index("width", width, 1 << 16)
-    h = _index("height", height, 1 << 16)
-    if w == 0 or h == 0:
-        raise ValueError(f"{'width' if w == 0 else 'height'}: must be at least 1")
-    fov = _a.number("fov_deg", fov_deg)
-    if not 0 < fov < 180:
-        raise ValueError(f"fov_deg: must be in (0, 180), not {fov_deg}")
-    e, c, u = (_a.rows(name, v, 3, np.dtype(np.float64), finite=True)
-               for name, v in (("eye", eye), ("center", center), ("up", up)))
-    for name, v in (("eye", e), ("center", c), ("up", u)):
-        if len(v) != 1:
-            raise ValueError(f"{name}: shape must be (3,), not {v.shape}")
-    forward = (c - e)[0]
-    if not np.linalg.norm(forward) > 0:
-        raise ValueError("center: must differ from eye")
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, u[0])
-    if not np.linalg.norm(right) > 1e-12 * np.linalg.norm(u[0]):
-        raise ValueError("up: must not be parallel to center - eye")
-    right /= np.linalg.norm(right)
-    true_up = np.cross(right, forward)
-    focal = 0.5 * w / math.tan(math.radians(fov) / 2)
-    x = np.arange(w) + 0.5 - 0.5 * w
-    y = 0.5 * h - (np.arange(h) + 0.5)
-    d = (focal * forward + x[None, :, None] * right + y[:, None, None] * true_up).reshape(-1, 3)
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    origins = np.ascontiguousarray(np.broadcast_to(e[0].astype(dt), d.shape))
-    return origins, np.ascontiguousarray(d, dtype=dt)

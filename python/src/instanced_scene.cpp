@@ -118,6 +118,35 @@ class InstancedScene {
         scene_.set_poses(which, poses);  // checks every pose before it moves any
     }
 
+    /// New options for instances, every row checked before any changes: of user_data, group,
+    /// mask and margin, those whose bit (1, 2, 4, 8) is set in `given`; the others stay (read
+    /// and written under the same lock, so no other thread's change between is undone).
+    void set_options(const Ids& ids, const Column<std::uint64_t>& user_data,
+                     const Column<std::uint32_t>& group, const Column<std::uint32_t>& mask,
+                     const Column<T>& margin, unsigned given) {
+        const std::size_t k = ids.shape(0);
+        expect_rows(user_data, k, "user_data");
+        expect_rows(group, k, "group");
+        expect_rows(mask, k, "mask");
+        expect_rows(margin, k, "margin");
+        if (given & 8u)
+            for (std::size_t i = 0; i < k; ++i)
+                if (!(std::isfinite(margin.data()[i]) && margin.data()[i] >= T(0)))
+                    throw Error("margin: row " + std::to_string(i) + " must be finite and >= 0");
+        nb::gil_scoped_release release;
+        const std::unique_lock<std::shared_mutex> lock(mutex_);
+        check_ids(ids, "ids");
+        for (std::size_t i = 0; i < k; ++i) {
+            const InstanceId id = id_of(ids.data()[i]);
+            InstanceOptions<T> o = scene_.options(id);
+            if (given & 1u) o.user_data = user_data.data()[i];
+            if (given & 2u) o.group = group.data()[i];
+            if (given & 4u) o.mask = mask.data()[i];
+            if (given & 8u) o.margin = margin.data()[i];
+            scene_.set_options(id, o);
+        }
+    }
+
     void remove(const Ids& ids) {
         std::vector<std::int64_t> sorted(ids.data(), ids.data() + ids.shape(0));
         std::sort(sorted.begin(), sorted.end());
@@ -478,6 +507,8 @@ void bind_instanced_type(nb::module_& m, const char* name) {
              nb::arg("margin"), nb::arg("ids"))
         .def("set_poses", &S::set_poses, nb::arg("ids"), nb::arg("rotations"),
              nb::arg("translations"))
+        .def("set_options", &S::set_options, nb::arg("ids"), nb::arg("user_data"), nb::arg("group"),
+             nb::arg("mask"), nb::arg("margin"), nb::arg("given"))
         .def("remove", &S::remove, nb::arg("ids"))
         .def("__len__", &S::size)
         .def("geometry_count", &S::geometry_count)

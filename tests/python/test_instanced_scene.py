@@ -257,13 +257,23 @@ def test_touching_overlapping_filters_and_margins():
     rest = m.scene.colliding_pairs(ignore=[[c, a], [b, a]])
     assert (a, c) not in {tuple(p) for p in rest} and (b, c) in {tuple(p) for p in rest}
     assert m.scene.any_collision() and not bvhkit.Scene().any_collision()
+    # New options: e joins the rest; what was not given stays.
+    m.scene.set_options([e], group=1, mask=0xFFFFFFFF)
+    m.poses[e] = m.poses[e][:3] + (1, 0xFFFFFFFF, 0.0)
+    assert np.array_equal(m.scene.colliding_pairs(), brute_pairs(m))
+    assert {(a, e), (c, e)} <= {tuple(p) for p in m.scene.colliding_pairs()}
+    m.scene.set_options(e, user_data=9)
+    assert m.scene.options(e) == {"user_data": 9, "group": 1, "mask": 0xFFFFFFFF, "margin": 0}
+    with pytest.raises(ValueError, match="margin"):
+        m.scene.set_options([a, e], margin=[0.0, -1.0])
+    assert m.scene.options(a)["margin"] == 0 and m.scene.options(e)["user_data"] == 9
     # One more posed mesh against the scene.
     assert list(m.scene.colliding_instances(0, None, [10, 0, 0])) == []
-    assert list(m.scene.colliding_instances(0, None, [-1, 0, 0])) == [a]
+    assert list(m.scene.colliding_instances(0, None, [-1, 0, 0])) == [a, e]  # e touches too
     assert m.scene.collides_with(0, np.eye(3), [-1.2, 0, 0], margin=0.3)
     assert not m.scene.collides_with(0, np.eye(3), [-1.2, 0, 0])
     assert m.scene.user_data(a) == 0 and m.scene.geometry_of(e) == 0
-    assert m.scene.options(e)["group"] == 2
+    assert m.scene.options(e)["group"] == 1
     r, t = m.scene.pose(d)
     assert np.array_equal(r, np.eye(3)) and np.array_equal(t, [2.5, 0, 0])
     # Overlapping copies: a ray through them lists every face it crosses, nearest first.
@@ -417,6 +427,9 @@ def test_bad_arguments_are_named():
         (lambda: s.set_poses([i + 7], None, [[0, 0, 0]]), ValueError, r"ids\[0\]"),
         (lambda: s.set_pose(-3), ValueError, "id"),
         (lambda: s.remove([i, i]), ValueError, "more than once"),
+        (lambda: s.set_options([i + 7], group=3), ValueError, r"ids\[0\]"),
+        (lambda: s.set_options([i], mask=-1), ValueError, "mask"),
+        (lambda: s.set_options([i], user_data=[1, 2]), ValueError, "user_data"),
         (lambda: s.remove([[i]]), ValueError, "ids"),
         (lambda: s.user_data(i + 1), ValueError, "id"),
         (lambda: s.intersect([[0, 0, 0]], [[1, 0]]), ValueError, "directions"),
