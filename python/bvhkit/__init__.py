@@ -8,6 +8,8 @@
 - :class:`Sphere`, :class:`Box`, :class:`Capsule`, :class:`Cylinder`, :class:`Cone` and
   :class:`ConvexHull` with :func:`convex_distance` (GJK) and :func:`convex_signed_distance` (EPA).
 - :class:`DynamicTree2D` and :class:`DynamicTree3D`: a dynamic AABB tree for moving boxes.
+- :class:`Scene`: many posed instances of shared meshes, for rays, closest points and collision
+  (with :func:`pinhole_rays` for a camera's rays).
 
 Arrays go in and come out as numpy arrays. Inputs that are C-contiguous and of the object's scalar
 type are used in place; anything else is converted once. Every batch query releases the GIL and
@@ -52,6 +54,11 @@ __all__ = [
     "ConvexSignedDistances",
     "DynamicTree2D",
     "DynamicTree3D",
+    "Scene",
+    "SceneHits",
+    "SceneIntersections",
+    "SceneClosest",
+    "pinhole_rays",
     "MissingFileError",
 ]
 
@@ -450,3 +457,10 @@ from ._convex import (  # noqa: E402
     convex_signed_distance,
 )
 from ._dynamic import DynamicTree2D, DynamicTree3D  # noqa: E402
+from ._instances import (  # noqa: E402
+    Scene,
+    SceneClosest,
+    SceneHits,
+    SceneIntersections,
+)
+from ._camera import pinhole_rays  # noqa: E402

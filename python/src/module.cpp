@@ -1,6 +1,7 @@
 // The extension module bvhkit._bvhkit: bvhkit::Error becomes ValueError (FileNotFoundError becomes
 // MissingFileError, a FileNotFoundError and a ValueError), load_mesh, read_file, and the scene,
-// collision and dynamic tree classes (scene.cpp, collision.cpp, dynamic.cpp). The public API with
+// collision, dynamic tree and instanced scene classes (scene.cpp, collision.cpp, dynamic.cpp,
+// instanced_scene.cpp). The public API with
 // argument checks and defaults is the Python package around it (python/bvhkit/).
 #include <string>
 
@@ -84,4 +85,5 @@ NB_MODULE(_bvhkit, m) {
     bind_collision32(m);
     bind_collision64(m);
     bind_dynamic(m);
+    bind_instanced_scene(m);
 }
