@@ -672,12 +672,13 @@ TEST(BatchRays, StreamsEqualTheOneByOneCalls) {
         for (std::size_t b = 0, r = 0; b < rays.size(); ++r) {
             const std::size_t n = std::min(runs[r % std::size(runs)], rays.size() - b);
             const std::span<const Ray3f> chunk(rays.data() + b, n);
-            bvh.trace_stream(chunk, std::span<Hit<float>>(hits.data() + b, n));
+            bvh.trace_on_calling_thread(chunk, std::span<Hit<float>>(hits.data() + b, n));
             bvh.occluded_stream(chunk, std::span<std::uint8_t>(blocked.data() + b, n));
             b += n;
         }
         expect_same(hits, blocked);
-        EXPECT_THROW(bvh.trace_stream(rays, std::span<Hit<float>>(hits.data(), 3)), Error);
+        EXPECT_THROW(bvh.trace_on_calling_thread(rays, std::span<Hit<float>>(hits.data(), 3)),
+                     Error);
         EXPECT_THROW(bvh.occluded_stream(rays, std::span<std::uint8_t>(blocked.data(), 3)), Error);
     }
     // A small layout keeps one ray at a time.
