@@ -124,8 +124,9 @@ class QueryExclusion {
 /// Which tree rays walk. The wide layouts serve float trees with the watertight test, on x86
 /// (query/ray_wide.hpp); anything else walks the binary tree.
 enum class RayLayout {
-    Auto,    // eight wide when the CPU has AVX2, else four wide (the default)
-    Wide8,   // eight wide; four wide on a CPU without AVX2
+    Auto,  // eight wide when the CPU has AVX2, else four wide (the default)
+    // Kept one release, its value (1) too: saved files carry it.
+    Wide8 [[deprecated("use Auto: Wide8 always behaved as Auto")]],
     Wide4,   // four wide (SSE2)
     Binary,  // the binary tree only
 };

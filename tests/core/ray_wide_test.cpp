@@ -97,7 +97,7 @@ TEST(WideRays, LayoutChosenAsDocumented) {
     EXPECT_EQ(TriangleBvh<float>(mesh).ray_width(), cpu_has_avx2() ? 8 : 4);
     TriangleBvhOptions four, eight;
     four.ray_layout = RayLayout::Wide4;
-    eight.ray_layout = RayLayout::Wide8;
+    eight.ray_layout = RayLayout(1);  // the deprecated Wide8, which is Auto
     EXPECT_EQ(TriangleBvh<float>(mesh, four).ray_width(), 4);
     EXPECT_EQ(TriangleBvh<float>(mesh, eight).ray_width(), cpu_has_avx2() ? 8 : 4);
     EXPECT_FALSE(TriangleBvh<double>(mesh).traces_wide());
@@ -198,7 +198,7 @@ TEST(WideRays, SameAnswersAsTheBinaryWalkOnHardGeometry) {
     TriangleBvhOptions binary, four, eight, four_of_eights;
     binary.ray_layout = RayLayout::Binary;
     four.ray_layout = RayLayout::Wide4;
-    eight.ray_layout = RayLayout::Wide8;
+    eight.ray_layout = RayLayout::Auto;
     // The four-wide walk over a tree of leaves priced in eights: what a tree saved where the
     // eight-wide layout runs becomes on a CPU without AVX2.
     four_of_eights.ray_layout = RayLayout::Wide4;
@@ -444,7 +444,7 @@ TEST(WideRays, RefitWithANonFiniteVertexIsAnError) {
     const TriangleMesh mesh = make_sphere(3);
     const auto tris = test::placed<float>(mesh, 1, 0);
     const auto rays = rays_for(tris, test::scaled(2000), 7);
-    for (const RayLayout layout : {RayLayout::Binary, RayLayout::Wide4, RayLayout::Wide8}) {
+    for (const RayLayout layout : {RayLayout::Binary, RayLayout::Wide4, RayLayout::Auto}) {
         TriangleBvhOptions options;
         options.ray_layout = layout;
         for (const float bad :
@@ -572,7 +572,7 @@ TEST(WideRays, FourAbreastTestEqualsTheScalarTest) {
 TEST(BatchRays, EqualTheOneByOneCallsOnEveryThreadCount) {
     const auto tris = test::placed<float>(make_sphere(4), 1, 1e3);
     const auto rays = rays_for(tris, test::scaled(30000, 3), 5);
-    for (const RayLayout layout : {RayLayout::Binary, RayLayout::Wide4, RayLayout::Wide8}) {
+    for (const RayLayout layout : {RayLayout::Binary, RayLayout::Wide4, RayLayout::Auto}) {
         TriangleBvhOptions options;
         options.ray_layout = layout;
         const TriangleBvh<float> bvh(tris, options);
