@@ -452,7 +452,7 @@ class ClosestPointMesh {
 
     AabbBvh<T, 3> bvh_;
     std::vector<Triangle<T>> tris_;         // leaf-slot order, then one of padding
-    WideBvh4<T> wide_;                      // bvh_ collapsed, for closest_point
+    WideSlotBvh<T> wide_;                   // bvh_ collapsed, for closest_point
     std::vector<TrianglePack4<T>> packs_;   // wide_'s leaf groups: triangles four abreast
     std::vector<AccurateFrame<T>> frames_;  // leaf-slot order, where W is double (see above)
     T longest_edge_ = 0;                    // the mesh's longest edge (finite triangles)
