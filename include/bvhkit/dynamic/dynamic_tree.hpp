@@ -313,7 +313,7 @@ class DynamicTree {
         dynamic_detail::check_vector(direction, "direction", "DynamicTree::ray_cast");
         check_fraction(max_fraction, "DynamicTree::ray_cast");
         const Guard guard(walks_);
-        dynamic_detail::cast(view(), dynamic_detail::Segment<T, N>(origin, direction),
+        dynamic_detail::cast(view(), dynamic_detail::CastSegment<T, N>(origin, direction),
                              CastInput<T, N>{origin, direction, VecT{}, max_fraction}, callback,
                              stats);
     }
@@ -328,7 +328,7 @@ class DynamicTree {
         const Guard guard(walks_);
         const VecT centre = safe_centroid(box);
         dynamic_detail::cast(
-            view(), dynamic_detail::Segment<T, N>(centre, translation),
+            view(), dynamic_detail::CastSegment<T, N>(centre, translation),
             CastInput<T, N>{centre, translation, box.max * T(0.5) - box.min * T(0.5), max_fraction},
             callback, stats);
     }
