@@ -39,24 +39,19 @@ TEST(NearestWide, SharedMeshesFarFromTheOrigin) {
 }
 
 // The bunny (0.25 across) moved by 1e4 in float: its corners round to ~1e-3, and 603 of its
-// triangles end up with p0 == p1. FAILS as of this commit, because of closest_point()
-// (primitives/closest_point.hpp), not the wide walk: for a triangle with p0 == p1 every point with
-// dot(p2 - p0, p - p0) > 0 falls into the "edge p0-p1" branch (d1 = d3 = 0, vc = 0), whose
-// s = d1 / (d1 - d3) is 0 / 0, so the closest point and distance are NaN. The brute force then
-// sorts NaNs, ClosestPointMesh ignores those triangles (NaN < best is false) and k_nearest returns
-// them with NaN distances (its `d2 > radius2` test lets NaN in). Checked: it passes when that
-// branch is taken only for d1 > d3 (an edge of nonzero length; the point then reaches the p0-p2
-// branch). See TriangleWithFirstTwoCornersEqual.
+// triangles end up with p0 == p1. closest_point() (primitives/closest_point.hpp) must not take
+// the "edge p0-p1" branch for them (d1 = d3 = 0 there, so s = d1 / (d1 - d3) would be 0 / 0 and
+// the point NaN, which ClosestPointMesh would never report and k_nearest would return). See
+// TriangleWithFirstTwoCornersEqual.
 TEST(NearestWide, SharedBunnyFloatFarFromTheOrigin) {
     BVHKIT_REQUIRE_MESH(path, "stanford-bunny.obj");
     test::check_against_brute_force(test::moved<float>(read_mesh(path), 1e4f),
                                     test::scaled(100, 10), 37);
 }
 
-// FAILS as of this commit (see above): a triangle whose first two corners are equal is the
-// segment from p1 to p2, but closest_point() gives NaN for every point with
-// dot(p2 - p0, p - p0) > 0, so ClosestPointMesh never reports it (and returns nothing, or a farther
-// triangle).
+// A triangle whose first two corners are equal is the segment from p1 to p2: closest_point()
+// gives its closest point (not NaN) for a point with dot(p2 - p0, p - p0) > 0, and ClosestPointMesh
+// reports it, alone and beside a farther triangle.
 TEST(NearestWide, TriangleWithFirstTwoCornersEqual) {
     const Trianglef segment{{0, 0, 0}, {0, 0, 0}, {1, 0, 0}};
     const Vec3f p(0.5f, 1.0f, 0.0f);

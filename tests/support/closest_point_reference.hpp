@@ -127,8 +127,9 @@ std::vector<Triangle<T>> moved(const TriangleMesh& mesh, T offset, T scale = T(1
     return out;
 }
 
-/// Triangles with p0 == p1 != p2 get p1 and p2 swapped (the same segment): closest_point() gives
-/// NaN for them (TriangleWithFirstTwoCornersEqual), which would break the brute force.
+/// Triangles with p0 == p1 != p2 get p1 and p2 swapped (the same segment), so that the soups'
+/// segments come with distinct first corners (TriangleWithFirstTwoCornersEqual tests the other
+/// form).
 template <class T>
 std::vector<Triangle<T>> no_equal_first_corners(std::vector<Triangle<T>> tris) {
     for (auto& t : tris)
