@@ -8,10 +8,10 @@
 // BuildReport / skipped()); degenerate (zero-area) triangles stay in the tree and are never hit.
 // A ray with a NaN or infinite component or a zero direction misses without walking the tree.
 //
-// Batches of rays: trace() and occluded() over spans, on every core with oneTBB; trace_stream()
-// and occluded_stream() on the calling thread. On the eight-wide layout a batch walks several
-// rays at once (query/ray_stream.hpp; occlusion rays below 8 MB in octant streams,
-// query/ray_octant_stream.hpp): the one-by-one calls' answers, bit for bit.
+// Batches of rays: trace() and occluded() over spans, on every core with oneTBB;
+// trace_on_calling_thread() and occluded_stream() on the calling thread. On the eight-wide layout a
+// batch walks several rays at once (query/ray_stream.hpp; occlusion rays below 8 MB in octant
+// streams, query/ray_octant_stream.hpp): the one-by-one calls' answers, bit for bit.
 //
 // The triangle test is TriangleBvhOptions::triangle_test: watertight by default (no ray slips
 // through a shared edge or vertex of a closed mesh), or the fast Moller-Trumbore test, which can
@@ -124,8 +124,9 @@ class QueryExclusion {
 /// Which tree rays walk. The wide layouts serve float trees with the watertight test, on x86
 /// (query/ray_wide.hpp); anything else walks the binary tree.
 enum class RayLayout {
-    Auto,    // eight wide when the CPU has AVX2, else four wide (the default)
-    Wide8,   // eight wide; four wide on a CPU without AVX2
+    Auto,  // eight wide when the CPU has AVX2, else four wide (the default)
+    // Kept one release, its value (1) too: saved files carry it.
+    Wide8 [[deprecated("use Auto: Wide8 always behaved as Auto")]],
     Wide4,   // four wide (SSE2)
     Binary,  // the binary tree only
 };
@@ -233,12 +234,12 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
 
     /// hits[i] = closest_hit(rays[i]) for every ray, on the calling thread (an Error when the
     /// spans differ in length).
-    void trace_stream(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
+    void trace_on_calling_thread(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
         const Reading reading(exclusion_);
 #if BVHKIT_RAY_AVX2
         if constexpr (std::is_same_v<T, float>)
             if (streams_rays()) {
-                this->check_lengths(rays.size(), hits.size(), "trace_stream: hits");
+                this->check_lengths(rays.size(), hits.size(), "trace_on_calling_thread: hits");
                 stream<false>(
                     rays,
                     [&](const detail::StreamRay& s) {
@@ -249,7 +250,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
                 return;
             }
 #endif
-        RayBatches<TriangleBvh<T>, T>::trace_stream(rays, hits);
+        RayBatches<TriangleBvh<T>, T>::trace_on_calling_thread(rays, hits);
     }
     /// occluded[i] = any_hit(rays[i]) (1 or 0) for every ray, on the calling thread.
     void occluded_stream(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded) const {

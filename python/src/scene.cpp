@@ -207,7 +207,7 @@ class Scene {
         ray_chunks(origins, directions, limits, threads,
                    [&](std::size_t first, std::span<const Ray3> chunk) {
                        Hit<T> hits[ray_chunk];
-                       rays_.trace_stream(chunk, std::span<Hit<T>>(hits, chunk.size()));
+                       rays_.trace_on_calling_thread(chunk, std::span<Hit<T>>(hits, chunk.size()));
                        for (std::size_t j = 0; j < chunk.size(); ++j) {
                            const Hit<T>& h = hits[j];
                            const std::size_t i = first + j;

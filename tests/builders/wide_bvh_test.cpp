@@ -1,4 +1,4 @@
-// WideBvh4 (bvh/wide_bvh.hpp): collapse_to_wide of every builder's tree passes validate(), and
+// WideSlotBvh (bvh/wide_bvh.hpp): collapse_to_wide of every builder's tree passes validate(), and
 // keeps what the header promises, checked here independently of validate(): an inner child holds
 // more than leaf_limit primitives, a leaf child at most leaf_limit or exactly one binary leaf, a
 // leaf child's groups are the fewest that hold its slots (padding only at the end), every group
@@ -47,7 +47,8 @@ std::vector<Aabb<T, 3>> slot_boxes_of(const Bvh<Aabb<T, 3>>& bvh,
 
 /// The valid slots of a leaf child, in group order.
 template <class T>
-std::vector<std::uint32_t> leaf_slots(const WideBvh4<T>& wide, const WideNode4<T>& node, int c) {
+std::vector<std::uint32_t> leaf_slots(const WideSlotBvh<T>& wide, const WideSlotNode<T>& node,
+                                      int c) {
     std::vector<std::uint32_t> out;
     for (std::size_t i = std::size_t(node.child[c]) * 4;
          i < (std::size_t(node.child[c]) + node.groups[c]) * 4; ++i)
@@ -57,7 +58,7 @@ std::vector<std::uint32_t> leaf_slots(const WideBvh4<T>& wide, const WideNode4<T
 
 /// The structure collapse promises (see the top of the file); returns the primitives under w.
 template <class T>
-std::size_t check_node(const WideBvh4<T>& wide, std::uint32_t w, std::uint32_t leaf_limit,
+std::size_t check_node(const WideSlotBvh<T>& wide, std::uint32_t w, std::uint32_t leaf_limit,
                        const std::map<std::uint32_t, std::uint32_t>& binary_leaves,
                        std::vector<std::uint8_t>& group_owner, std::size_t& failures) {
     const auto& node = wide.nodes[w];
@@ -119,12 +120,12 @@ void check_collapse(const Bvh<Aabb<T, 3>>& bvh, const std::vector<Aabb<T, 3>>& b
     SCOPED_TRACE("leaf_limit " + std::to_string(leaf_limit));
     ASSERT_NO_THROW(validate(bvh, std::span<const Aabb<T, 3>>(boxes)));
     const auto slot_boxes = slot_boxes_of(bvh, boxes);
-    const WideBvh4<T> wide = collapse_to_wide(bvh, leaf_limit);
+    const WideSlotBvh<T> wide = collapse_to_wide(bvh, leaf_limit);
     ASSERT_NO_THROW(validate(wide, slot_boxes));
     ASSERT_EQ(wide.empty(), bvh.empty());
     // Eight wide (the AVX ray layout): every slot once, inside its boxes, and the same leaf
     // children (the subtrees that do not open do not depend on the width).
-    const WideBvh<T, 8> wide8 = collapse_to_wide<T, 8>(bvh, leaf_limit);
+    const WideSlotBvh<T, 8> wide8 = collapse_to_wide<T, 8>(bvh, leaf_limit);
     ASSERT_NO_THROW(validate(wide8, slot_boxes));
     EXPECT_EQ(wide8.group_count(), wide.group_count());
     // Lanes filled by opening small subtrees too (the eight-wide ray layout): still every slot
@@ -164,24 +165,24 @@ void check_every_builder(const std::vector<Triangle<T>>& tris) {
     }
 }
 
-TEST(WideBvh, EveryBuilderOnASoupFloatAndDouble) {
+TEST(WideSlotBvh, EveryBuilderOnASoupFloatAndDouble) {
     check_every_builder(test::random_soup<float>(test::scaled(3000, 5), 21));
     check_every_builder(test::random_soup<double>(test::scaled(3000, 5), 22));
 }
 
-TEST(WideBvh, EveryBuilderOnSharedBunny) {
+TEST(WideSlotBvh, EveryBuilderOnSharedBunny) {
     BVHKIT_REQUIRE_MESH(path, "stanford-bunny.obj");
     check_every_builder(mesh_triangles<float>(read_mesh(path)));
 }
 
-TEST(WideBvh, EveryBuilderOnSharedFandisk) {
+TEST(WideSlotBvh, EveryBuilderOnSharedFandisk) {
     BVHKIT_REQUIRE_MESH(path, "fandisk.obj");
     const TriangleMesh mesh = read_mesh(path);
     check_every_builder(mesh_triangles<float>(mesh));
     check_every_builder(mesh_triangles<double>(mesh));
 }
 
-TEST(WideBvh, LargeLeavesSmallLeavesAndSkippedPrimitives) {
+TEST(WideSlotBvh, LargeLeavesSmallLeavesAndSkippedPrimitives) {
     auto tris = test::random_soup<float>(test::scaled(2000, 5), 23);
     // A few primitives with NaN corners: the builders leave them out, so slots < primitives.
     for (std::size_t i = 0; i < tris.size(); i += 97)
@@ -203,7 +204,7 @@ TEST(WideBvh, LargeLeavesSmallLeavesAndSkippedPrimitives) {
     EXPECT_LT(wide.group_count(), bvh.primitive_indices.size() / 2);
 }
 
-TEST(WideBvh, EmptyAndOnePrimitive) {
+TEST(WideSlotBvh, EmptyAndOnePrimitive) {
     const Bvh<Aabb3f> empty;
     const auto wide = collapse_to_wide(empty);
     EXPECT_TRUE(wide.empty());
@@ -233,7 +234,7 @@ TEST(WideBvh, EmptyAndOnePrimitive) {
 /// A wide tree with several levels and padded groups, and its slot boxes, for corrupting.
 struct Corruptible {
     std::vector<Aabb3f> slot_boxes;
-    WideBvh4<float> wide;
+    WideSlotBvh<float> wide;
     Corruptible() {
         const auto tris = test::random_soup<float>(2000, 24);
         const auto boxes = boxes_of(tris);
@@ -255,7 +256,7 @@ struct Corruptible {
     }
     /// Shrinks the box of the first child (leaf or inner as asked) to its low face on an axis
     /// where its content reaches past that face; false when there is none.
-    bool shrink(bool leaf, WideBvh4<float>& out) const {
+    bool shrink(bool leaf, WideSlotBvh<float>& out) const {
         out = wide;
         for (std::uint32_t w = 0; w < wide.nodes.size(); ++w)
             for (int c = 0; c < 4; ++c) {
@@ -272,11 +273,11 @@ struct Corruptible {
     }
 };
 
-TEST(WideBvh, ValidateRejectsCorruptedTrees) {
+TEST(WideSlotBvh, ValidateRejectsCorruptedTrees) {
     const Corruptible t;
     ASSERT_NO_THROW(validate(t.wide, t.slot_boxes));
     ASSERT_GT(t.wide.nodes.size(), 4u);
-    WideBvh4<float> bad;
+    WideSlotBvh<float> bad;
 
     // A leaf lane's box shrunk below its slots' boxes; an inner lane's below its child's boxes.
     ASSERT_TRUE(t.shrink(true, bad));

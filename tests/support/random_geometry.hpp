@@ -97,4 +97,39 @@ std::vector<Triangle<T>> placed(const TriangleMesh& mesh, double scale, double o
     return out;
 }
 
+/// Rays through the triangles' bounding box: from outside and inside, some aimed exactly at a
+/// vertex or along an axis, some with direction components +0, -0 or subnormal.
+inline std::vector<Ray<float, 3>> rays_through_box(const std::vector<Triangle<float>>& tris,
+                                                   std::size_t n, std::uint64_t seed) {
+    Aabb<float, 3> box;
+    for (const auto& t : tris) box.grow(t.bounds());
+    const Vec<double, 3> lo{box.min[0], box.min[1], box.min[2]};
+    const Vec<double, 3> ext{double(box.max[0]) - lo[0], double(box.max[1]) - lo[1],
+                             double(box.max[2]) - lo[2]};
+    Random rng(seed);
+    std::vector<Ray<float, 3>> rays;
+    for (std::size_t i = 0; i < n; ++i) {
+        Vec<double, 3> o, target;
+        const double spread = i % 5 == 0 ? 0.5 : 3.0;  // one in five starts inside the box
+        for (int k = 0; k < 3; ++k) {
+            o[k] = lo[k] + ext[k] * (0.5 + spread * rng.uniform(-0.5, 0.5));
+            target[k] = lo[k] + ext[k] * rng.uniform(0, 1);
+        }
+        if (i % 7 == 0) {
+            const auto& t = tris[rng.below(std::uint32_t(tris.size()))];
+            target = {t.p0[0], t.p0[1], t.p0[2]};
+        }
+        Ray<float, 3> ray;
+        for (int k = 0; k < 3; ++k) {
+            ray.origin[k] = float(o[k]);
+            ray.direction[k] = float(target[k] - double(ray.origin[k]));
+        }
+        if (i % 4 == 1) ray.direction[i % 3] = (i / 4) % 2 ? 0.0f : -0.0f;
+        if (i % 11 == 3) ray.direction[(i + 1) % 3] = (i / 11) % 2 ? 1e-40f : -1e-41f;
+        if (i % 13 == 5) ray.tmax = float(rng.uniform(0, 1));  // short rays
+        rays.push_back(ray);
+    }
+    return rays;
+}
+
 }  // namespace bvhkit::test

@@ -20,7 +20,7 @@ void visit_in_order(const BspTree<T, N>& tree, const Vec<T, N>& eye, bool front_
         bool emit;  // the node's own polygons, its subtrees already scheduled
     };
     const auto& nodes = tree.nodes();
-    TraversalStack<Entry> stack(2 * tree.statistics().depth + 4);
+    BspTraversalStack<Entry> stack(2 * tree.statistics().depth + 4);
     stack.push({0, false});
     while (!stack.empty()) {
         const Entry e = stack.pop();

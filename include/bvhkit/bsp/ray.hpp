@@ -100,7 +100,7 @@ BspHit<T> closest_hit(const BspTree<T, N>& tree, const Ray<T, N>& ray,
     const auto& pool = tree.polygons();
     // Twice the build's thickness: the traversal's distances round differently from the build's.
     const T eps = T(2) * tree.epsilon();
-    bsp_detail::TraversalStack<Entry> stack(tree.statistics().depth + 2);
+    bsp_detail::BspTraversalStack<Entry> stack(tree.statistics().depth + 2);
     stack.push({0, ray.tmin, ray.tmax});
     std::size_t visited = 0, tested = 0;
     // tmax is inclusive in the caller's ray: test up to just past it, then drop a hit beyond.

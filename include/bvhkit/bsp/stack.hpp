@@ -9,17 +9,17 @@
 namespace bvhkit::bsp_detail {
 
 template <class E>
-class TraversalStack {
+class BspTraversalStack {
   public:
     static constexpr std::size_t inline_capacity = tuning::bsp_stack_inline;
-    explicit TraversalStack(std::size_t capacity) {
+    explicit BspTraversalStack(std::size_t capacity) {
         if (capacity > inline_capacity) {
             heap_.resize(capacity);
             data_ = heap_.data();
         }
     }
-    TraversalStack(const TraversalStack&) = delete;
-    TraversalStack& operator=(const TraversalStack&) = delete;
+    BspTraversalStack(const BspTraversalStack&) = delete;
+    BspTraversalStack& operator=(const BspTraversalStack&) = delete;
     void push(const E& e) { data_[size_++] = e; }
     E pop() { return data_[--size_]; }
     bool empty() const { return size_ == 0; }

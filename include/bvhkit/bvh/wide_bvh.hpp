@@ -1,8 +1,8 @@
 #pragma once
-// WideBvh<T, W> (WideBvh4<T> for W = 4): a binary Bvh of 3D boxes collapsed into nodes of up to W
-// children whose boxes lie side by side, one array per axis and bound, so that one SIMD instruction
-// measures a point against all of them (W = 4 for SSE, 8 for AVX) (the wide layout of Wald, Benthin
-// and Boulos 2008, "Getting rid of packets", and Dammertz et al. 2008, "Shallow bounding volume
+// WideSlotBvh<T, W = 4>: a binary Bvh of 3D boxes collapsed into nodes of up to W children whose
+// boxes lie side by side, one array per axis and bound, so that one SIMD instruction measures a
+// point against all of them (W = 4 for SSE, 8 for AVX) (the wide layout of Wald, Benthin and
+// Boulos 2008, "Getting rid of packets", and Dammertz et al. 2008, "Shallow bounding volume
 // hierarchies"). Half as many levels as the binary tree means half as many dependent loads on a
 // walk that misses the caches at every node.
 //
@@ -20,7 +20,7 @@
 namespace bvhkit {
 
 template <class T, int W = 4>
-struct alignas(64) WideNode {
+struct alignas(64) WideSlotNode {
     static constexpr int width = W;
     T lo[3][W];  // lo[axis][child]: the children's boxes
     T hi[3][W];
@@ -36,18 +36,24 @@ struct alignas(64) WideNode {
 };
 
 template <class T, int W = 4>
-struct WideBvh {
-    std::vector<WideNode<T, W>> nodes;       // nodes[0] is the root; empty for an empty tree
+struct WideSlotBvh {
+    std::vector<WideSlotNode<T, W>> nodes;   // nodes[0] is the root; empty for an empty tree
     std::vector<std::uint32_t> group_slots;  // four slots a group; invalid_index pads
 
     bool empty() const { return nodes.empty(); }
     std::size_t group_count() const { return group_slots.size() / 4; }
 };
 
+// The former names, kept for one release: "WideBvh" read as the ray layout's WideRayBvh
+// (query/ray_wide_layout.hpp), a different format (its leaves hold triangles, these slots).
+template <class T, int W = 4>
+using WideNode [[deprecated("use WideSlotNode")]] = WideSlotNode<T, W>;
 template <class T>
-using WideNode4 = WideNode<T, 4>;
+using WideNode4 [[deprecated("use WideSlotNode")]] = WideSlotNode<T, 4>;
+template <class T, int W = 4>
+using WideBvh [[deprecated("use WideSlotBvh")]] = WideSlotBvh<T, W>;
 template <class T>
-using WideBvh4 = WideBvh<T, 4>;
+using WideBvh4 [[deprecated("use WideSlotBvh")]] = WideSlotBvh<T, 4>;
 
 namespace wide_detail {
 
@@ -109,18 +115,18 @@ void append_leaf_groups(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t n,
 
 }  // namespace wide_detail
 
-/// Collapses `bvh` into a WideBvh<T, W>. An inner binary node takes up to W children by opening,
-/// of its children and grandchildren, the one of largest area until W or none is left to open;
-/// a subtree of at most `leaf_limit` primitives becomes one leaf child. With `fill_lanes`, any
-/// inner binary node may open to fill a node's lanes, also one of at most `leaf_limit` primitives
-/// (whose halves then become two leaf children): the nodes come out full, as a builder that
-/// splits the largest child until the node is full makes them, where without it a node whose
+/// Collapses `bvh` into a WideSlotBvh<T, W>. An inner binary node takes up to W children by
+/// opening, of its children and grandchildren, the one of largest area until W or none is left to
+/// open; a subtree of at most `leaf_limit` primitives becomes one leaf child. With `fill_lanes`,
+/// any inner binary node may open to fill a node's lanes, also one of at most `leaf_limit`
+/// primitives (whose halves then become two leaf children): the nodes come out full, as a builder
+/// that splits the largest child until the node is full makes them, where without it a node whose
 /// children are all small enough to be leaves stays at two or three lanes (igea, eight wide,
 /// leaf_limit 8: 3.7 lanes a node on average without, 6.9 with).
 template <class T, int W = 4>
-WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4,
-                               bool fill_lanes = false) {
-    WideBvh<T, W> out;
+WideSlotBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4,
+                                   bool fill_lanes = false) {
+    WideSlotBvh<T, W> out;
     if (bvh.empty()) return out;
     const auto& nodes = bvh.nodes;
     const std::vector<std::uint32_t> under = wide_detail::primitives_under(bvh);
@@ -142,7 +148,7 @@ WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_li
         const int size = !opens(b)    ? 1
                          : fill_lanes ? wide_detail::pick_lanes<W>(bvh, b, fills, lanes)
                                       : wide_detail::pick_lanes<W>(bvh, b, opens, lanes);
-        WideNode<T, W> node{};
+        WideSlotNode<T, W> node{};
         for (int c = 0; c < W; ++c) {
             node.child[c] = invalid_index;
             for (int a = 0; a < 3; ++a) node.lo[a][c] = T(0), node.hi[a][c] = T(0);
@@ -168,8 +174,8 @@ WideBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_li
 /// Throws Error unless `wide` holds every slot of [0, slot_boxes.size()) exactly once, each inside
 /// its leaf child's box, and every inner child's box holds its node's boxes.
 template <class T, int W>
-void validate(const WideBvh<T, W>& wide, const std::vector<Aabb<T, 3>>& slot_boxes) {
-    const auto fail = [](const std::string& what) { throw Error("WideBvh: " + what); };
+void validate(const WideSlotBvh<T, W>& wide, const std::vector<Aabb<T, 3>>& slot_boxes) {
+    const auto fail = [](const std::string& what) { throw Error("WideSlotBvh: " + what); };
     if (wide.empty()) {
         if (!slot_boxes.empty())
             fail("empty tree over " + std::to_string(slot_boxes.size()) + " slots");

@@ -81,14 +81,14 @@ void query_point(const TreeView<T, N, U>& t, const Vec<T, N>& p, F&& callback, Q
     query_box(t, Aabb<T, N>(p, p), callback, stats);
 }
 
-/// A segment origin + s * direction, s in [0, max_fraction], tested with the library's slab test
-/// (math/ray.hpp: exact for +0/-0 direction components, conservative after Ize 2013) against boxes
-/// grown by a pad (zero for a ray cast, the cast box's half extents for a box cast).
+/// A cast's segment origin + s * direction, s in [0, max_fraction], tested with the library's slab
+/// test (math/ray.hpp: exact for +0/-0 direction components, conservative after Ize 2013) against
+/// boxes grown by a pad (zero for a ray cast, the cast box's half extents for a box cast).
 template <class T, std::size_t N>
-struct Segment {
+struct CastSegment {
     RaySlabData<T, N> slab;
 
-    Segment(const Vec<T, N>& o, const Vec<T, N>& d) : slab(Ray<T, N>(o, d)) {}
+    CastSegment(const Vec<T, N>& o, const Vec<T, N>& d) : slab(Ray<T, N>(o, d)) {}
 
     /// The entry fraction (0 when the origin is inside), or a negative value on a miss.
     T entry(const Aabb<T, N>& box, const Vec<T, N>& pad, T max_fraction) const {
@@ -109,8 +109,8 @@ struct Segment {
 /// first, so a callback that clips (closest hit) shortens the segment early and the farther
 /// subtrees are dropped when popped: their entry then lies beyond the new max fraction.
 template <class T, std::size_t N, class U, class F>
-void cast(const TreeView<T, N, U>& t, const Segment<T, N>& seg, CastInput<T, N> in, F&& callback,
-          QueryStats* stats) {
+void cast(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, CastInput<T, N> in,
+          F&& callback, QueryStats* stats) {
     if (t.root == kNullNode) return;
     const Vec<T, N> pad = in.half_extent;
     T& max_fraction = in.max_fraction;

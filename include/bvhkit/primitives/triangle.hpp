@@ -88,6 +88,14 @@ struct WatertightRay {
     }
 };
 
+/// A triangle's corners moved to a watertight ray's origin and sheared so that the ray runs along
+/// its kz axis: x and y across the ray, z along it; a, b, c are the corners p0, p1, p2. What
+/// watertight_finish takes.
+template <class T>
+struct ShearedTriangle {
+    T ax, ay, az, bx, by, bz, cx, cy, cz;
+};
+
 namespace detail {
 /// Keeps `x` as computed: stops the compiler from fusing the product that made it into a later
 /// subtraction (an FMA there would make a shared edge's two edge functions differ in more than
@@ -106,9 +114,9 @@ template <class T>
 /// watertight_finish's paths. Gives t (before any power of two of the scaled path), det and the
 /// edge functions of p1 and p2, whose quotients by det are the barycentrics.
 template <class W>
-[[gnu::always_inline]] inline bool watertight_solve(W ax, W ay, W az, W bx, W by, W bz, W cx, W cy,
-                                                    W cz, W dz, W& t, W& det, W& ev_out,
-                                                    W& ew_out) {
+[[gnu::always_inline]] inline bool watertight_solve(const ShearedTriangle<W>& s, W dz, W& t, W& det,
+                                                    W& ev_out, W& ew_out) {
+    const auto [ax, ay, az, bx, by, bz, cx, cy, cz] = s;
     const W eu = opaque(cx * by) - opaque(cy * bx);  // edge b-c: weight of p0
     const W ev = opaque(ax * cy) - opaque(ay * cx);  // edge c-a: weight of p1
     const W ew = opaque(bx * ay) - opaque(by * ax);  // edge a-b: weight of p2
@@ -203,34 +211,40 @@ inline int scale_exponent(double x) {
 /// and d[kz] are scaled apart. Inside the window nothing is scaled and the bits are as before.
 /// Float corners never need it: their products of three stay within double's range.
 template <class T>
-inline bool watertight_finish(const WatertightRay<T>& r, T ax_, T ay_, T az, T bx_, T by_, T bz,
-                              T cx_, T cy_, T cz, T tmin, T tmax, TriangleHit<T>& hit) {
+inline bool watertight_finish(const WatertightRay<T>& r, const ShearedTriangle<T>& s, T tmin,
+                              T tmax, TriangleHit<T>& hit) {
     using W = typename WatertightRay<T>::Wide;
     W t_wide, det, ev, ew;
     if constexpr (std::is_same_v<T, double>) {
-        const int e[3] = {detail::corner_exponent(ax_, ay_), detail::corner_exponent(bx_, by_),
-                          detail::corner_exponent(cx_, cy_)};
-        const double mz = std::max({std::fabs(az), std::fabs(bz), std::fabs(cz)});
+        const int e[3] = {detail::corner_exponent(s.ax, s.ay), detail::corner_exponent(s.bx, s.by),
+                          detail::corner_exponent(s.cx, s.cy)};
+        const double mz = std::max({std::fabs(s.az), std::fabs(s.bz), std::fabs(s.cz)});
         if ((e[0] | e[1] | e[2]) == 0 && detail::in_direct_window(mz) &&
             detail::in_direct_window(r.dz)) {
-            if (!detail::watertight_solve<W>(ax_, ay_, az, bx_, by_, bz, cx_, cy_, cz, r.dz, t_wide,
-                                             det, ev, ew))
-                return false;
-        } else if (!detail::watertight_solve_scaled(e, {ax_, bx_, cx_}, {ay_, by_, cy_},
-                                                    {az, bz, cz}, r.dz, t_wide, det, ev, ew)) {
+            if (!detail::watertight_solve<W>(s, r.dz, t_wide, det, ev, ew)) return false;
+        } else if (!detail::watertight_solve_scaled(e, {s.ax, s.bx, s.cx}, {s.ay, s.by, s.cy},
+                                                    {s.az, s.bz, s.cz}, r.dz, t_wide, det, ev,
+                                                    ew)) {
             return false;
         }
     } else {
-        const W ax = ax_, ay = ay_, bx = bx_, by = by_, cx = cx_, cy = cy_;
-        if (!detail::watertight_solve<W>(ax, ay, W(az), bx, by, W(bz), cx, cy, W(cz), r.dz, t_wide,
-                                         det, ev, ew))
-            return false;
+        const ShearedTriangle<W> w{W(s.ax), W(s.ay), W(s.az), W(s.bx), W(s.by),
+                                   W(s.bz), W(s.cx), W(s.cy), W(s.cz)};
+        if (!detail::watertight_solve<W>(w, r.dz, t_wide, det, ev, ew)) return false;
     }
     const T t = T(t_wide);
     if (!(t >= tmin && t <= tmax) || !std::isfinite(t)) return false;
     const W inv_det = W(1) / det;
     hit = {t, T(ev * inv_det), T(ew * inv_det)};
     return true;
+}
+/// The corners one by one: kept for one release.
+template <class T>
+[[deprecated("use watertight_finish(r, ShearedTriangle<T>{...}, tmin, tmax, hit)")]] inline bool
+watertight_finish(const WatertightRay<T>& r, T ax, T ay, T az, T bx, T by, T bz, T cx, T cy, T cz,
+                  T tmin, T tmax, TriangleHit<T>& hit) {
+    return watertight_finish(r, ShearedTriangle<T>{ax, ay, az, bx, by, bz, cx, cy, cz}, tmin, tmax,
+                             hit);
 }
 
 /// The watertight test of the triangle (p0, p1, p2) for a ray prepared as `r`: hits with t in
@@ -249,7 +263,8 @@ inline bool intersect_watertight(const WatertightRay<T>& r, const Vec<T, 3>& p0,
     const T ax = (p0[r.kx] - r.ox) - opaque(r.sx * az), ay = (p0[r.ky] - r.oy) - opaque(r.sy * az);
     const T bx = (p1[r.kx] - r.ox) - opaque(r.sx * bz), by = (p1[r.ky] - r.oy) - opaque(r.sy * bz);
     const T cx = (p2[r.kx] - r.ox) - opaque(r.sx * cz), cy = (p2[r.ky] - r.oy) - opaque(r.sy * cz);
-    return watertight_finish(r, ax, ay, az, bx, by, bz, cx, cy, cz, tmin, tmax, hit);
+    return watertight_finish(r, ShearedTriangle<T>{ax, ay, az, bx, by, bz, cx, cy, cz}, tmin, tmax,
+                             hit);
 }
 
 template <class T>

@@ -113,9 +113,10 @@ template <class OnHit>
     for (int lane = 0; lane < 4; ++lane) {
         if ((rejected >> lane) & 1u) continue;
         TriangleHit<float> h;
-        if (watertight_finish(s, v[0][lane], v[1][lane], v[2][lane], v[3][lane], v[4][lane],
-                              v[5][lane], v[6][lane], v[7][lane], v[8][lane], tmin, tmax, h))
-            tmax = on_hit(lane, h);
+        const ShearedTriangle<float> sheared{v[0][lane], v[1][lane], v[2][lane],
+                                             v[3][lane], v[4][lane], v[5][lane],
+                                             v[6][lane], v[7][lane], v[8][lane]};
+        if (watertight_finish(s, sheared, tmin, tmax, h)) tmax = on_hit(lane, h);
     }
 }
 
@@ -168,9 +169,10 @@ template <class OnHit>
     for (; live; live &= live - 1) {
         const int lane = __builtin_ctz(live);
         TriangleHit<float> h;
-        if (watertight_finish(s, v[0][lane], v[1][lane], v[2][lane], v[3][lane], v[4][lane],
-                              v[5][lane], v[6][lane], v[7][lane], v[8][lane], tmin, tmax, h))
-            tmax = on_hit(lane, h);
+        const ShearedTriangle<float> sheared{v[0][lane], v[1][lane], v[2][lane],
+                                             v[3][lane], v[4][lane], v[5][lane],
+                                             v[6][lane], v[7][lane], v[8][lane]};
+        if (watertight_finish(s, sheared, tmin, tmax, h)) tmax = on_hit(lane, h);
     }
 }
 #endif

@@ -30,6 +30,7 @@
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/primitives/triangle_pack.hpp"
+#include "bvhkit/query/closest_point_search.hpp"
 #include "bvhkit/query/nearest.hpp"
 #include "bvhkit/query/nearest_wide.hpp"
 #include "bvhkit/query/point_order.hpp"
@@ -164,36 +165,10 @@ class ClosestPointMesh {
   private:
     friend struct serial_detail::ClosestPointMeshAccess;
 
-    /// A closest point's search limit: a squared distance in T, judged on the squared distance
-    /// rounded to T (closest_point's), or a distance, judged in W (closest_point_within's).
-    struct Limit {
-        using W = AccurateScalar<T>;
-        bool by_distance = false;
-        T squared_limit = std::numeric_limits<T>::infinity();
-        W distance_limit = 0, distance_limit2 = 0;  // by distance: the limit and its square in W
-        static Limit squared(T max2) { return {false, max2, 0, 0}; }
-        static Limit distance(W max) { return {true, 0, max, max * max}; }
-        bool none() const {
-            return by_distance ? !(distance_limit >= W(0)) : !(squared_limit >= T(0));
-        }
-        /// The limit squared and times scale^2, rounded up to T (inf past its range), to prune.
-        T scaled2(T scale) const {
-            if (!by_distance) return squared_limit * scale * scale;
-            const W s = distance_limit * W(scale);
-            return nearest_detail::round_up_key<T>(s * s);
-        }
-        bool admits(W d2) const {
-            if (!by_distance)  // (rounding to T: inf past its range)
-                return (d2 > W(std::numeric_limits<T>::max()) ? std::numeric_limits<T>::infinity()
-                                                              : T(d2)) <= squared_limit;
-            // Where the square leaves W's normal range (W is double: a double limit past 1e154),
-            // the distances are compared instead.
-            if (distance_limit2 >= std::numeric_limits<W>::min() &&
-                distance_limit2 < std::numeric_limits<W>::infinity())
-                return d2 <= distance_limit2;
-            return std::sqrt(d2) <= distance_limit;
-        }
-    };
+    template <class, class, class>
+    friend struct detail::ClosestPointSearch;
+    using Limit = detail::ClosestPointLimit<T>;
+
     // closest_point, its walk started from the triangle in leaf slot `start` when that is one.
     template <class Stats>
     MeshPoint<T> closest_point_from(const Vec<T, 3>& p, std::uint32_t start,
@@ -201,122 +176,22 @@ class ClosestPointMesh {
                                     Stats&& stats) const {
         // No distance is within a negative or NaN limit (and the walk would still measure).
         if (!is_finite(p) || limit.none()) return {};
-        using W = AccurateScalar<T>;
-        NearestSlot<T> best;
-        // Candidates are measured accurately, in W (closest_point_accurate), and compared there:
-        // a squared distance past T's range (a point 1e19 from a float mesh) still ranks. The
-        // walk ranks by the packs' float distances and measures accurately only at the end, and
-        // only the candidates that rounding leaves in the running: a pack's distance is within
-        // the slack of widened() of the true one, so a candidate can still win while its estimate
-        // is within twice that slack of the best estimate. Slivers (a pack's exact_lanes) and
-        // points too far for the pack's formula are measured at once. The packs hold the mesh
-        // scaled to unit magnitude (see build): p likewise, and the estimates and the search
-        // radius are kept in those units, where the squared distances of a mesh 1e-36 across
-        // (float) do not sink below T's least normal. The node walk gets the radius unscaled.
-        W best2 = std::numeric_limits<W>::infinity();          // accurate, unscaled
-        T best_estimate = std::numeric_limits<T>::infinity();  // scaled
-        auto& candidates = scratch.candidates;
-        candidates.clear();
-        const T limit2 = widened_scaled(limit.scaled2(pack_scale_));
-        T search2 = limit2;  // scaled
-        const Vec<T, 3> ps = p * pack_scale_;
-        // The pack formula squares lengths twice over: beyond 2^(max_exponent / 4) from the
-        // (unit) mesh it would overflow, and every lane is measured.
-        const bool scaled_ok =
-            max_component(abs(ps)) < std::ldexp(T(1), std::numeric_limits<T>::max_exponent / 4);
-        const T unscale = T(1) / pack_scale_;  // exact: a power of two (its square may not be)
-        // The radius for the node walk's unscaled boxes: search2 unscaled, exactly, unless that
-        // falls below 4 least normals, where rounding could drop a box within reach.
-        const auto box_radius = [&] {
-            return std::max(search2 * unscale * unscale, T(4) * std::numeric_limits<T>::min());
-        };
-        T box_radius2 = box_radius();
-        // The best triangle's answer is kept, not measured again at the end: the triangle
-        // measured is tris_[s] bit for bit (a pack's copy only when it unscales exactly).
-        AccurateClosestPoint<T> best_point;
-        // Candidates are ranked by their squared distance, which rounds by eps_W d^2: from a
-        // point far off (d beyond twice the mesh's extent) that is more than the gaps between
-        // its triangles' distances (1e16 from a float unit sphere, double's ulp there is 2). The
-        // ranking then uses far_key (see there), which rounds in proportion to the mesh's
-        // extent and coordinates, not to d.
-        const FarFrame far = far_frame(p);
-        W best_key = std::numeric_limits<W>::infinity();
-        const auto measure = [&](std::uint32_t s, const Triangle<T>& t) {
-            const AccurateClosestPoint<T> c = frames_.empty()
-                                                  ? closest_point_accurate(t, p)
-                                                  : closest_point_accurate(t, frames_[s], p);
-            const W d2 = c.distance_squared;
-            const W key = far.far ? far_key(far, t, c) : d2;
-            // The limit is judged as Limit::admits says. Of triangles with the same key the one
-            // in the lowest slot wins, whatever the order they were measured in: every triangle
-            // that ties with the best is measured (its estimate is within the slack), so the
-            // answer does not depend on where the walk started.
-            if ((key < best_key || (key == best_key && s < best.slot)) && limit.admits(d2))
-                best = {s, T(d2)}, best2 = d2, best_key = key, best_point = c;
-        };
-        const auto tighten = [&] {
-            T bound = std::min(limit2, widened_scaled(widened_scaled(best_estimate)));
-            if (best) bound = std::min(bound, widened_scaled(T(best2 * pack_scale_ * pack_scale_)));
-            search2 = bound;
-            box_radius2 = box_radius();
-        };
-        const auto open_leaf = [&](std::uint32_t first, std::uint32_t groups) {
-            for (std::uint32_t g = first; g < first + groups; ++g) {
-                const TrianglePack4<T>& pack = packs_[g];
-                for (int l = 0; l < 4; ++l)
-                    if (pack.slot[l] != invalid_index) stats.primitive();
-                T d[4];
-                const unsigned lanes =
-                    scaled_ok ? pack.lanes_within(ps, search2, d) : pack.used_lanes();
-                const unsigned now = scaled_ok ? lanes & pack.exact_lanes : lanes;
-                bool changed = false;
-                for (unsigned m = now; m; m &= m - 1) {
-                    const int l = __builtin_ctz(m);
-                    const std::uint32_t s = pack.slot[l];
-                    // The pack's own copy, in cache already, when it unscales exactly.
-                    measure(s, packs_unscale_exactly_ ? pack.triangle(l, unscale) : tris_[s]);
-                    changed = true;
-                }
-                for (unsigned m = lanes & ~now; m; m &= m - 1) {
-                    const int l = __builtin_ctz(m);
-                    const T estimate = d[l];
-                    candidates.push_back({estimate, pack.slot[l]});
-                    if (estimate < best_estimate) best_estimate = estimate, changed = true;
-                }
-                if (changed) tighten();
-            }
-        };
+        using Search =
+            detail::ClosestPointSearch<T, ClosestPointMesh, std::remove_reference_t<Stats>>;
+        Search search(*this, p, limit, stats, scratch);
         struct OpenLeaf {
-            decltype(open_leaf)& open;
+            Search& search;
             const TrianglePack4<T>* packs;
-            void operator()(std::uint32_t first, std::uint32_t groups) { open(first, groups); }
+            void operator()(std::uint32_t first, std::uint32_t groups) {
+                search.open_leaf(first, groups);
+            }
             std::uintptr_t address(std::uint32_t first) const {
                 return reinterpret_cast<std::uintptr_t>(packs) + first * sizeof(*packs);
             }
         };
-        if (start < triangle_slots_) {
-            // The nearest corner of the starting triangle bounds the distance from above, cheaply
-            // (measuring the triangle itself bounds it tighter but cost more than it saved). The
-            // bound is widened twice, as a pack's estimate is: its rounding is a few ulps of the
-            // distance, far inside one widening.
-            const Triangle<T>& t = tris_[start];
-            const auto scaled2 = [&](const Vec<T, 3>& corner) {
-                return length_squared((p - corner) * pack_scale_);
-            };
-            const T corner2 = std::min({scaled2(t.p0), scaled2(t.p1), scaled2(t.p2)});
-            search2 = std::min(search2, widened_scaled(widened_scaled(corner2)));
-            box_radius2 = box_radius();
-        }
-        nearest_wide(wide_, p, scratch, box_radius2, OpenLeaf{open_leaf, packs_.data()}, stats);
-        // Nearest estimate first; stop at the first whose estimate rounding cannot bring below
-        // the best measured so far.
-        std::sort(candidates.begin(), candidates.end());
-        for (const auto& [estimate, s] : candidates) {
-            if (best && estimate > widened_scaled(T(best2 * pack_scale_ * pack_scale_))) break;
-            if (estimate > search2) break;
-            measure(s, tris_[s]);
-        }
-        return best ? point_of(best.slot, best_point) : MeshPoint<T>{};
+        if (start < triangle_slots_) search.start_from(start);
+        nearest_wide(wide_, p, scratch, search.box_radius2, OpenLeaf{search, packs_.data()}, stats);
+        return search.finish() ? point_of(search.best.slot, search.best_point) : MeshPoint<T>{};
     }
 
     void build(const std::vector<Triangle<T>>& tris, const BuildOptions& options) {
@@ -577,7 +452,7 @@ class ClosestPointMesh {
 
     AabbBvh<T, 3> bvh_;
     std::vector<Triangle<T>> tris_;         // leaf-slot order, then one of padding
-    WideBvh4<T> wide_;                      // bvh_ collapsed, for closest_point
+    WideSlotBvh<T> wide_;                   // bvh_ collapsed, for closest_point
     std::vector<TrianglePack4<T>> packs_;   // wide_'s leaf groups: triangles four abreast
     std::vector<AccurateFrame<T>> frames_;  // leaf-slot order, where W is double (see above)
     T longest_edge_ = 0;                    // the mesh's longest edge (finite triangles)

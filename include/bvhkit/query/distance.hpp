@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "bvhkit/math/wide_length.hpp"
@@ -109,12 +110,179 @@ struct ScaledSquare {
     }
 };
 
+/// A query's limits from the models' scales and the pose: `slack`, by which the volumes' bounds are
+/// widened (infinite, turning pruning off, where their squares would leave T's range), and
+/// `window_top`, whether every coordinate in A's frame stays within 2^150.
+template <class T>
+struct DistanceLimits {
+    T slack;
+    bool window_top;
+};
+
+template <class T>
+DistanceLimits<T> distance_limits(T scale_a, T scale_b, const Transform<T>& pose_of_b_in_a) {
+    // The volumes' distance bounds square lengths of the scene in T: where those squares leave
+    // T's range (float models near 1e19 and beyond) a bound can overflow to inf and drop the
+    // closest pair. Such models are measured without pruning (an infinite slack makes every
+    // bound -inf): every pair, exactly; slow, but right.
+    const T extent =
+        scale_a + scale_b +
+        max_component(bvhkit::max(pose_of_b_in_a.translation, -pose_of_b_in_a.translation));
+    // At the other end the squares sink below T's normal range (models near 1e-154 in double,
+    // 1e-19 in float), and a length rooted from them may be off by up to sqrt(2.5 denorm_min):
+    // 16 sqrt(denorm_min) more slack keeps any bound made of a few such lengths below the true
+    // distance (at ordinary scales it vanishes in the slack's rounding; models far below, it
+    // turns pruning off as above).
+    const T slack = std::isfinite(T(16) * extent * extent)
+                        ? pose_slack(scale_a, scale_b, pose_of_b_in_a) +
+                              T(16) * std::sqrt(std::numeric_limits<T>::denorm_min())
+                        : std::numeric_limits<T>::infinity();
+    // Whether every coordinate in A's frame is within 2^150: |R x + t| <= sqrt(3) |x| + |t| in
+    // the largest component, so twice the extent (rounding included) bounds them.
+    return {slack, 2 * double(extent) <= 0x1p150};
+}
+
+/// A pending node pair of distance()'s search and its volumes' distance lower bound.
+template <class T>
+struct DistancePair {
+    std::uint32_t a, b;
+    T bound;
+};
+
+/// Measures every triangle pair of leaves `na` (of A) and `nb` (of B), handing each one not
+/// rejected to take(d2, exponent, p, q, slot_a, slot_b), which lowers `best` when it is closer.
+/// Inlined: the search loop stays one piece of code, as it was measured.
+template <class T, class Node, class Take>
+[[gnu::always_inline]] inline void measure_leaf_pair(std::span<const Triangle<T>> ta,
+                                                     std::span<const Triangle<T>> tb,
+                                                     const Node& na, const Node& nb,
+                                                     const PosedTriangles<T>& posed,
+                                                     bool window_top, const T& best,
+                                                     PairStats& stats, Take&& take) {
+    // B's triangle outside: carried into A's frame (in double) once for all of A's.
+    for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
+        using D = Vec<double, 3>;
+        const D vb[3] = {posed.apply(tb[sb].p0), posed.apply(tb[sb].p1), posed.apply(tb[sb].p2)};
+        const Triangle<double> tri_b{vb[0], vb[1], vb[2]};
+        // Every pair with this triangle inside the window of triangle_distance.hpp
+        // (coordinates up to `window_top`, one of B's at least 2^-150): measured as
+        // given, with no per-pair look at the magnitudes.
+        const bool inside = window_top && max_component(abs(vb[0])) >= 0x1p-150;
+        const double rb =
+            std::sqrt(std::max(length_squared(vb[1] - vb[0]), length_squared(vb[2] - vb[0])));
+        for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
+            const Triangle<double> tri_a{D(ta[sa].p0), D(ta[sa].p1), D(ta[sa].p2)};
+            // Outside the window the pair is tested and measured at scale 2^-k (best
+            // scaled alike), where its powers stay finite and normal.
+            const int k =
+                inside
+                    ? 0
+                    : pair_exponent(std::max(largest_coordinate(tri_b), largest_coordinate(tri_a)));
+            if (k != 0) [[unlikely]] {
+                if (rejected_at_scale(tri_a, tri_b, k, double(best))) continue;
+                stats.primitive();
+                const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
+                if (x.hit) {
+                    take(0.0, 0, D(x.p), D(x.p), sa, sb);
+                } else {
+                    const FeatureDistance f = feature_distance_at_scale(tri_a, tri_b, k);
+                    take(f.distance_squared, k, f.p, f.q, sa, sb);
+                }
+                continue;
+            }
+            // Cheap rejection by the triangles' spheres about their first corners.
+            const double ra = std::sqrt(
+                std::max(length_squared(tri_a.p1 - tri_a.p0), length_squared(tri_a.p2 - tri_a.p0)));
+            const double reach = double(best) + ra + rb;
+            if (length_squared(tri_a.p0 - tri_b.p0) > reach * reach) continue;
+            // Then by either triangle's plane: the other wholly at least `best` beyond
+            // it (facing triangles of two surfaces, which the spheres keep).
+            if (beyond_plane(tri_a, tri_b, double(best)) ||
+                beyond_plane(tri_b, tri_a, double(best)))
+                continue;
+            stats.primitive();
+            const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
+            if (x.hit) {
+                take(0.0, 0, D(x.p), D(x.p), sa, sb);
+            } else {
+                const D u[3] = {tri_a.p0, tri_a.p1, tri_a.p2};
+                const FeatureDistance f = feature_distance(u, vb);
+                take(f.distance_squared, 0, f.p, f.q, sa, sb);
+            }
+        }
+    }
+}
+
+/// The child pairs of the inner pair `e` (nodes `na`, `nb`) that the descent rule opens, with
+/// their bounds: bound(x, y) for a node of A against one of B, placed_bound(node, placed) for a
+/// node against the other side's node placed in its frame (pairs.hpp, Placeable). The opening is
+/// pairs.hpp's rule (choose picks the side, left child measured first here where that walk
+/// pushes the right one first): keep the two in step. Returns how many of `kids` it filled.
+template <BoundingVolume V, class Node, class Prepared, class Bound, class PlacedBound>
+[[gnu::always_inline]] inline int open_pair(std::span<const Node> na_, std::span<const Node> nb_,
+                                            const DistancePair<typename V::Scalar>& e,
+                                            const Node& na, const Node& nb, DescentRule rule,
+                                            const Prepared& pose, const Prepared& inverse,
+                                            Bound&& bound, PlacedBound&& placed_bound,
+                                            DistancePair<typename V::Scalar> (&kids)[4]) {
+    using Traits = VolumeTraits<V>;
+    int n = 0;
+    switch (choose(rule, na, nb)) {
+        case Open::A:
+            if constexpr (Placeable<V>) {
+                const V w = Traits::place(nb.bounds, pose);
+                for (const std::uint32_t x : {na.left(), na.right()})
+                    kids[n++] = {x, e.b, placed_bound(na_[x].bounds, w)};
+            } else {
+                kids[n++] = {na.left(), e.b, bound(na.left(), e.b)};
+                kids[n++] = {na.right(), e.b, bound(na.right(), e.b)};
+            }
+            break;
+        case Open::B:
+            if constexpr (Placeable<V>) {
+                const V w = Traits::place(na.bounds, inverse);
+                for (const std::uint32_t y : {nb.left(), nb.right()})
+                    kids[n++] = {e.a, y, placed_bound(nb_[y].bounds, w)};
+            } else {
+                kids[n++] = {e.a, nb.left(), bound(e.a, nb.left())};
+                kids[n++] = {e.a, nb.right(), bound(e.a, nb.right())};
+            }
+            break;
+        case Open::Both:
+            for (std::uint32_t x : {na.left(), na.right()})
+                for (std::uint32_t y : {nb.left(), nb.right()}) kids[n++] = {x, y, bound(x, y)};
+            break;
+    }
+    return n;
+}
+
+/// Queues the child pairs that can still beat the best: the least of them goes on as `next`
+/// without a trip through the heap when no pending pair is below it (the usual case while
+/// refining toward a leaf), the others into the heap.
+template <class T, class Heap, class Hopeless>
+[[gnu::always_inline]] inline void queue_children(const DistancePair<T> (&kids)[4], int n,
+                                                  Hopeless&& hopeless, Heap& heap,
+                                                  DistancePair<T>& next, bool& have_next) {
+    int least = -1;
+    for (int k = 0; k < n; ++k)
+        if (!hopeless(kids[k].bound) && (least < 0 || kids[k].bound < kids[least].bound)) least = k;
+    for (int k = 0; k < n; ++k) {
+        if (hopeless(kids[k].bound)) continue;
+        if (k == least && (heap.empty() || kids[k].bound <= heap.top().bound)) {
+            next = kids[k];
+            have_next = true;
+        } else {
+            heap.push(kids[k]);
+        }
+    }
+}
+
 }  // namespace detail
 
-// One function, on purpose: every split tried took more instructions on the placeable volumes
-// (docs/benchmarks.md, "distance() in one piece"). The opening is pairs.hpp's rule
-// (detail::choose picks the side, left child measured first here where that walk pushes the right
-// one first): keep the two in step.
+// The search loop, its bounds and the best so far stay in this function; its steps (the limits,
+// a leaf pair's measurement, a pair's opening, the children's queueing) are detail functions
+// forced inline: the steps as members of a query class, or out of line, took more instructions
+// on the placeable volumes (docs/benchmarks.md, "distance() in one piece").
 template <BoundingVolume V>
 DistanceResult<typename V::Scalar> distance(
     const CollisionModel<V>& a, const CollisionModel<V>& b,
@@ -130,25 +298,9 @@ DistanceResult<typename V::Scalar> distance(
     const auto ta = a.slot_triangles();
     const auto tb = b.slot_triangles();
     const PosedTriangles<T> posed(pose_of_b_in_a, b.scale());
-    // The volumes' distance bounds square lengths of the scene in T: where those squares leave
-    // T's range (float models near 1e19 and beyond) a bound can overflow to inf and drop the
-    // closest pair. Such models are measured without pruning (an infinite slack makes every
-    // bound -inf): every pair, exactly; slow, but right.
-    const T extent =
-        a.scale() + b.scale() +
-        max_component(bvhkit::max(pose_of_b_in_a.translation, -pose_of_b_in_a.translation));
-    // At the other end the squares sink below T's normal range (models near 1e-154 in double,
-    // 1e-19 in float), and a length rooted from them may be off by up to sqrt(2.5 denorm_min):
-    // 16 sqrt(denorm_min) more slack keeps any bound made of a few such lengths below the true
-    // distance (at ordinary scales it vanishes in the slack's rounding; models far below, it
-    // turns pruning off as above).
-    const T slack = std::isfinite(T(16) * extent * extent)
-                        ? pose_slack(a.scale(), b.scale(), pose_of_b_in_a) +
-                              T(16) * std::sqrt(std::numeric_limits<T>::denorm_min())
-                        : std::numeric_limits<T>::infinity();
-    // Whether every coordinate in A's frame is within 2^150: |R x + t| <= sqrt(3) |x| + |t| in
-    // the largest component, so twice the extent (rounding included) bounds them.
-    const bool window_top = 2 * double(extent) <= 0x1p150;
+    const detail::DistanceLimits<T> limits =
+        detail::distance_limits(a.scale(), b.scale(), pose_of_b_in_a);
+    const T slack = limits.slack;
     const auto pose = Traits::prepare(pose_of_b_in_a, slack);
     const auto inverse = Traits::prepare(pose_of_b_in_a.inverse(), slack);
     // The best squared distance, kept in double (finite for any finite float input: a float
@@ -186,10 +338,18 @@ DistanceResult<typename V::Scalar> distance(
             return T(0);  // not called: only placeable volumes are placed
         }
     };
-    struct Entry {
-        std::uint32_t a, b;
-        T bound;
+    const auto take = [&](double d2, int exponent, const Vec<double, 3>& p, const Vec<double, 3>& q,
+                          std::uint32_t sa, std::uint32_t sb) {
+        if (!best2.exceeds(d2, exponent)) return;
+        best2 = {d2, exponent};
+        best = best2.root<T>();
+        result.distance = best;
+        result.point_a = Vec<T, 3>(p);
+        result.point_b = Vec<T, 3>(q);
+        result.triangle_a = a.triangle_id(sa);
+        result.triangle_b = b.triangle_id(sb);
     };
+    using Entry = detail::DistancePair<T>;
     // Best first: the pending pair with the least bound is opened next, so the query ends as
     // soon as that bound cannot beat the best, having opened (nearly) only pairs whose bound is
     // below the answer; depth first with near-first children opened about twice as many on the
@@ -201,6 +361,8 @@ DistanceResult<typename V::Scalar> distance(
     // the heap (the usual case while refining toward a leaf).
     Entry next{0, 0, bound(0, 0)};
     bool have_next = true;
+    const DescentRule rule =
+        options.rule == DescentRule::ByOverlap ? DescentRule::Larger : options.rule;
     while (have_next || !heap.empty()) {
         Entry e = next;
         if (!have_next) e = heap.pop();
@@ -209,117 +371,15 @@ DistanceResult<typename V::Scalar> distance(
         const auto& na = na_[e.a];
         const auto& nb = nb_[e.b];
         if (na.is_leaf() && nb.is_leaf()) {
-            const auto take = [&](double d2, int exponent, const Vec<double, 3>& p,
-                                  const Vec<double, 3>& q, std::uint32_t sa, std::uint32_t sb) {
-                if (!best2.exceeds(d2, exponent)) return;
-                best2 = {d2, exponent};
-                best = best2.root<T>();
-                result.distance = best;
-                result.point_a = Vec<T, 3>(p);
-                result.point_b = Vec<T, 3>(q);
-                result.triangle_a = a.triangle_id(sa);
-                result.triangle_b = b.triangle_id(sb);
-            };
-            // B's triangle outside: carried into A's frame (in double) once for all of A's.
-            for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
-                using D = Vec<double, 3>;
-                const D vb[3] = {posed.apply(tb[sb].p0), posed.apply(tb[sb].p1),
-                                 posed.apply(tb[sb].p2)};
-                const Triangle<double> tri_b{vb[0], vb[1], vb[2]};
-                // Every pair with this triangle inside the window of triangle_distance.hpp
-                // (coordinates up to `window_top`, one of B's at least 2^-150): measured as
-                // given, with no per-pair look at the magnitudes.
-                const bool inside = window_top && max_component(abs(vb[0])) >= 0x1p-150;
-                const double rb = std::sqrt(
-                    std::max(length_squared(vb[1] - vb[0]), length_squared(vb[2] - vb[0])));
-                for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa) {
-                    const Triangle<double> tri_a{D(ta[sa].p0), D(ta[sa].p1), D(ta[sa].p2)};
-                    // Outside the window the pair is tested and measured at scale 2^-k (best
-                    // scaled alike), where its powers stay finite and normal.
-                    const int k =
-                        inside ? 0
-                               : detail::pair_exponent(std::max(detail::largest_coordinate(tri_b),
-                                                                detail::largest_coordinate(tri_a)));
-                    if (k != 0) [[unlikely]] {
-                        if (detail::rejected_at_scale(tri_a, tri_b, k, double(best))) continue;
-                        result.stats.primitive();
-                        const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
-                        if (x.hit) {
-                            take(0.0, 0, D(x.p), D(x.p), sa, sb);
-                        } else {
-                            const detail::FeatureDistance f =
-                                detail::feature_distance_at_scale(tri_a, tri_b, k);
-                            take(f.distance_squared, k, f.p, f.q, sa, sb);
-                        }
-                        continue;
-                    }
-                    // Cheap rejection by the triangles' spheres about their first corners.
-                    const double ra = std::sqrt(std::max(length_squared(tri_a.p1 - tri_a.p0),
-                                                         length_squared(tri_a.p2 - tri_a.p0)));
-                    const double reach = double(best) + ra + rb;
-                    if (length_squared(tri_a.p0 - tri_b.p0) > reach * reach) continue;
-                    // Then by either triangle's plane: the other wholly at least `best` beyond
-                    // it (facing triangles of two surfaces, which the spheres keep).
-                    if (detail::beyond_plane(tri_a, tri_b, double(best)) ||
-                        detail::beyond_plane(tri_b, tri_a, double(best)))
-                        continue;
-                    result.stats.primitive();
-                    const TriangleIntersection<T> x = posed.intersect(ta[sa], tb[sb], vb);
-                    if (x.hit) {
-                        take(0.0, 0, D(x.p), D(x.p), sa, sb);
-                    } else {
-                        const D u[3] = {tri_a.p0, tri_a.p1, tri_a.p2};
-                        const detail::FeatureDistance f = detail::feature_distance(u, vb);
-                        take(f.distance_squared, 0, f.p, f.q, sa, sb);
-                    }
-                }
-            }
+            detail::measure_leaf_pair<T>(ta, tb, na, nb, posed, limits.window_top, best,
+                                         result.stats, take);
             if (best2.s2 == 0) break;
             continue;
         }
-        const DescentRule rule =
-            options.rule == DescentRule::ByOverlap ? DescentRule::Larger : options.rule;
         Entry kids[4];
-        int n = 0;
-        switch (detail::choose(rule, na, nb)) {
-            case detail::Open::A:
-                if constexpr (detail::Placeable<V>) {
-                    const V w = Traits::place(nb.bounds, pose);
-                    for (const std::uint32_t x : {na.left(), na.right()})
-                        kids[n++] = {x, e.b, placed_bound(na_[x].bounds, w)};
-                } else {
-                    kids[n++] = {na.left(), e.b, bound(na.left(), e.b)};
-                    kids[n++] = {na.right(), e.b, bound(na.right(), e.b)};
-                }
-                break;
-            case detail::Open::B:
-                if constexpr (detail::Placeable<V>) {
-                    const V w = Traits::place(na.bounds, inverse);
-                    for (const std::uint32_t y : {nb.left(), nb.right()})
-                        kids[n++] = {e.a, y, placed_bound(nb_[y].bounds, w)};
-                } else {
-                    kids[n++] = {e.a, nb.left(), bound(e.a, nb.left())};
-                    kids[n++] = {e.a, nb.right(), bound(e.a, nb.right())};
-                }
-                break;
-            case detail::Open::Both:
-                for (std::uint32_t x : {na.left(), na.right()})
-                    for (std::uint32_t y : {nb.left(), nb.right()}) kids[n++] = {x, y, bound(x, y)};
-                break;
-        }
-        int least = -1;
-        for (int k = 0; k < n; ++k)
-            if (!hopeless(kids[k].bound) && (least < 0 || kids[k].bound < kids[least].bound))
-                least = k;
-        for (int k = 0; k < n; ++k) {
-            if (hopeless(kids[k].bound)) continue;
-            if (k == least && (heap.empty() || kids[k].bound <= heap.top().bound)) {
-                next = kids[k];
-                have_next = true;
-            } else {
-                heap.push(kids[k]);
-            }
-        }
+        const int n = detail::open_pair<V>(std::span(na_), std::span(nb_), e, na, nb, rule, pose,
+                                           inverse, bound, placed_bound, kids);
+        detail::queue_children(kids, n, hopeless, heap, next, have_next);
     }
     return result;
 }

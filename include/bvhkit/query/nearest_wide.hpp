@@ -1,5 +1,5 @@
 #pragma once
-// The best-first nearest walk of nearest.hpp over a WideBvh4: a min-heap of nodes keyed by their
+// The best-first nearest walk of nearest.hpp over a WideSlotBvh: a min-heap of nodes keyed by their
 // squared distance from the point and a search radius that shrinks as closer primitives are
 // found. A node measures its four children at once; leaf children within the radius are opened
 // on the spot (shrinking the radius before the inner children are judged), the nearest inner
@@ -22,8 +22,8 @@ namespace wide_detail {
 /// Squared distances from p to the node's child boxes (0 inside) in `d`; returns a bit per
 /// child that exists and lies within `radius2`.
 template <class T>
-[[gnu::always_inline]] inline unsigned children_within(const WideNode4<T>& node, const Vec<T, 3>& p,
-                                                       T radius2, T d[4]) {
+[[gnu::always_inline]] inline unsigned children_within(const WideSlotNode<T>& node,
+                                                       const Vec<T, 3>& p, T radius2, T d[4]) {
 #if defined(__SSE2__)
     if constexpr (std::is_same_v<T, float>) {
         __m128 sum = _mm_setzero_ps();
@@ -54,7 +54,7 @@ template <class T>
 
 /// A bit per child that is a leaf.
 template <class T>
-[[gnu::always_inline]] inline unsigned leaf_children(const WideNode4<T>& node) {
+[[gnu::always_inline]] inline unsigned leaf_children(const WideSlotNode<T>& node) {
     return 15u & ~lanes_equal(node.groups, 0u);
 }
 
@@ -63,10 +63,10 @@ template <class T>
 /// Walks `wide` best first from p while nodes lie within `radius2`, calling on_leaf for each leaf
 /// child within it (see above); stats.node() counts child boxes measured.
 template <class T, class OnLeaf, class Stats>
-void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>& scratch,
+void nearest_wide(const WideSlotBvh<T>& wide, const Vec<T, 3>& p, NearestScratch<T>& scratch,
                   T& radius2, OnLeaf&& on_leaf, Stats&& stats) {
     if (wide.empty()) return;
-    const WideNode4<T>* nodes = wide.nodes.data();
+    const WideSlotNode<T>* nodes = wide.nodes.data();
     MinHeap4 heap(scratch.heap, [](const NearestEntry<T>& e) { return e.distance_squared; });
     heap.push({T(0), 0});
     while (!heap.empty()) {
@@ -74,7 +74,7 @@ void nearest_wide(const WideBvh4<T>& wide, const Vec<T, 3>& p, NearestScratch<T>
         if (e.distance_squared > radius2) break;  // every node left is farther still
         std::uint32_t current = e.node;
         while (true) {
-            const WideNode4<T>& node = nodes[current];
+            const WideSlotNode<T>& node = nodes[current];
             T d[4];
             const unsigned within = wide_detail::children_within(node, p, radius2, d);
             for (int c = 0; c < 4; ++c)

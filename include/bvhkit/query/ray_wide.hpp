@@ -78,7 +78,9 @@ struct alignas(16) SlabConstants {
 
     /// Whether the ray can meet `box` in [tmin, tmax], by the walks' own slab test and rounding:
     /// a box inside this one gives an interval inside this one's, so a miss here is a miss of
-    /// everything in it.
+    /// everything in it. TriangleBvh tests the tree's bounds so before a walk: a ray that misses
+    /// a mesh's bounds (most camera rays around a model) then costs this test and no set-up of
+    /// the walk (the watertight ray and the stack took more than half of such a ray's time).
     bool meets(const Aabb<float, 3>& box, float tmin, float tmax) const {
         const float inf = std::numeric_limits<float>::infinity();
         // Lane 3 goes from 0 along 1 through [-inf, inf]: it restricts nothing.
@@ -350,15 +352,6 @@ bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
     detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return hit_group != nullptr;
 }
-/// The same, with the slab constants made here.
-template <int W, class Stats = NoStats>
-bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray,
-                      const WatertightRay<float>& prep, TriangleHit<float>& best,
-                      const typename WideRayBvh<W>::Group*& hit_group, int& hit_lane,
-                      Stats&& stats = {}) {
-    return closest_hit_wide(tree, ray, detail::SlabConstants(ray), prep, best, hit_group, hit_lane,
-                            stats);
-}
 
 /// Any hit through a wide tree (same conditions as closest_hit_wide).
 template <int W, class Stats = NoStats>
@@ -373,17 +366,6 @@ bool any_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
         tree.groups.data(), prep, ray, found, stats};
     detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return found;
-}
-#endif
-
-#if defined(__SSE2__)
-/// Whether `ray` (one wide_ray_usable accepts) can meet `box` in [tmin, tmax], by the walk's own
-/// slab test and rounding (SlabConstants): a box inside this one gives an interval inside this
-/// one's, so a miss here is a miss of everything in it. A ray that misses a mesh's bounds (most
-/// camera rays around a model) then costs this test and no set-up of the walk: the watertight
-/// ray, the slab constants and the stack took more than half of such a ray's time.
-inline bool ray_meets_box(const Ray<float, 3>& ray, const Aabb<float, 3>& box) {
-    return detail::SlabConstants(ray).meets(box, ray.tmin, ray.tmax);
 }
 #endif
 

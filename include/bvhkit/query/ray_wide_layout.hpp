@@ -67,11 +67,11 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
     // lie side by side; smaller ones for the four-wide layout (tuning.hpp).
     constexpr std::uint32_t leaf_limit =
         W == 8 ? tuning::wide8_leaf_limit : tuning::wide4_leaf_limit;
-    const WideBvh<float, W> wide = collapse_to_wide<float, W>(bvh, leaf_limit, true);
+    const WideSlotBvh<float, W> wide = collapse_to_wide<float, W>(bvh, leaf_limit, true);
     out.nodes.resize(wide.nodes.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
     for (std::size_t i = 0; i < wide.nodes.size(); ++i) {
-        const WideNode<float, W>& w = wide.nodes[i];
+        const WideSlotNode<float, W>& w = wide.nodes[i];
         RayNode<W>& n = out.nodes[i];
         for (int c = 0; c < W; ++c) {
             for (int a = 0; a < 3; ++a) {
@@ -91,7 +91,7 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
         return std::uint32_t((4 * std::size_t(run) + lanes - 1) / lanes);
     };
     std::vector<std::uint32_t> run_of(wide.group_count(), 0), first_of(wide.group_count(), 0);
-    for (const WideNode<float, W>& w : wide.nodes)
+    for (const WideSlotNode<float, W>& w : wide.nodes)
         for (int c = 0; c < W; ++c)
             if (w.has(c) && w.groups[c] > 0) run_of[w.child[c]] = w.groups[c];
     std::size_t group_count = 0;

@@ -106,7 +106,7 @@ class RayBatches {
     void trace(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits,
                const Executor& exec) const {
         for_each(rays, hits, exec, "trace: hits",
-                 [&](auto chunk, auto out) { tree().trace_stream(chunk, out); });
+                 [&](auto chunk, auto out) { tree().trace_on_calling_thread(chunk, out); });
     }
     void occluded(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded,
                   unsigned threads = 0) const {
@@ -120,9 +120,14 @@ class RayBatches {
 
     /// trace() on the calling thread: hits[i] = closest_hit(rays[i]). A tree that walks several
     /// rays at once (TriangleBvh) hides this with its own, of the same answers.
-    void trace_stream(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
-        check_lengths(rays.size(), hits.size(), "trace_stream: hits");
+    void trace_on_calling_thread(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
+        check_lengths(rays.size(), hits.size(), "trace_on_calling_thread: hits");
         for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = tree().closest_hit(rays[i]);
+    }
+    /// The former name of trace_on_calling_thread, kept for one release.
+    [[deprecated("use trace_on_calling_thread")]] void trace_stream(std::span<const Ray<T, 3>> rays,
+                                                                    std::span<Hit<T>> hits) const {
+        tree().trace_on_calling_thread(rays, hits);
     }
     /// occluded() on the calling thread: occluded[i] = any_hit(rays[i]) (1 or 0).
     void occluded_stream(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded) const {
