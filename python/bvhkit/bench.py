@@ -11,6 +11,9 @@ Workloads (sizes times --scale):
   P5  per-call cost: one-pose collide (and python-fcl's), one-point signed distance and one-ray
       intersect, in microseconds per Python call; and collide on batches of 1, 10, 100 and 1,000
       poses with threads=0 against threads=1 (the ratio: at most about 1 for small batches)
+  P6  a collision manager per robot configuration: a six-link arm among three scanned meshes,
+      1,000 configurations one call each, against python-fcl's DynamicAABBTreeCollisionManager
+      (bvhkit/_bench_scene.py)
 
 A peer runs when it imports and sets up; a peer that fails is listed with the reason and the rest
 go on. Peers: Open3D (RaycastingScene), Embree 4 through embreex (its scene's `run`, one
@@ -503,7 +506,7 @@ def main(argv=None) -> None:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scale", type=float, default=1.0, help="workload size factor (1 = full)")
     ap.add_argument("--reps", type=int, default=3, help="repetitions (median reported)")
-    ap.add_argument("--only", default="P1,P2,P3,P4,P5", help="comma-separated workloads")
+    ap.add_argument("--only", default="P1,P2,P3,P4,P5,P6", help="comma-separated workloads")
     ap.add_argument("--mesh", default="igea.ply", help="mesh file or spec for P1 and P2")
     ap.add_argument("--big-mesh", default="sphere:subdiv=8,displacement=0.2",
                     help="the large mesh of P1 (1.3M triangles by default); 'none' skips it")
@@ -555,6 +558,13 @@ def main(argv=None) -> None:
         cv, cf, name = _mesh(args.collision_mesh)
         print(f"P5: {name}, {len(cf)} triangles")
         show(p5(cv, cf, max(args.reps, 5), mods))
+    if "P6" in only:
+        from ._bench_scene import p6
+
+        meshes = [_mesh(m)[:2] for m in ("stanford-bunny.obj", "igea.ply", "spot.obj")]
+        print(f"P6: arm of 6 capsules among {', '.join(str(len(f)) for _, f in meshes)} "
+              "triangles")
+        show(p6(meshes, max(10, int(1000 * s)), args.reps, mods.get("fcl")))
 
 
 if __name__ == "__main__":
