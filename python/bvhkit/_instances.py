@@ -117,13 +117,14 @@ def _integers(name: str, value: Any, k: int, top: int, dtype: Any) -> np.ndarray
     return np.ascontiguousarray(np.broadcast_to(a.astype(dtype), (k,)))
 
 
-def _rotations(name: str, value: Any, k: Optional[int], dtype: np.dtype) -> np.ndarray:
-    """(k, 3, 3) rigid rotations (None: identities), checked as _arrays.rotations checks them,
-    the error naming `name`."""
+def _rotations(name: str, value: Any, k: Optional[int], dtype: np.dtype, values: bool = True
+               ) -> np.ndarray:
+    """(k, 3, 3) rigid rotations (None: identities), checked as _arrays.rotations checks them
+    (``values=False``: type and shape only), the error naming `name`."""
     if value is None:
         return np.ascontiguousarray(np.broadcast_to(np.eye(3, dtype=dtype), (k or 1, 3, 3)))
     try:
-        r = _a.rotations(value, dtype)
+        r = _a.rotations(value, dtype, values=values)
     except (TypeError, ValueError) as e:
         raise type(e)(str(e).replace("rotations:", f"{name}:", 1)) from None
     if k is not None and len(r) != k:
@@ -131,10 +132,11 @@ def _rotations(name: str, value: Any, k: Optional[int], dtype: np.dtype) -> np.n
     return r
 
 
-def _translations(name: str, value: Any, k: Optional[int], dtype: np.dtype) -> np.ndarray:
+def _translations(name: str, value: Any, k: Optional[int], dtype: np.dtype, finite: bool = True
+                  ) -> np.ndarray:
     if value is None:
         return np.zeros((k or 1, 3), dtype)
-    t = _a.rows(name, value, 3, dtype, finite=True)
+    t = _a.rows(name, value, 3, dtype, finite=finite)
     if k is not None and len(t) != k:
         raise ValueError(f"{name}: {len(t)} rows, expected {k}")
     return t
@@ -266,13 +268,19 @@ class Scene:
 
     def _set_poses(self, i: np.ndarray, rotations: Any, translations: Any, rn: str, tn: str
                    ) -> None:
-        r = _rotations(rn, rotations, len(i), self.dtype)
-        t = _translations(tn, translations, len(i), self.dtype)
+        # Types and shapes here; values (finite, rigid) in the C++ call's one pass, which names
+        # the argument and row as _rotations would (a planner calls this once a configuration).
+        r = _rotations(rn, rotations, len(i), self.dtype, values=False)
+        t = _translations(tn, translations, len(i), self.dtype, finite=False)
         try:
             self._impl.set_poses(i, r, t)
         except ValueError as e:
-            if str(e).startswith("ids") and rn == "rotation":
-                raise ValueError("id" + str(e)[len("ids[0]"):]) from None
+            message = str(e)
+            if message.startswith("ids") and rn == "rotation":
+                raise ValueError("id" + message[len("ids[0]"):]) from None
+            for plural, name in (("rotations", rn), ("translations", tn)):
+                if message.startswith(plural + ":") and name != plural:
+                    raise ValueError(name + message[len(plural):]) from None
             raise
 
     def set_options(

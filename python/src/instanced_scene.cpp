@@ -112,10 +112,34 @@ class InstancedScene {
             which[i] = id_of(ids.data()[i]);
             poses[i] = pose_at(rotations, translations, i);
         }
+        check_pose_rows(poses);
         nb::gil_scoped_release release;
         const std::unique_lock<std::shared_mutex> lock(mutex_);
         check_ids(ids, "ids");
-        scene_.set_poses(which, poses);  // checks every pose before it moves any
+        scene_.set_poses(which, poses);  // checks every pose again before it moves any
+    }
+    /// Every pose finite and rigid (check_rigid_pose's rule), the error naming the argument and
+    /// row as the package's own checks do: the per-call check a planner's loop pays is this one
+    /// pass, not numpy's.
+    static void check_pose_rows(const std::vector<Pose>& poses) {
+        for (std::size_t i = 0; i < poses.size(); ++i) {
+            const Pose& p = poses[i];
+            bool finite = true;
+            for (std::size_t a = 0; a < 3; ++a) {
+                if (!std::isfinite(p.translation[a]))
+                    throw Error("translations: row " + std::to_string(i) +
+                                " has a NaN or infinite coordinate");
+                for (std::size_t b = 0; b < 3; ++b)
+                    finite = finite && std::isfinite(p.rotation[a][b]);
+            }
+            if (!finite)
+                throw Error("rotations: rotation " + std::to_string(i) +
+                            " has a NaN or infinite entry");
+            if (!(rigid_deviation(p.rotation) <= rigid_tolerance<T>()))
+                throw Error("rotations: rotation " + std::to_string(i) +
+                            " is not a rotation matrix (R^T R must be the identity and det R = "
+                            "+1, to 1e-4)");
+        }
     }
 
     /// New options for instances, every row checked before any changes: of user_data, group,
