@@ -145,11 +145,15 @@ class SceneGeometry {
     /// triangles gets the point box at t.
     Aabb<T, 3> world_box(const Transform<T>& pose, W pad) const {
         if (hull_.empty()) return Aabb<T, 3>(pose.translation, pose.translation);
-        Vec<W, 3> lo(std::numeric_limits<W>::infinity()), hi(-std::numeric_limits<W>::infinity());
-        for (const Vec<T, 3>& v : hull_) {
-            const Vec<W, 3> w = scene_detail::apply_wide<W>(pose, v);
-            for (std::size_t a = 0; a < 3; ++a)
-                lo[a] = std::min(lo[a], w[a]), hi[a] = std::max(hi[a], w[a]);
+        Vec<W, 3> lo, hi;
+        if (!extremes_in_double(pose, lo, hi)) {  // beyond double's range: the slow exact way
+            lo = Vec<W, 3>(std::numeric_limits<W>::infinity());
+            hi = Vec<W, 3>(-std::numeric_limits<W>::infinity());
+            for (const Vec<T, 3>& v : hull_) {
+                const Vec<W, 3> w = scene_detail::apply_wide<W>(pose, v);
+                for (std::size_t a = 0; a < 3; ++a)
+                    lo[a] = std::min(lo[a], w[a]), hi[a] = std::max(hi[a], w[a]);
+            }
         }
         Aabb<T, 3> box;
         for (std::size_t a = 0; a < 3; ++a) {
@@ -157,6 +161,37 @@ class SceneGeometry {
             box.max[a] = scene_detail::round_up<T>(hi[a] + pad);
         }
         return box;
+    }
+
+    /// The extremes of R x + t over the hull, each widened by a bound on its rounding, computed
+    /// in double: a pose change pays one pass over the hull, and long double (W for a double
+    /// mesh) costs several times double's arithmetic there. For a float mesh every product is
+    /// exact in double and the two sums and t round by at most 2 eps_d of 3.01 e + |t| (e the
+    /// hull's largest |coordinate|, |R_ab| <= 1 + 1e-4); for a double mesh the three products
+    /// add one rounding each: 4 eps_d of the same. False (nothing written) where a value leaves
+    /// double's range.
+    bool extremes_in_double(const Transform<T>& pose, Vec<W, 3>& lo_out, Vec<W, 3>& hi_out) const {
+        const Mat3<double> r(pose.rotation);
+        Vec<double, 3> lo(std::numeric_limits<double>::infinity()), hi(-lo[0]);
+        for (const Vec<T, 3>& v : hull_) {
+            const Vec<double, 3> x(v);
+            for (std::size_t a = 0; a < 3; ++a) {
+                const double w =
+                    r[a][0] * x[0] + r[a][1] * x[1] + r[a][2] * x[2] + double(pose.translation[a]);
+                lo[a] = std::min(lo[a], w);
+                hi[a] = std::max(hi[a], w);
+            }
+        }
+        const double eps = std::numeric_limits<double>::epsilon();
+        for (std::size_t a = 0; a < 3; ++a) {
+            const double slack =
+                4 * eps * (3.01 * double(extent_) + std::fabs(double(pose.translation[a])));
+            if (!(std::isfinite(lo[a]) && std::isfinite(hi[a]) && std::isfinite(slack)))
+                return false;
+            lo_out[a] = W(lo[a]) - W(slack);
+            hi_out[a] = W(hi[a]) + W(slack);
+        }
+        return true;
     }
 
     /// The pad for a pose: what the queries' roundings can move a point of the geometry by. A
