@@ -285,7 +285,7 @@ TEST(TriangleBvhFile, HeaderMatchesTheDocumentedLayout) {
     };
     ASSERT_GE(b.size(), 72u);
     EXPECT_EQ(0, std::memcmp(b.data(), "BVHKIT\x1a\n", 8));
-    EXPECT_EQ(u32(8), 1u);           // format version
+    EXPECT_EQ(u32(8), 2u);           // format version (of a TriangleBvh file)
     EXPECT_EQ(u32(12), 1u);          // kind: TriangleBvh
     EXPECT_EQ(b[16], 2);             // scalar: double
     EXPECT_EQ(b[17], 1);             // volume: Aabb3
