@@ -5,8 +5,9 @@
 // skip when one is retuned; only the eight-wide paths skip, naming AVX2, on a CPU without it.
 //
 // The wide walks open boxes in another order than the binary walk, so where a ray meets two
-// triangles at the same t either may be reported: then the t must be the reference's and the
-// reported triangle must be hit there, with the t, u and v the scalar test gives. Every other
+// triangles at the same t either may be reported: then the t must equal the reference's (a zero
+// may differ in sign: each triangle's own t) and the reported triangle must be hit there, with the
+// t, u and v the scalar test gives. Every other
 // answer (t, u, v, triangle, normal, the any-hit flag) must be the reference's, bit for bit. The
 // fast test (Moller-Trumbore) is another test whose answers differ in the last bits: its batches
 // are held to its own one-ray calls.
@@ -70,18 +71,21 @@ Reference reference_answers(const std::vector<Triangle<float>>& tris,
     return ref;
 }
 
-/// `hit` is the reference's answer `want` for `ray`, or at a tie another triangle hit at the
-/// same t, u and v as the scalar test gives for it.
+/// `hit` is the reference's answer `want` for `ray`, or at a tie another triangle hit at an
+/// equal t, with the t, u and v the scalar test gives for it.
 ::testing::AssertionResult same_answer(const Hit<float>& hit, const Hit<float>& want,
                                        const Ray3f& ray, const std::vector<Triangle<float>>& tris) {
     if (bool(hit) != bool(want)) return ::testing::AssertionFailure() << "hit differs from miss";
     if (!want) return ::testing::AssertionSuccess();
-    if (!same_bits(hit.t, want.t))
+    // At a tie the t is equal but may differ in the sign of a zero: a ray starting on two
+    // triangles of opposite winding meets one at +0 and the other at -0.
+    if (!(hit.t == want.t))
         return ::testing::AssertionFailure() << "t " << hit.t << " vs " << want.t;
     if (hit.primitive == want.primitive)
-        return same_bits(hit.u, want.u) && same_bits(hit.v, want.v) && hit.normal == want.normal
+        return same_bits(hit.t, want.t) && same_bits(hit.u, want.u) && same_bits(hit.v, want.v) &&
+                       hit.normal == want.normal
                    ? ::testing::AssertionSuccess()
-                   : ::testing::AssertionFailure() << "u, v or normal differ";
+                   : ::testing::AssertionFailure() << "t, u, v or normal differ";
     const auto h = tris[hit.primitive].intersect_watertight(ray);
     if (h && same_bits(h->t, hit.t) && same_bits(h->u, hit.u) && same_bits(h->v, hit.v) &&
         hit.normal == tris[hit.primitive].normal())

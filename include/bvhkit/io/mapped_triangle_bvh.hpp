@@ -61,7 +61,9 @@ class MappedTriangleBvh : public RayBatches<MappedTriangleBvh<T>, T> {
 #endif
         return rays_.closest_hit(ray, stats);
     }
-    bool any_hit(const Ray<T, 3>& ray) const { return any_hit(ray, NoStats{}); }
+    bool any_hit(const Ray<T, 3>& ray) const {
+        return any_hit(ray, NoStats{});
+    }
     template <class Stats>
     bool any_hit(const Ray<T, 3>& ray, Stats&& stats) const {
 #if defined(__SSE2__)
@@ -105,37 +107,51 @@ class MappedTriangleBvh : public RayBatches<MappedTriangleBvh<T>, T> {
     }
 
     /// The tree, in place in the file.
-    BvhView<Aabb<T, 3>> bvh() const { return rays_.bvh(); }
+    BvhView<Aabb<T, 3>> bvh() const {
+        return rays_.bvh();
+    }
     /// Triangles left out of the tree for non-finite coordinates, by mesh index.
-    std::span<const std::uint32_t> skipped() const { return skipped_; }
-    std::size_t triangle_count() const { return triangle_count_; }
-    TriangleTest triangle_test() const { return rays_.triangle_test(); }
+    std::span<const std::uint32_t> skipped() const {
+        return skipped_;
+    }
+    std::size_t triangle_count() const {
+        return triangle_count_;
+    }
+    TriangleTest triangle_test() const {
+        return rays_.triangle_test();
+    }
     /// The width of the tree rays walk: 8 or 4 (the file's wide layout), or 2 (the binary tree).
-    int ray_width() const { return !wide8_.empty() ? 8 : !wide4_.empty() ? 4 : 2; }
+    int ray_width() const {
+        return !wide8_.empty() ? 8 : !wide4_.empty() ? 4 : 2;
+    }
     /// The bytes of the wide ray layout rays walk (0 for the binary tree).
     std::size_t ray_layout_bytes() const {
         return wide8_.empty() ? wide4_.bytes() : wide8_.bytes();
     }
     /// As TriangleBvh's (query/wide_triangle_rays.hpp).
-    RayBatchPath batch_path() const { return batch_path_; }
+    RayBatchPath batch_path() const {
+        return batch_path_;
+    }
     void set_batch_path(RayBatchPath path) {
         check_batch_path(path, ray_width(), "MappedTriangleBvh::set_batch_path");
         batch_path_ = path;
     }
     /// Whether the wide sections are read where they lie in the file (false: none are walked,
     /// or the caller's bytes were not aligned for them and they were copied).
-    bool wide_layout_in_place() const { return ray_width() > 2 && copied4_.empty() && copied8_.empty(); }
+    bool wide_layout_in_place() const {
+        return ray_width() > 2 && copied4_.empty() && copied8_.empty();
+    }
     /// The bytes the tree is read from (the whole file).
-    std::span<const std::uint8_t> bytes() const { return bytes_; }
+    std::span<const std::uint8_t> bytes() const {
+        return bytes_;
+    }
 
   private:
     friend struct serial_detail::MappedTriangleBvhAccess;
 
 #if defined(__SSE2__)
     // Every ray path of a float tree over the file's sections (made per call: a few spans).
-    WideTriangleRays wide_rays() const
-        requires std::is_same_v<T, float>
-    {
+    WideTriangleRays wide_rays() const requires std::is_same_v<T, float> {
         return WideTriangleRays(rays_, wide4_, wide8_, batch_path_);
     }
 #endif

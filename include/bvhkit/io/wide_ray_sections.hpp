@@ -28,7 +28,8 @@ inline constexpr std::uint64_t wide_header_bytes = 24;
 template <int W>
 inline constexpr std::uint64_t ray_node_record_bytes = 32 * W;  // 6 W floats, 2 W u32
 template <int W>
-inline constexpr std::uint64_t ray_group_record_bytes = 40 * RayGroup<W>::lanes;  // 9 L floats, L u32
+inline constexpr std::uint64_t ray_group_record_bytes =
+    40 * RayGroup<W>::lanes;  // 9 L floats, L u32
 
 // The records hold no padding, so comparing and mapping them byte for byte is sound.
 static_assert(sizeof(RayNode<4>) == ray_node_record_bytes<4> &&
@@ -85,7 +86,8 @@ inline WideSectionHeader get_wide_header(ByteReader& r) {
         return h;
     }
     const std::uint64_t left = r.remaining(), pad = wide_padding(r.position());
-    const std::uint64_t node_bytes = width == 8 ? ray_node_record_bytes<8> : ray_node_record_bytes<4>;
+    const std::uint64_t node_bytes =
+        width == 8 ? ray_node_record_bytes<8> : ray_node_record_bytes<4>;
     const std::uint64_t group_bytes =
         width == 8 ? ray_group_record_bytes<8> : ray_group_record_bytes<4>;
     // By division first, so that no count can overflow the sum.
