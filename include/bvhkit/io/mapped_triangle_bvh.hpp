@@ -247,15 +247,8 @@ struct MappedTriangleBvhAccess {
     static void open_wide(MappedTriangleBvh<T>& tree, ByteReader& r, const WideSectionHeader& h,
                           const TriangleBvhFileHeader& f, BvhView<Aabb<T, 3>> bvh,
                           std::span<const Triangle<T>> corners, const LoadOptions& options) {
-        WideRayView<W> view;
         WideRayBvh<W> copied;
-        if (r.aligned_in_memory(alignof(RayNode<W>))) {
-            view.nodes = r.records_in_place<RayNode<W>>(std::size_t(h.nodes), 8);
-            view.groups = r.records_in_place<RayGroup<W>>(std::size_t(h.groups), 8);
-        } else {
-            get_wide_layout(r, h, copied);
-            view = copied.view();
-        }
+        const WideRayView<W> view = read_wide_layout(r, h, copied);
         const std::uint64_t triangle_count = f.file.header.counts[3];
         check_wide_structure<W>(view, triangle_count, what);
         if (W != f.wide_width_here<T>()) return;

@@ -187,10 +187,13 @@ struct TriangleBvhAccess {
         auto& skipped = tree.report_.skipped;
         get_u32s(r, skipped, skipped_count);
         const WideSectionHeader wide = open_wide_sections<T>(f, r, what);
-        WideRayBvh<4> stored4;
-        WideRayBvh<8> stored8;
-        if (wide.width == 4) get_wide_layout(r, wide, stored4);
-        if (wide.width == 8) get_wide_layout(r, wide, stored8);
+        // Read in place where the bytes allow (copied only when kept), else copied here.
+        WideRayBvh<4> copy4;
+        WideRayBvh<8> copy8;
+        WideRayView<4> stored4;
+        WideRayView<8> stored8;
+        if (wide.width == 4) stored4 = read_wide_layout(r, wide, copy4);
+        if (wide.width == 8) stored8 = read_wide_layout(r, wide, copy8);
 
         check_loaded_triangle_tree<T>(tree.binary_rays(), tree.exact_, triangle_count, skipped,
                                       options, what);
@@ -199,8 +202,10 @@ struct TriangleBvhAccess {
         // The stored layout where it is the one this CPU walks and is trusted or proved the
         // derived one; else derived from the tree, whose structure was checked above.
         if (wide.width != 0 && wide.width == f.wide_width_here<T>() && !options.validate) {
-            tree.wide4_ = std::move(stored4);
-            tree.wide8_ = std::move(stored8);
+            tree.wide4_.nodes.assign(stored4.nodes.begin(), stored4.nodes.end());
+            tree.wide4_.groups.assign(stored4.groups.begin(), stored4.groups.end());
+            tree.wide8_.nodes.assign(stored8.nodes.begin(), stored8.nodes.end());
+            tree.wide8_.groups.assign(stored8.groups.begin(), stored8.groups.end());
             return tree;
         }
         tree.make_ray_layout();

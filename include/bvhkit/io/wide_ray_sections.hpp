@@ -107,6 +107,15 @@ template <int W>
 void get_wide_layout(ByteReader& r, const WideSectionHeader& h, WideRayBvh<W>& out) {
     out.nodes.resize(std::size_t(h.nodes));
     out.groups.resize(std::size_t(h.groups));
+    if constexpr (std::endian::native == std::endian::little) {
+        // The file's records are the memory's (no padding, little-endian): copied whole.
+        const std::size_t node_bytes = out.nodes.size() * sizeof(RayNode<W>);
+        const std::size_t group_bytes = out.groups.size() * sizeof(RayGroup<W>);
+        if (node_bytes > 0) std::memcpy(out.nodes.data(), r.take(node_bytes).data(), node_bytes);
+        if (group_bytes > 0)
+            std::memcpy(out.groups.data(), r.take(group_bytes).data(), group_bytes);
+        return;
+    }
     for (RayNode<W>& n : out.nodes) {
         for (auto& row : n.lo)
             for (float& x : row) x = r.scalar<float>();
@@ -118,6 +127,20 @@ void get_wide_layout(ByteReader& r, const WideSectionHeader& h, WideRayBvh<W>& o
             for (float& x : row) x = r.scalar<float>();
         for (std::uint32_t& s : g.slot) s = r.u32();
     }
+}
+
+/// The records where they lie when this machine's records are the file's (little-endian) and the
+/// bytes are aligned for them, else copied into `copy`; either way the view to check and walk.
+template <int W>
+WideRayView<W> read_wide_layout(ByteReader& r, const WideSectionHeader& h, WideRayBvh<W>& copy) {
+    if (std::endian::native == std::endian::little && r.aligned_in_memory(alignof(RayNode<W>))) {
+        WideRayView<W> view;
+        view.nodes = r.records_in_place<RayNode<W>>(std::size_t(h.nodes), 8);
+        view.groups = r.records_in_place<RayGroup<W>>(std::size_t(h.groups), 8);
+        return view;
+    }
+    get_wide_layout(r, h, copy);
+    return copy.view();
 }
 
 /// What a walk needs, whatever the boxes hold: an empty lane (child invalid_index, groups 0) has
