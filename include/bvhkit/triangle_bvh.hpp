@@ -325,8 +325,9 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     }
 
 #if defined(__SSE2__)
-    // Every ray path of a float tree over this tree's own arrays (made per call: a few spans).
-    WideTriangleRays wide_rays() const requires std::is_same_v<T, float> {
+    // Every ray path of a float tree over this tree's own arrays (made per call: a few spans;
+    // called for float trees only).
+    WideTriangleRays wide_rays() const {
         return WideTriangleRays(binary_rays(), wide4_, wide8_, batch_path_);
     }
 #endif

@@ -150,8 +150,9 @@ class MappedTriangleBvh : public RayBatches<MappedTriangleBvh<T>, T> {
     friend struct serial_detail::MappedTriangleBvhAccess;
 
 #if defined(__SSE2__)
-    // Every ray path of a float tree over the file's sections (made per call: a few spans).
-    WideTriangleRays wide_rays() const requires std::is_same_v<T, float> {
+    // Every ray path of a float tree over the file's sections (made per call: a few spans;
+    // called for float trees only).
+    WideTriangleRays wide_rays() const {
         return WideTriangleRays(rays_, wide4_, wide8_, batch_path_);
     }
 #endif
