@@ -11,7 +11,8 @@
 // Batches of rays: trace() and occluded() over spans, on every core with oneTBB;
 // trace_on_calling_thread() and occluded_stream() on the calling thread. On the eight-wide layout a
 // batch walks several rays at once (query/ray_stream.hpp; occlusion rays below 8 MB in octant
-// streams, query/ray_octant_stream.hpp): the one-by-one calls' answers, bit for bit.
+// streams, query/ray_octant_stream.hpp), or as RayBatchPath forces: the one-by-one calls' answers,
+// bit for bit. The float paths are query/wide_triangle_rays.hpp's, shared with MappedTriangleBvh.
 //
 // The triangle test is TriangleBvhOptions::triangle_test: watertight by default (no ray slips
 // through a shared edge or vertex of a closed mesh), or the fast Moller-Trumbore test, which can
@@ -39,10 +40,9 @@
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/ray.hpp"
-#include "bvhkit/query/ray_octant_stream.hpp"
-#include "bvhkit/query/ray_stream.hpp"
 #include "bvhkit/query/ray_wide.hpp"
 #include "bvhkit/query/triangle_rays.hpp"
+#include "bvhkit/query/wide_triangle_rays.hpp"
 #include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
@@ -137,6 +137,9 @@ enum class RayLayout {
 struct TriangleBvhOptions : BuildOptions {
     TriangleTest triangle_test = TriangleTest::Watertight;
     RayLayout ray_layout = RayLayout::Auto;
+    /// Which walk batches take on the eight-wide layout (query/wide_triangle_rays.hpp): Streams
+    /// and OctantStreams are an Error unless the tree's rays walk eight wide.
+    RayBatchPath batch_path = RayBatchPath::Auto;
     /// The high-quality build: binned SAH with spatial splits (Stich et al. 2009), `spatial` its
     /// parameters. Serial, several times the default build's time, and up to spatial.budget more
     /// triangle references; needs Builder::BinnedSah and no optimize (else bvhkit::Error).
@@ -171,25 +174,8 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     Hit<T> closest_hit(const Ray<T, 3>& ray, Stats&& stats) const {
         const Reading reading(exclusion_);
 #if defined(__SSE2__)
-        if constexpr (std::is_same_v<T, float>) {
-            detail::SlabConstants k;
-            const WideRoute route = traces_wide() ? route_wide(ray, k) : WideRoute::Binary;
-            if (route == WideRoute::Miss) return Hit<T>{};
-            if (route == WideRoute::Walk) {
-                const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
-                // The groups hold the primitive index and a copy of the corners: the same normal
-                // as exact_'s, from the line just tested.
-                const auto trace = [&](const auto& wide) {
-                    TriangleHit<float> h;
-                    const typename std::remove_cvref_t<decltype(wide)>::Group* group;
-                    int lane;
-                    if (!closest_hit_wide(wide, ray, k, prep, h, group, lane, stats))
-                        return Hit<T>{};
-                    return wide_hit(h, *group, lane);
-                };
-                return wide8_.empty() ? trace(wide4_) : trace(wide8_);
-            }
-        }
+        if constexpr (std::is_same_v<T, float>)
+            if (traces_wide()) return wide_rays().closest_hit(ray, stats);
 #endif
         return binary_rays().closest_hit(ray, stats);
     }
@@ -202,11 +188,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         const Reading reading(exclusion_);
 #if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>)
-            if (traces_wide() && wide_ray_usable(ray)) {
-                const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
-                return wide8_.empty() ? any_hit_wide(wide4_, ray, prep, stats)
-                                      : any_hit_wide(wide8_, ray, prep, stats);
-            }
+            if (traces_wide()) return wide_rays().any_hit(ray, stats);
 #endif
         return binary_rays().any_hit(ray, stats);
     }
@@ -236,17 +218,11 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     /// spans differ in length).
     void trace_on_calling_thread(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
         const Reading reading(exclusion_);
-#if BVHKIT_RAY_AVX2
+#if defined(__SSE2__)
         if constexpr (std::is_same_v<T, float>)
-            if (streams_rays()) {
+            if (traces_wide()) {
                 this->check_lengths(rays.size(), hits.size(), "trace_on_calling_thread: hits");
-                stream<false>(
-                    rays,
-                    [&](const detail::StreamRay& s) {
-                        hits[s.index] =
-                            s.hit_group ? wide_hit(s.best, *s.hit_group, s.hit_lane) : Hit<T>{};
-                    },
-                    [&](std::size_t i) { hits[i] = closest_hit(rays[i]); });
+                wide_rays().trace_on_calling_thread(rays, hits);
                 return;
             }
 #endif
@@ -255,20 +231,13 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     /// occluded[i] = any_hit(rays[i]) (1 or 0) for every ray, on the calling thread.
     void occluded_stream(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded) const {
         const Reading reading(exclusion_);
-#if BVHKIT_RAY_AVX2
-        if constexpr (std::is_same_v<T, float>) {
-            if (!wide8_.empty()) {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>)
+            if (traces_wide()) {
                 this->check_lengths(rays.size(), occluded.size(), "occluded_stream: occluded");
-                if (detail::octant_streams_pay(wide8_))
-                    occlude_in_octants(rays, occluded);
-                else
-                    stream<true>(
-                        rays,
-                        [&](const detail::StreamRay& s) { occluded[s.index] = s.found ? 1 : 0; },
-                        [&](std::size_t i) { occluded[i] = any_hit(rays[i]) ? 1 : 0; });
+                wide_rays().occluded_stream(rays, occluded);
                 return;
             }
-        }
 #endif
         RayBatches<TriangleBvh<T>, T>::occluded_stream(rays, occluded);
     }
@@ -288,15 +257,24 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         return wide8_.empty() ? wide4_.bytes() : wide8_.bytes();
     }
     /// Whether trace batches walk several rays at once (query/ray_stream.hpp): on the eight-wide
-    /// layout once it is 2 MB or more (about 45,000 triangles). Occlusion batches on the
-    /// eight-wide layout always do: in octant streams below 8 MB (query/ray_octant_stream.hpp),
-    /// as trace batches above.
+    /// layout once it is 2 MB or more (about 45,000 triangles), or as batch_path() says.
+    /// Occlusion batches on the eight-wide layout do unless batch_path() is OneByOne: in octant
+    /// streams below 8 MB (query/ray_octant_stream.hpp), as trace batches above.
     bool streams_rays() const {
-#if BVHKIT_RAY_AVX2
-        return !wide8_.empty() && detail::stream_pays(wide8_);
-#else
-        return false;
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>) return wide_rays().streams_traces();
 #endif
+        return false;
+    }
+    /// Which walk batches take on the eight-wide layout (query/wide_triangle_rays.hpp).
+    RayBatchPath batch_path() const {
+        return batch_path_;
+    }
+    /// Forces the batches' walk (for tests and measuring; answers stay the same): an Error for
+    /// Streams or OctantStreams unless ray_width() is 8. Not while queries run on the tree.
+    void set_batch_path(RayBatchPath path) {
+        check_batch_path(path, ray_width(), "TriangleBvh::set_batch_path");
+        batch_path_ = path;
     }
 
     /// After the mesh's vertices moved (same triangles, same order): refit the boxes, one pass.
@@ -347,6 +325,14 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         return TriangleRays<T>(bvh_view(bvh_), std::span<const PrecomputedTriangle<T>>(fast_));
     }
 
+#if defined(__SSE2__)
+    // Every ray path of a float tree over this tree's own arrays (made per call: a few spans;
+    // called for float trees only).
+    WideTriangleRays wide_rays() const {
+        return WideTriangleRays(binary_rays(), wide4_, wide8_, batch_path_);
+    }
+#endif
+
     template <class TriangleAt>
     void build(TriangleAt&& triangle, std::size_t count, const TriangleBvhOptions& options) {
         BuildOptions tree_options = options;
@@ -378,6 +364,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         split_references_ = bvh_.primitive_indices.size() + report_.skipped.size() != count;
         triangle_count_ = count;
         lay_out(triangle);
+        set_batch_path(options.batch_path);
     }
 
     // Only the chosen test's layout is kept.
@@ -412,75 +399,6 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
         return ray_layout_ != RayLayout::Wide4 && cpu_has_avx2();
     }
 
-    /// A wide walk's hit as a Hit: the group holds the triangle's index and a copy of its corners
-    /// (the same normal as exact_'s, from the line just tested).
-    template <class Group>
-    static Hit<T> wide_hit(const TriangleHit<float>& h, const Group& group, int lane) {
-        return Hit<T>{h.t, group.slot[lane], h.u, h.v, group.triangle(lane).normal()};
-    }
-
-#if defined(__SSE2__)
-    /// Where a wide walk sends `ray`: to the binary tree's one-ray call (the wide walk does not
-    /// serve it), nowhere (it misses the tree's bounds: no hit) or down the wide layout, with its
-    /// slab constants in `k` (which also served the bounds test).
-    enum class WideRoute{Binary, Miss, Walk};
-    WideRoute route_wide(const Ray<float, 3>& ray, detail::SlabConstants& k) const {
-        if (!wide_ray_usable(ray)) return WideRoute::Binary;
-        k = detail::SlabConstants(ray);
-        return k.meets(bvh_.root().bounds, ray.tmin, ray.tmax) ? WideRoute::Walk : WideRoute::Miss;
-    }
-#endif
-
-#if BVHKIT_RAY_AVX2
-    /// The rays through the eight-wide layout in a stream (query/ray_stream.hpp): finish(s) takes
-    /// each walked ray; a ray the wide walk does not serve goes to alone(i) (the one-ray call,
-    /// which walks the binary tree), one that misses the bounds is a miss without a walk.
-    template <bool AnyHit, class Finish, class Alone>
-    void stream(std::span<const Ray<float, 3>> rays, Finish&& finish, Alone&& alone) const {
-        std::size_t next = 0;
-        const auto start = [&](detail::StreamRay& s) {
-            while (next < rays.size()) {
-                const std::size_t i = next++;
-                const Ray<float, 3>& ray = rays[i];
-                const WideRoute route = route_wide(ray, s.k);
-                if (route == WideRoute::Binary) {
-                    alone(i);
-                    continue;
-                }
-                s.index = i;
-                s.ray = ray;
-                if (route == WideRoute::Miss) {
-                    finish(s);  // no hit: stream8 cleared the slot's hit
-                    continue;
-                }
-                s.prep = WatertightRay<float>(ray, WatertightRay<float>::KnownValid{});
-                return true;
-            }
-            return false;
-        };
-        detail::StreamRay slots[detail::stream_width];
-        detail::stream8<AnyHit>(wide8_, slots, start, finish);
-    }
-
-    // occluded_stream on an eight-wide layout below 8 MB: the rays in octant streams
-    // (query/ray_octant_stream.hpp); those the wide walk does not take go one by one.
-    void occlude_in_octants(std::span<const Ray<float, 3>> rays,
-                            std::span<std::uint8_t> occluded) const {
-        const auto blocked = [&](std::size_t i, bool b) { occluded[i] = b ? 1 : 0; };
-        detail::OctantStreams streams;
-        detail::SlabConstants k;
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            const Ray<float, 3>& ray = rays[i];
-            const WideRoute route = route_wide(ray, k);
-            if (route == WideRoute::Walk)
-                streams.add(wide8_, ray, k, i, blocked);
-            else
-                occluded[i] = route == WideRoute::Binary && any_hit(ray) ? 1 : 0;
-        }
-        streams.finish(wide8_, blocked);
-    }
-#endif
-
     // The wide ray layout (query/ray_wide_layout.hpp), derived from the tree and the triangles:
     // made after a build, a refit or a load.
     void make_ray_layout() {
@@ -507,6 +425,7 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     bool split_references_ = false;  // some triangle is in more than one leaf
     TriangleTest triangle_test_ = TriangleTest::Watertight;
     RayLayout ray_layout_ = RayLayout::Auto;
+    RayBatchPath batch_path_ = RayBatchPath::Auto;  // not saved: a loaded tree starts at Auto
     WideRayBvh<4> wide4_;  // at most one of the two is filled (float, watertight, x86 only)
     WideRayBvh<8> wide8_;
     detail::QueryExclusion exclusion_;  // debug builds: refit() and queries never overlap

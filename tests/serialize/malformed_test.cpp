@@ -252,7 +252,10 @@ TEST(TriangleBvhFileHostile, BadHeadersAreErrors) {
     std::vector<std::uint8_t> magic = two_leaves().bytes();
     magic[3] = 'X';
     expect_error(magic, "magic", "magic");
-    expect_error(with([](RawTree& t) { t.version = 2; }), "version 2", "version 2");
+    expect_error(with([](RawTree& t) { t.version = 3; }), "version 3", "version 3");
+    // Version 2 needs the wide sections' header after the skipped list.
+    expect_error(with([](RawTree& t) { t.version = 2; }), "version 2 without wide sections",
+                 "payload bytes");
     expect_error(with([](RawTree& t) { t.version = 0; }), "version 0", "version");
     expect_error(with([](RawTree& t) { t.kind = 2; }), "kind", "kind");
     expect_error(with([](RawTree& t) { t.scalar = 7; }), "scalar 7", "unknown");

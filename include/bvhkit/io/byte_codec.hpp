@@ -106,6 +106,18 @@ class ByteReader {
         skip_padding(alignment);
         return {reinterpret_cast<const U*>(at), count};
     }
+    /// The next `n` bytes as they lie, then past them (a little-endian machine copies records
+    /// with them whole).
+    std::span<const std::uint8_t> take(std::size_t n) {
+        need(n);
+        const std::span<const std::uint8_t> out = bytes_.subspan(pos_, n);
+        pos_ += n;
+        return out;
+    }
+    /// Whether the next byte lies at an address that is a multiple of `alignment`.
+    bool aligned_in_memory(std::size_t alignment) const {
+        return reinterpret_cast<std::uintptr_t>(bytes_.data() + pos_) % alignment == 0;
+    }
     [[noreturn]] void fail(const std::string& message) const {
         throw Error(std::string(what_) + ": " + message + " (at byte " + std::to_string(pos_) +
                     ")");

@@ -5,11 +5,15 @@
 // and skipped list are the file's sections themselves, read in place: the format pads every section
 // to 8 bytes (docs/serialization.md), which aligns each record for its type.
 //
-// It answers closest_hit, any_hit, all_hits, trace and occluded as a TriangleBvh with
-// RayLayout::Binary loaded from the same file does, bit for bit: rays walk the binary tree, because
-// the wide layout is derived, not stored, and deriving it would copy the tree into memory. Against
-// a tree that traces wide (the default) the hits, t, barycentrics and normals are the same; where
-// two triangles are hit at the same t, which one is reported may differ (docs/serialization.md).
+// It answers closest_hit, any_hit, all_hits, trace and occluded as the TriangleBvh that
+// load_triangle_bvh makes of the same file does, bit for bit, by the same paths
+// (query/wide_triangle_rays.hpp): a file of version 2 holds the wide ray layout, read in place
+// too when the bytes lie aligned for it (always in a mapping, which starts on a page; a caller's
+// buffer that is not gets a copy of the wide sections). Where the file holds no wide layout of the
+// width this CPU walks (a file of version 1, or one written where AVX2 was present and read where
+// it is not), rays walk the binary tree, as a TriangleBvh with RayLayout::Binary would: the same
+// hits, t, barycentrics and normals as the wide walk, but where two triangles are hit at the same
+// t, which one is reported may differ (docs/serialization.md).
 //
 // Loading trusts the file no more than load_triangle_bvh does: the envelope and checksum, every
 // count, the tree's shape and every index always, validate() unless LoadOptions::validate is false.
@@ -27,7 +31,9 @@
 
 #include "bvhkit/io/mapped_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
+#include "bvhkit/io/wide_ray_sections.hpp"
 #include "bvhkit/query/triangle_rays.hpp"
+#include "bvhkit/query/wide_triangle_rays.hpp"
 
 namespace bvhkit {
 
@@ -46,14 +52,24 @@ class MappedTriangleBvh : public RayBatches<MappedTriangleBvh<T>, T> {
         return *this;
     }
 
-    Hit<T> closest_hit(const Ray<T, 3>& ray) const { return rays_.closest_hit(ray); }
+    Hit<T> closest_hit(const Ray<T, 3>& ray) const { return closest_hit(ray, NoStats{}); }
     template <class Stats>
     Hit<T> closest_hit(const Ray<T, 3>& ray, Stats&& stats) const {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>)
+            if (ray_width() > 2) return wide_rays().closest_hit(ray, stats);
+#endif
         return rays_.closest_hit(ray, stats);
     }
-    bool any_hit(const Ray<T, 3>& ray) const { return rays_.any_hit(ray); }
+    bool any_hit(const Ray<T, 3>& ray) const {
+        return any_hit(ray, NoStats{});
+    }
     template <class Stats>
     bool any_hit(const Ray<T, 3>& ray, Stats&& stats) const {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>)
+            if (ray_width() > 2) return wide_rays().any_hit(ray, stats);
+#endif
         return rays_.any_hit(ray, stats);
     }
     /// on_hit(const Hit<T>&) -> bool (true to go on); hits come in no particular order.
@@ -62,28 +78,99 @@ class MappedTriangleBvh : public RayBatches<MappedTriangleBvh<T>, T> {
         rays_.all_hits(ray, on_hit, stats);
     }
 
-    // Batches: trace() and occluded(), from RayBatches (query/triangle_rays.hpp).
+    // Batches: trace() and occluded(), from RayBatches (query/triangle_rays.hpp), which run these
+    // two on chunks of rays.
+
+    /// hits[i] = closest_hit(rays[i]) for every ray, on the calling thread.
+    void trace_on_calling_thread(std::span<const Ray<T, 3>> rays, std::span<Hit<T>> hits) const {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>)
+            if (ray_width() > 2) {
+                this->check_lengths(rays.size(), hits.size(), "trace_on_calling_thread: hits");
+                wide_rays().trace_on_calling_thread(rays, hits);
+                return;
+            }
+#endif
+        RayBatches<MappedTriangleBvh<T>, T>::trace_on_calling_thread(rays, hits);
+    }
+    /// occluded[i] = any_hit(rays[i]) (1 or 0) for every ray, on the calling thread.
+    void occluded_stream(std::span<const Ray<T, 3>> rays, std::span<std::uint8_t> occluded) const {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>)
+            if (ray_width() > 2) {
+                this->check_lengths(rays.size(), occluded.size(), "occluded_stream: occluded");
+                wide_rays().occluded_stream(rays, occluded);
+                return;
+            }
+#endif
+        RayBatches<MappedTriangleBvh<T>, T>::occluded_stream(rays, occluded);
+    }
 
     /// The tree, in place in the file.
-    BvhView<Aabb<T, 3>> bvh() const { return rays_.bvh(); }
+    BvhView<Aabb<T, 3>> bvh() const {
+        return rays_.bvh();
+    }
     /// Triangles left out of the tree for non-finite coordinates, by mesh index.
-    std::span<const std::uint32_t> skipped() const { return skipped_; }
-    std::size_t triangle_count() const { return triangle_count_; }
-    TriangleTest triangle_test() const { return rays_.triangle_test(); }
-    /// Always 2: rays walk the binary tree.
-    static constexpr int ray_width() { return 2; }
+    std::span<const std::uint32_t> skipped() const {
+        return skipped_;
+    }
+    std::size_t triangle_count() const {
+        return triangle_count_;
+    }
+    TriangleTest triangle_test() const {
+        return rays_.triangle_test();
+    }
+    /// The width of the tree rays walk: 8 or 4 (the file's wide layout), or 2 (the binary tree).
+    int ray_width() const {
+        return !wide8_.empty() ? 8 : !wide4_.empty() ? 4 : 2;
+    }
+    /// The bytes of the wide ray layout rays walk (0 for the binary tree).
+    std::size_t ray_layout_bytes() const {
+        return wide8_.empty() ? wide4_.bytes() : wide8_.bytes();
+    }
+    /// As TriangleBvh's (query/wide_triangle_rays.hpp).
+    RayBatchPath batch_path() const {
+        return batch_path_;
+    }
+    void set_batch_path(RayBatchPath path) {
+        check_batch_path(path, ray_width(), "MappedTriangleBvh::set_batch_path");
+        batch_path_ = path;
+    }
+    /// Whether the wide sections are read where they lie in the file (false: none are walked,
+    /// or the caller's bytes were not aligned for them and they were copied).
+    bool wide_layout_in_place() const {
+        return ray_width() > 2 && copied4_.empty() && copied8_.empty();
+    }
     /// The bytes the tree is read from (the whole file).
-    std::span<const std::uint8_t> bytes() const { return bytes_; }
+    std::span<const std::uint8_t> bytes() const {
+        return bytes_;
+    }
 
   private:
     friend struct serial_detail::MappedTriangleBvhAccess;
 
+#if defined(__SSE2__)
+    // Every ray path of a float tree over the file's sections (made per call: a few spans;
+    // called for float trees only).
+    WideTriangleRays wide_rays() const {
+        return WideTriangleRays(rays_, wide4_, wide8_, batch_path_);
+    }
+#endif
+
+    // The views stay valid: a moved mapping and moved vectors keep their addresses.
     void take(MappedTriangleBvh& other) noexcept {
         file_ = std::move(other.file_);
         bytes_ = std::exchange(other.bytes_, {});
         rays_ = std::exchange(other.rays_, {});
         skipped_ = std::exchange(other.skipped_, {});
         triangle_count_ = std::exchange(other.triangle_count_, 0);
+        wide4_ = std::exchange(other.wide4_, {});
+        wide8_ = std::exchange(other.wide8_, {});
+        copied4_ = std::move(other.copied4_);
+        copied8_ = std::move(other.copied8_);
+        other.copied4_ = {};
+        other.copied8_ = {};
+        batch_path_ = std::exchange(other.batch_path_, RayBatchPath::Auto);
     }
 
     MappedFile file_;  // empty for a view of the caller's bytes
@@ -91,6 +178,11 @@ class MappedTriangleBvh : public RayBatches<MappedTriangleBvh<T>, T> {
     TriangleRays<T> rays_;
     std::span<const std::uint32_t> skipped_;
     std::size_t triangle_count_ = 0;
+    WideRayView<4> wide4_;  // at most one is non-empty: the file's sections, or copied*_
+    WideRayView<8> wide8_;
+    WideRayBvh<4> copied4_;  // the wide sections, when the bytes were not aligned for them
+    WideRayBvh<8> copied8_;
+    RayBatchPath batch_path_ = RayBatchPath::Auto;
 };
 
 namespace serial_detail {
@@ -105,6 +197,8 @@ constexpr bool records_match_the_file() {
            sizeof(Node) == node_record_bytes<T> && offsetof(Node, first) == 6 * sizeof(T) &&
            sizeof(Triangle<T>) == 9 * sizeof(T) &&
            sizeof(PrecomputedTriangle<T>) == 12 * sizeof(T) && std::is_trivially_copyable_v<Node> &&
+           std::is_trivially_copyable_v<RayNode<8>> && std::is_trivially_copyable_v<RayGroup<8>> &&
+           std::is_trivially_copyable_v<RayNode<4>> && std::is_trivially_copyable_v<RayGroup<4>> &&
            std::is_trivially_copyable_v<Triangle<T>> &&
            std::is_trivially_copyable_v<PrecomputedTriangle<T>>;
 }
@@ -137,11 +231,49 @@ struct MappedTriangleBvhAccess {
                 rays = TriangleRays<T>(bvh, corners);
             }
             const auto skipped = r.records_in_place<std::uint32_t>(std::size_t(skipped_count), 8);
+            const WideSectionHeader wide = open_wide_sections<T>(f, r, what);
             check_loaded_triangle_tree<T>(rays, corners, triangle_count, skipped, options, what);
+            if (wide.width == 4) open_wide<4>(tree, r, wide, f, bvh, corners, options);
+            if (wide.width == 8) open_wide<8>(tree, r, wide, f, bvh, corners, options);
             tree.bytes_ = bytes;
             tree.rays_ = rays;
             tree.skipped_ = skipped;
             tree.triangle_count_ = std::size_t(triangle_count);
+        }
+    }
+
+    // The wide sections in place (or copied where the bytes are not aligned for them), checked as
+    // load_triangle_bvh checks them; walked only when of the width this CPU walks.
+    template <int W, class T>
+    static void open_wide(MappedTriangleBvh<T>& tree, ByteReader& r, const WideSectionHeader& h,
+                          const TriangleBvhFileHeader& f, BvhView<Aabb<T, 3>> bvh,
+                          std::span<const Triangle<T>> corners, const LoadOptions& options) {
+        WideRayBvh<W> copied;
+        const WideRayView<W> view = read_wide_layout(r, h, copied);
+        const std::uint64_t triangle_count = f.file.header.counts[3];
+        check_wide_structure<W>(view, triangle_count, what);
+        if (W != f.wide_width_here<T>()) return;
+        if constexpr (std::is_same_v<T, float>) {
+            if (options.validate) {
+                // The layout a load derives, from a copy of the tree, compared and dropped.
+                Bvh<Aabb<float, 3>> tree_copy;
+                tree_copy.nodes.assign(bvh.nodes.begin(), bvh.nodes.end());
+                tree_copy.primitive_indices.assign(bvh.primitive_indices.begin(),
+                                                   bvh.primitive_indices.end());
+                const WideRayBvh<W> derived = make_wide_ray_bvh<W>(
+                    tree_copy, [&](std::uint32_t s) { return corners[s]; },
+                    [&](std::uint32_t s) { return bvh.primitive_indices[s]; });
+                if (!same_wide_layout<W>(derived, view))
+                    throw Error(std::string(what) +
+                                ": the stored wide ray layout is not the one the tree derives");
+            }
+            if constexpr (W == 4) {
+                tree.copied4_ = std::move(copied);
+                tree.wide4_ = view;
+            } else {
+                tree.copied8_ = std::move(copied);
+                tree.wide8_ = view;
+            }
         }
     }
 

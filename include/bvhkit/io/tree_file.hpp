@@ -18,8 +18,12 @@
 
 namespace bvhkit {
 
-/// The format version this library writes; it reads this version only.
+/// The format version this library writes for every kind but TriangleBvh; it reads this version
+/// only.
 inline constexpr std::uint32_t tree_file_version = 1;
+/// The TriangleBvh file's version: 2 adds the wide ray layout's sections (docs/serialization.md).
+/// Files of version 1 still load.
+inline constexpr std::uint32_t triangle_bvh_file_version = 2;
 
 struct LoadOptions {
     /// Run validate() on the loaded tree (each node encloses its children and its triangles, each
@@ -115,9 +119,10 @@ struct OpenedTreeFile {
     std::span<const std::uint8_t> payload;
 };
 
-/// Checks the envelope: size, magic, version, kind, reserved bytes, payload size, checksum.
+/// Checks the envelope: size, magic, version (1 to `newest`), kind, reserved bytes, payload size,
+/// checksum.
 inline OpenedTreeFile open_tree_file(std::span<const std::uint8_t> file, FileKind expected,
-                                     const char* what) {
+                                     const char* what, std::uint32_t newest = tree_file_version) {
     ByteReader r(file, what);
     if (file.size() < tree_file_header_size)
         r.fail("truncated: " + std::to_string(file.size()) + " bytes, shorter than the " +
@@ -127,13 +132,16 @@ inline OpenedTreeFile open_tree_file(std::span<const std::uint8_t> file, FileKin
     OpenedTreeFile f;
     TreeFileHeader& h = f.header;
     h.version = r.u32();
-    if (h.version != tree_file_version)
-        r.fail("format version " + std::to_string(h.version) + ", this library reads version " +
-               std::to_string(tree_file_version));
     h.kind = FileKind(r.u32());
+    // The kind first: each kind has versions of its own, so another kind's file may carry a
+    // version this kind never had.
     if (h.kind != expected)
         r.fail("the file holds structure kind " + std::to_string(std::uint32_t(h.kind)) +
                ", expected " + std::to_string(std::uint32_t(expected)));
+    if (h.version < 1 || h.version > newest)
+        r.fail("format version " + std::to_string(h.version) + ", this library reads version " +
+               (newest == 1 ? std::string("1") : "1 to " + std::to_string(newest)) +
+               " of this kind");
     h.scalar = ScalarCode(r.u8());
     h.volume = VolumeCode(r.u8());
     h.layout = r.u8();

@@ -2,16 +2,19 @@
 // Saving and loading a TriangleBvh (format: docs/serialization.md). The file holds exactly what the
 // tree holds: nodes, slot -> triangle indices, the triangles in slot order in the layout of the
 // tree's triangle test (corners for the watertight test, p0/edges/normal for the fast one), the
-// skipped triangles, and the ray layout it was built with (RayLayout, in the layout byte's high
-// half). Nothing is rebuilt on load but the wide ray layout, derived from the loaded tree by the
-// code a build uses (storing it does not pay: docs/serialization.md), so a loaded tree answers bit
-// for bit as the saved one (on a CPU of the same kind: RayLayout::Auto picks by AVX2), and saving
-// it again gives the same bytes.
+// skipped triangles, the ray layout it was built with (RayLayout, in the layout byte's high half)
+// and, from version 2 on, the wide ray layout itself (io/wide_ray_sections.hpp), so that a mapped
+// file traces wide (io/mapped_triangle_bvh.hpp). A load uses the stored wide layout when it is
+// the width this CPU walks (RayLayout::Auto picks by AVX2) and derives it from the loaded tree by
+// the code a build uses otherwise (a file of version 1, or one written on a CPU of another kind).
+// A loaded tree answers bit for bit as the saved one, and saving it again gives the same bytes
+// (of version 2, and on a CPU of the same kind).
 //
 // Loading trusts nothing: the envelope (size, checksum) is checked first, every count against the
 // bytes there are before anything is allocated, then the tree's shape and every index
-// (check_tree_structure), always; then validate() unless LoadOptions::validate is false. Any
-// failure is a bvhkit::Error.
+// (check_tree_structure) and the wide layout's (check_wide_structure), always; then validate()
+// unless LoadOptions::validate is false, which for the wide layout means it must be the one the
+// tree derives, byte for byte. Any failure is a bvhkit::Error.
 //
 // Thread safety: saving reads the tree only (const queries may run at the same time); loading
 // touches only its input and the tree it returns.
@@ -24,6 +27,7 @@
 #include "bvhkit/io/tree_file.hpp"
 #include "bvhkit/io/tree_sections.hpp"
 #include "bvhkit/io/tree_structure.hpp"
+#include "bvhkit/io/wide_ray_sections.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 
 namespace bvhkit {
@@ -40,12 +44,31 @@ struct TriangleBvhFileHeader {
     OpenedTreeFile file;
     bool fast = false;  // precomputed triangles (the fast test) rather than corners
     RayLayout ray_layout = RayLayout::Auto;
+
+    /// Whether the tree's rays can walk a wide layout on some CPU: else the file holds none.
+    template <class T>
+    bool walks_wide_somewhere() const {
+        return std::is_same_v<T, float> && !fast && ray_layout != RayLayout::Binary &&
+               file.header.counts[0] > 0;
+    }
+    /// The width of the wide layout the tree walks on this CPU (TriangleBvh::make_ray_layout's
+    /// choice), 0 for none.
+    template <class T>
+    int wide_width_here() const {
+#if defined(__SSE2__)
+        if (!walks_wide_somewhere<T>()) return 0;
+        return ray_layout != RayLayout::Wide4 && cpu_has_avx2() ? 8 : 4;
+#else
+        return 0;
+#endif
+    }
 };
 
 template <class T>
 TriangleBvhFileHeader open_triangle_bvh_file(std::span<const std::uint8_t> bytes,
                                              const char* what) {
-    TriangleBvhFileHeader out{open_tree_file(bytes, FileKind::TriangleBvh, what)};
+    TriangleBvhFileHeader out{
+        open_tree_file(bytes, FileKind::TriangleBvh, what, triangle_bvh_file_version)};
     const TreeFileHeader& h = out.file.header;
     check_scalar_and_volume<T>(h, what);
     const auto layout = TriangleLayout(h.layout & 0x0f);
@@ -56,8 +79,23 @@ TriangleBvhFileHeader open_triangle_bvh_file(std::span<const std::uint8_t> bytes
                     std::to_string(int(h.layout)));
     out.fast = layout == TriangleLayout::Precomputed;
     out.ray_layout = RayLayout(ray_layout);
-    check_tree_counts(h, node_record_bytes<T>, (out.fast ? 12 : 9) * sizeof(T), 0, what);
+    // Version 2: the wide layout's sections follow, checked by get_wide_header.
+    check_tree_counts(h, node_record_bytes<T>, (out.fast ? 12 : 9) * sizeof(T),
+                      h.version >= 2 ? wide_header_bytes : 0, what, h.version == 1);
     return out;
+}
+
+// The wide layout's header of a version-2 file (none in version 1), after the skipped list.
+template <class T>
+WideSectionHeader open_wide_sections(const TriangleBvhFileHeader& f, ByteReader& r,
+                                     const char* what) {
+    if (f.file.header.version < 2) return {};
+    const WideSectionHeader h = get_wide_header(r);
+    if (h.width != 0 && !f.walks_wide_somewhere<T>())
+        throw Error(std::string(what) +
+                    ": a wide ray layout in a tree whose rays walk the binary tree (a double "
+                    "tree, the fast test, RayLayout::Binary or no nodes)");
+    return h;
 }
 
 // The checks on a loaded tree, wherever its arrays lie: shape and indices always, then validate()
@@ -106,7 +144,12 @@ struct TriangleBvhAccess {
             put_corners<T>(w, tree.exact_);
         }
         put_u32s(w, tree.report_.skipped);
+        if (!tree.wide8_.empty())
+            put_wide_layout<8>(w, tree.wide8_);
+        else
+            put_wide_layout<4>(w, tree.wide4_);  // width 0 when empty
         TreeFileHeader h;
+        h.version = triangle_bvh_file_version;
         h.kind = FileKind::TriangleBvh;
         h.scalar = scalar_code<T>();
         h.volume = VolumeCode::Aabb3;
@@ -143,10 +186,34 @@ struct TriangleBvhAccess {
         }
         auto& skipped = tree.report_.skipped;
         get_u32s(r, skipped, skipped_count);
+        const WideSectionHeader wide = open_wide_sections<T>(f, r, what);
+        // Read in place where the bytes allow (copied only when kept), else copied here.
+        WideRayBvh<4> copy4;
+        WideRayBvh<8> copy8;
+        WideRayView<4> stored4;
+        WideRayView<8> stored8;
+        if (wide.width == 4) stored4 = read_wide_layout(r, wide, copy4);
+        if (wide.width == 8) stored8 = read_wide_layout(r, wide, copy8);
 
         check_loaded_triangle_tree<T>(tree.binary_rays(), tree.exact_, triangle_count, skipped,
                                       options, what);
-        tree.make_ray_layout();  // derived, not stored: the structure was checked above
+        check_wide_structure<4>(stored4, triangle_count, what);
+        check_wide_structure<8>(stored8, triangle_count, what);
+        // The stored layout where it is the one this CPU walks and is trusted or proved the
+        // derived one; else derived from the tree, whose structure was checked above.
+        if (wide.width != 0 && wide.width == f.wide_width_here<T>() && !options.validate) {
+            tree.wide4_.nodes.assign(stored4.nodes.begin(), stored4.nodes.end());
+            tree.wide4_.groups.assign(stored4.groups.begin(), stored4.groups.end());
+            tree.wide8_.nodes.assign(stored8.nodes.begin(), stored8.nodes.end());
+            tree.wide8_.groups.assign(stored8.groups.begin(), stored8.groups.end());
+            return tree;
+        }
+        tree.make_ray_layout();
+        if (wide.width != 0 && wide.width == f.wide_width_here<T>() &&
+            !(same_wide_layout<4>(tree.wide4_, stored4) &&
+              same_wide_layout<8>(tree.wide8_, stored8)))
+            throw Error(std::string(what) +
+                        ": the stored wide ray layout is not the one the tree derives");
         return tree;
     }
 };

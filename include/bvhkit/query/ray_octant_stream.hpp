@@ -33,7 +33,7 @@ static_assert(octant_stream_size >= 1 && octant_stream_size <= 32);
 /// Whether octant streams serve an occlusion batch on `tree` better than the interleaved walks of
 /// query/ray_stream.hpp: below tuning::octant_streams_below_layout_bytes. Above it a node's rays
 /// are few and the walk waits for memory, which the interleaving hides better.
-inline bool octant_streams_pay(const WideRayBvh<8>& tree) {
+inline bool octant_streams_pay(WideRayView<8> tree) {
     return tree.bytes() < tuning::octant_streams_below_layout_bytes;
 }
 
@@ -72,7 +72,7 @@ inline int direction_octant(const SlabConstants& k) {
 /// Walks the stream's rays (all of octant `octant`) through `tree`; calls blocked(index, bool)
 /// once for each.
 template <class Blocked>
-[[gnu::target("avx2")]] void occlude_octant_stream(const WideRayBvh<8>& tree, const OctantStream& s,
+[[gnu::target("avx2")]] void occlude_octant_stream(WideRayView<8> tree, const OctantStream& s,
                                                    int octant, Blocked&& blocked) {
     struct Entry {
         std::uint32_t child, groups, rays;  // groups > 0: a leaf; rays: the mask of its rays
@@ -174,8 +174,8 @@ class OctantStreams {
     /// Adds ray i (one wide_ray_usable accepts, with its slab constants k); walks its octant's
     /// stream if that is now full.
     template <class Blocked>
-    void add(const WideRayBvh<8>& tree, const Ray<float, 3>& ray, const SlabConstants& k,
-             std::size_t i, Blocked&& blocked) {
+    void add(WideRayView<8> tree, const Ray<float, 3>& ray, const SlabConstants& k, std::size_t i,
+             Blocked&& blocked) {
         const int octant = direction_octant(k);
         OctantStream& s = streams_[octant];
         s.add(ray, k, i);
@@ -186,7 +186,7 @@ class OctantStreams {
     }
     /// Walks the rays still waiting.
     template <class Blocked>
-    void finish(const WideRayBvh<8>& tree, Blocked&& blocked) {
+    void finish(WideRayView<8> tree, Blocked&& blocked) {
         for (int octant = 0; octant < 8; ++octant) {
             OctantStream& s = streams_[octant];
             if (s.count > 0) occlude_octant_stream(tree, s, octant, blocked);

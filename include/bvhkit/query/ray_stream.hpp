@@ -30,7 +30,7 @@ inline constexpr int stream_width = tuning::stream_width;
 /// Whether a stream pays for `tree`: once its layout is tuning::stream_from_layout_bytes or more.
 /// A layout that stays in a core's L2 has little latency to hide, and the walks' interleaving
 /// costs it some (the branch history of one ray's walk no longer predicts its next step).
-inline bool stream_pays(const WideRayBvh<8>& tree) {
+inline bool stream_pays(WideRayView<8> tree) {
     return tree.bytes() >= tuning::stream_from_layout_bytes;
 }
 
@@ -59,7 +59,7 @@ struct StreamRay {
 /// at the first hit, children in any order (walk8 with AnyLeaves); else the closest hit
 /// (ClosestLeaves).
 template <bool AnyHit, class Start, class Finish>
-[[gnu::target("avx2")]] void stream8(const WideRayBvh<8>& tree, StreamRay* slots, Start&& start,
+[[gnu::target("avx2")]] void stream8(WideRayView<8> tree, StreamRay* slots, Start&& start,
                                      Finish&& finish) {
     const RayNode<8>* nodes = tree.nodes.data();
     const TriangleGroup8* groups = tree.groups.data();

@@ -114,7 +114,7 @@ struct alignas(16) SlabConstants {
 // is free. maxps/minps return their second operand when either is NaN, and the accumulators never
 // are, so a 0 * inf plane distance does not restrict the interval (as in the scalar test).
 template <class OnLeaf, class Stats>
-void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k, WideEntry* stack,
+void walk4(WideRayView<4> tree, Ray<float, 3>& ray, const SlabConstants& k, WideEntry* stack,
            OnLeaf& on_leaf, Stats& stats) {
     __m128 origin[3], inv[3], inv_far[3];
     for (int a = 0; a < 3; ++a) {
@@ -188,9 +188,8 @@ void walk4(const WideRayBvh<4>& tree, Ray<float, 3>& ray, const SlabConstants& k
 // that carries the target attribute itself (GCC will not inline them into a lambda or a generic
 // helper of the default target), and walk4 must not carry it.
 template <class OnLeaf, class Stats>
-[[gnu::target("avx2")]] void walk8(const WideRayBvh<8>& tree, Ray<float, 3>& ray,
-                                   const SlabConstants& k, WideStack8& stack, OnLeaf& on_leaf,
-                                   Stats& stats) {
+[[gnu::target("avx2")]] void walk8(WideRayView<8> tree, Ray<float, 3>& ray, const SlabConstants& k,
+                                   WideStack8& stack, OnLeaf& on_leaf, Stats& stats) {
     __m256 origin[3], inv[3], inv_far[3];
     for (int a = 0; a < 3; ++a) {
         origin[a] = _mm256_set1_ps(k.origin[a]);
@@ -232,7 +231,7 @@ template <class OnLeaf, class Stats>
 
 /// The walk of `tree` for `ray`.
 template <int W, class OnLeaf, class Stats>
-void traverse_wide_ray(const WideRayBvh<W>& tree, Ray<float, 3>& ray, const SlabConstants& k,
+void traverse_wide_ray(WideRayView<W> tree, Ray<float, 3>& ray, const SlabConstants& k,
                        OnLeaf&& on_leaf, Stats& stats) {
     if constexpr (W == 4) {
         WideStack4 stack;
@@ -340,14 +339,14 @@ struct AnyLeaves {
 /// misses); hit_group is null on a miss. The ray must be one wide_ray_usable accepts, and an
 /// eight-wide tree needs cpu_has_avx2().
 template <int W, class Stats = NoStats>
-bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
+bool closest_hit_wide(WideRayView<W> tree, const Ray<float, 3>& ray_in,
                       const detail::SlabConstants& k, const WatertightRay<float>& prep,
-                      TriangleHit<float>& best, const typename WideRayBvh<W>::Group*& hit_group,
+                      TriangleHit<float>& best, const typename WideRayView<W>::Group*& hit_group,
                       int& hit_lane, Stats&& stats = {}) {
     Ray<float, 3> ray = ray_in;
     hit_group = nullptr;
     hit_lane = 0;
-    detail::ClosestLeaves<typename WideRayBvh<W>::Group, std::remove_reference_t<Stats>> leaves{
+    detail::ClosestLeaves<typename WideRayView<W>::Group, std::remove_reference_t<Stats>> leaves{
         tree.groups.data(), prep, ray, best, hit_group, hit_lane, stats};
     detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return hit_group != nullptr;
@@ -355,14 +354,14 @@ bool closest_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
 
 /// Any hit through a wide tree (same conditions as closest_hit_wide).
 template <int W, class Stats = NoStats>
-bool any_hit_wide(const WideRayBvh<W>& tree, const Ray<float, 3>& ray_in,
+bool any_hit_wide(WideRayView<W> tree, const Ray<float, 3>& ray_in,
                   const WatertightRay<float>& prep, Stats&& stats = {}) {
     // The slab constants from the caller's ray, before the copy the walk reads: read from the
     // copy, its direction straddled the two stores that wrote it (a store-forwarding stall).
     const detail::SlabConstants k(ray_in);
     Ray<float, 3> ray = ray_in;
     bool found = false;
-    detail::AnyLeaves<typename WideRayBvh<W>::Group, std::remove_reference_t<Stats>> leaves{
+    detail::AnyLeaves<typename WideRayView<W>::Group, std::remove_reference_t<Stats>> leaves{
         tree.groups.data(), prep, ray, found, stats};
     detail::traverse_wide_ray(tree, ray, k, leaves, stats);
     return found;

@@ -1,9 +1,12 @@
 #pragma once
 // The wide ray layouts of TriangleBvh<float>: RayNode (a node's children's boxes one array per
 // axis and bound), WideRayBvh (the nodes and the leaves' triangle groups) and make_wide_ray_bvh,
-// which derives them from the binary tree. The walks over them are in query/ray_wide.hpp.
+// which derives them from the binary tree. WideRayView is what the walks (query/ray_wide.hpp)
+// read: spans over a WideRayBvh's arrays, or over a mapped file's sections
+// (io/mapped_triangle_bvh.hpp).
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "bvhkit/bvh/huge_page_allocator.hpp"
@@ -28,18 +31,36 @@ struct alignas(64) RayNode {
     std::uint32_t groups[W];  // leaf: how many groups (>= 1); inner or empty: 0
 };
 
+/// The triangle groups of the layout of width W: as wide as the walk's registers.
 template <int W>
-struct WideRayBvh {
-    using Group = TriangleGroup<W == 8 ? 8 : 4>;  // as wide as the walk's registers
-    // On huge pages once large (bvh/huge_page_allocator.hpp): incoherent rays read both at random.
-    std::vector<RayNode<W>, HugePageAllocator<RayNode<W>>> nodes;  // nodes[0] is the root
-    std::vector<Group, HugePageAllocator<Group>> groups;
+using RayGroup = TriangleGroup<W == 8 ? 8 : 4>;
+
+/// A wide ray layout where it lies, read only: nodes[0] is the root.
+template <int W>
+struct WideRayView {
+    using Group = RayGroup<W>;
+    std::span<const RayNode<W>> nodes;
+    std::span<const Group> groups;
 
     bool empty() const { return nodes.empty(); }
     /// The layout's size: what a walk reads from.
     std::size_t bytes() const {
         return nodes.size() * sizeof(RayNode<W>) + groups.size() * sizeof(Group);
     }
+};
+
+template <int W>
+struct WideRayBvh {
+    using Group = RayGroup<W>;
+    // On huge pages once large (bvh/huge_page_allocator.hpp): incoherent rays read both at random.
+    std::vector<RayNode<W>, HugePageAllocator<RayNode<W>>> nodes;  // nodes[0] is the root
+    std::vector<Group, HugePageAllocator<Group>> groups;
+
+    bool empty() const { return nodes.empty(); }
+    /// The layout's size: what a walk reads from.
+    std::size_t bytes() const { return view().bytes(); }
+    WideRayView<W> view() const { return {nodes, groups}; }
+    operator WideRayView<W>() const { return view(); }  // NOLINT: the walks take either
 };
 
 /// Whether this CPU runs the eight-wide walk (AVX2), asked once.

@@ -1,0 +1,214 @@
+#pragma once
+// WideTriangleRays: every ray path of a float tree with the watertight test that walks a wide
+// layout, over arrays it does not own. TriangleBvh<float> runs it on its own arrays and
+// MappedTriangleBvh<float> (io/mapped_triangle_bvh.hpp) on a mapped file's sections, so both take
+// the same path for the same ray and answer alike.
+//
+// The paths: a ray the wide walk does not serve (query/ray_wide.hpp, wide_ray_usable) takes the
+// binary tree; one that misses the tree's bounds is a miss without a walk; the others walk the
+// wide layout, four or eight wide. Batches on the eight-wide layout may walk several rays at once
+// (streams, query/ray_stream.hpp; octant streams for occlusion, query/ray_octant_stream.hpp),
+// chosen by the layout's size (tuning.hpp) or forced by RayBatchPath. Every path gives the
+// one-ray calls' answers, bit for bit.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "bvhkit/error.hpp"
+#include "bvhkit/query/ray_octant_stream.hpp"
+#include "bvhkit/query/ray_stream.hpp"
+#include "bvhkit/query/ray_wide.hpp"
+#include "bvhkit/query/triangle_rays.hpp"
+
+namespace bvhkit {
+
+/// Which walk the batch calls (trace, occluded and their _stream forms) take on the eight-wide
+/// layout. Every choice answers as the one-ray calls do, bit for bit; the choice is for tests,
+/// which must run every path whatever the mesh's size, and for measuring.
+enum class RayBatchPath {
+    Auto,           // by the layout's size (tuning.hpp): trace batches in streams from 2 MB on,
+                    // occlusion batches in octant streams below 8 MB and in streams above
+    OneByOne,       // each ray walks alone, as closest_hit / any_hit
+    Streams,        // eight rays in flight (query/ray_stream.hpp); needs the eight-wide layout
+    OctantStreams,  // occlusion batches in octant streams (query/ray_octant_stream.hpp), trace
+                    // batches as Auto; needs the eight-wide layout
+};
+
+/// An Error unless a tree whose rays walk `ray_width` wide can take `path`: the streams need the
+/// eight-wide layout (RayLayout Auto or Wide8 on a CPU with AVX2).
+inline void check_batch_path(RayBatchPath path, int ray_width, const char* what) {
+    if ((path == RayBatchPath::Streams || path == RayBatchPath::OctantStreams) && ray_width != 8)
+        throw Error(std::string(what) + ": RayBatchPath::" +
+                    (path == RayBatchPath::Streams ? "Streams" : "OctantStreams") +
+                    " needs the eight-wide ray layout, and this tree's rays walk " +
+                    std::to_string(ray_width) +
+                    " wide (the eight-wide walk needs a CPU with AVX2, the watertight test and "
+                    "RayLayout Auto or Wide8)");
+}
+
+#if defined(__SSE2__)
+class WideTriangleRays {
+  public:
+    WideTriangleRays() = default;
+    /// `binary` walks the tree (watertight, over corners) for the rays the wide walk does not
+    /// serve; at most one of `wide4` and `wide8` is non-empty, and an eight-wide one needs
+    /// cpu_has_avx2(). check_batch_path(path, width()) must hold.
+    WideTriangleRays(const TriangleRays<float>& binary, WideRayView<4> wide4, WideRayView<8> wide8,
+                     RayBatchPath path)
+        : binary_(binary), wide4_(wide4), wide8_(wide8), path_(path) {}
+
+    /// 8 or 4 (the wide layout's width), or 2 when there is none.
+    int width() const { return !wide8_.empty() ? 8 : !wide4_.empty() ? 4 : 2; }
+    std::size_t layout_bytes() const { return wide8_.empty() ? wide4_.bytes() : wide8_.bytes(); }
+
+    /// Whether trace batches walk streams.
+    bool streams_traces() const {
+#if BVHKIT_RAY_AVX2
+        if (wide8_.empty() || path_ == RayBatchPath::OneByOne) return false;
+        return path_ == RayBatchPath::Streams || detail::stream_pays(wide8_);
+#else
+        return false;
+#endif
+    }
+
+    template <class Stats>
+    Hit<float> closest_hit(const Ray<float, 3>& ray, Stats&& stats) const {
+        detail::SlabConstants k;
+        const Route route = width() > 2 ? route_wide(ray, k) : Route::Binary;
+        if (route == Route::Miss) return Hit<float>{};
+        if (route == Route::Binary) return binary_.closest_hit(ray, stats);
+        const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
+        const auto trace = [&](auto wide) {
+            TriangleHit<float> h;
+            const typename decltype(wide)::Group* group;
+            int lane;
+            if (!closest_hit_wide(wide, ray, k, prep, h, group, lane, stats)) return Hit<float>{};
+            return wide_hit(h, *group, lane);
+        };
+        return wide8_.empty() ? trace(wide4_) : trace(wide8_);
+    }
+
+    template <class Stats>
+    bool any_hit(const Ray<float, 3>& ray, Stats&& stats) const {
+        if (width() == 2 || !wide_ray_usable(ray)) return binary_.any_hit(ray, stats);
+        const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
+        return wide8_.empty() ? any_hit_wide(wide4_, ray, prep, stats)
+                              : any_hit_wide(wide8_, ray, prep, stats);
+    }
+
+    /// hits[i] = closest_hit(rays[i]); the spans are of one length.
+    void trace_on_calling_thread(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits) const {
+#if BVHKIT_RAY_AVX2
+        if (streams_traces()) {
+            stream<false>(
+                rays,
+                [&](const detail::StreamRay& s) {
+                    hits[s.index] =
+                        s.hit_group ? wide_hit(s.best, *s.hit_group, s.hit_lane) : Hit<float>{};
+                },
+                [&](std::size_t i) { hits[i] = closest_hit(rays[i], NoStats{}); });
+            return;
+        }
+#endif
+        for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], NoStats{});
+    }
+
+    /// occluded[i] = any_hit(rays[i]) (1 or 0); the spans are of one length.
+    void occluded_stream(std::span<const Ray<float, 3>> rays,
+                         std::span<std::uint8_t> occluded) const {
+#if BVHKIT_RAY_AVX2
+        if (!wide8_.empty() && path_ != RayBatchPath::OneByOne) {
+            const bool octants =
+                path_ == RayBatchPath::OctantStreams ||
+                (path_ == RayBatchPath::Auto && detail::octant_streams_pay(wide8_));
+            if (octants)
+                occlude_in_octants(rays, occluded);
+            else
+                stream<true>(
+                    rays, [&](const detail::StreamRay& s) { occluded[s.index] = s.found ? 1 : 0; },
+                    [&](std::size_t i) { occluded[i] = any_hit(rays[i], NoStats{}) ? 1 : 0; });
+            return;
+        }
+#endif
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            occluded[i] = any_hit(rays[i], NoStats{}) ? 1 : 0;
+    }
+
+  private:
+    /// A wide walk's hit as a Hit: the group holds the triangle's index and a copy of its corners
+    /// (the same normal as the binary walk's, from the line just tested).
+    template <class Group>
+    static Hit<float> wide_hit(const TriangleHit<float>& h, const Group& group, int lane) {
+        return Hit<float>{h.t, group.slot[lane], h.u, h.v, group.triangle(lane).normal()};
+    }
+
+    /// Where a wide walk sends `ray`: to the binary walk (the wide walk does not serve it),
+    /// nowhere (it misses the tree's bounds: no hit) or down the wide layout, with its slab
+    /// constants in `k` (which also served the bounds test).
+    enum class Route { Binary, Miss, Walk };
+    Route route_wide(const Ray<float, 3>& ray, detail::SlabConstants& k) const {
+        if (!wide_ray_usable(ray)) return Route::Binary;
+        k = detail::SlabConstants(ray);
+        return k.meets(binary_.bvh().nodes[0].bounds, ray.tmin, ray.tmax) ? Route::Walk
+                                                                          : Route::Miss;
+    }
+
+#if BVHKIT_RAY_AVX2
+    /// The rays through the eight-wide layout in a stream (query/ray_stream.hpp): finish(s) takes
+    /// each walked ray; a ray the wide walk does not serve goes to alone(i) (the one-ray call,
+    /// which walks the binary tree), one that misses the bounds is a miss without a walk.
+    template <bool AnyHit, class Finish, class Alone>
+    void stream(std::span<const Ray<float, 3>> rays, Finish&& finish, Alone&& alone) const {
+        std::size_t next = 0;
+        const auto start = [&](detail::StreamRay& s) {
+            while (next < rays.size()) {
+                const std::size_t i = next++;
+                const Ray<float, 3>& ray = rays[i];
+                const Route route = route_wide(ray, s.k);
+                if (route == Route::Binary) {
+                    alone(i);
+                    continue;
+                }
+                s.index = i;
+                s.ray = ray;
+                if (route == Route::Miss) {
+                    finish(s);  // no hit: stream8 cleared the slot's hit
+                    continue;
+                }
+                s.prep = WatertightRay<float>(ray, WatertightRay<float>::KnownValid{});
+                return true;
+            }
+            return false;
+        };
+        detail::StreamRay slots[detail::stream_width];
+        detail::stream8<AnyHit>(wide8_, slots, start, finish);
+    }
+
+    // Occlusion rays in octant streams (query/ray_octant_stream.hpp); those the wide walk does not
+    // take go one by one.
+    void occlude_in_octants(std::span<const Ray<float, 3>> rays,
+                            std::span<std::uint8_t> occluded) const {
+        const auto blocked = [&](std::size_t i, bool b) { occluded[i] = b ? 1 : 0; };
+        detail::OctantStreams streams;
+        detail::SlabConstants k;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            const Ray<float, 3>& ray = rays[i];
+            const Route route = route_wide(ray, k);
+            if (route == Route::Walk)
+                streams.add(wide8_, ray, k, i, blocked);
+            else
+                occluded[i] = route == Route::Binary && binary_.any_hit(ray) ? 1 : 0;
+        }
+        streams.finish(wide8_, blocked);
+    }
+#endif
+
+    TriangleRays<float> binary_;
+    WideRayView<4> wide4_;
+    WideRayView<8> wide8_;
+    RayBatchPath path_ = RayBatchPath::Auto;
+};
+#endif
+
+}  // namespace bvhkit
