@@ -144,11 +144,11 @@ void check_every_path(const std::vector<Triangle<float>>& tris, std::size_t ray_
         {"binary, fast", RayLayout::Binary, TriangleTest::Fast, 2, RayBatchPath::OneByOne},
         {"four wide", RayLayout::Wide4, TriangleTest::Watertight, empty ? 2 : 4,
          RayBatchPath::OneByOne},
-        {"eight wide", RayLayout::Wide8, TriangleTest::Watertight, empty ? 2 : 8,
+        {"eight wide", RayLayout::Auto, TriangleTest::Watertight, empty ? 2 : 8,
          RayBatchPath::OneByOne},
-        {"eight-ray streams", RayLayout::Wide8, TriangleTest::Watertight, empty ? 2 : 8,
+        {"eight-ray streams", RayLayout::Auto, TriangleTest::Watertight, empty ? 2 : 8,
          RayBatchPath::Streams},
-        {"octant streams", RayLayout::Wide8, TriangleTest::Watertight, empty ? 2 : 8,
+        {"octant streams", RayLayout::Auto, TriangleTest::Watertight, empty ? 2 : 8,
          RayBatchPath::OctantStreams},
     };
     std::vector<std::string> skipped;
