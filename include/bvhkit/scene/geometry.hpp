@@ -30,18 +30,82 @@ namespace bvhkit {
 
 namespace scene_detail {
 
-/// x rounded to T toward -inf (down) or +inf (up).
+/// x rounded to T toward -inf (down) or +inf (up). A value beyond T's finite range becomes the
+/// infinity on its side (or T's largest finite value, rounding toward zero): the conversion itself
+/// is only defined within the range, so the range is checked first.
 template <class T, class W>
 T round_down(W x) {
+    constexpr W big = W(std::numeric_limits<T>::max());
+    if (x > big) return std::numeric_limits<T>::max();
+    if (x < -big) return -std::numeric_limits<T>::infinity();
     T r = T(x);
     if (W(r) > x) r = std::nextafter(r, -std::numeric_limits<T>::infinity());
     return r;
 }
 template <class T, class W>
 T round_up(W x) {
+    constexpr W big = W(std::numeric_limits<T>::max());
+    if (x > big) return std::numeric_limits<T>::infinity();
+    if (x < -big) return -std::numeric_limits<T>::max();
     T r = T(x);
     if (W(r) < x) r = std::nextafter(r, std::numeric_limits<T>::infinity());
     return r;
+}
+/// x rounded to T to nearest, or the infinity on its side when beyond T's finite range (NaN stays
+/// NaN): the narrowing conversion without its undefined case.
+template <class T, class W>
+T narrow(W x) {
+    constexpr W big = W(std::numeric_limits<T>::max());
+    if (x > big) return std::numeric_limits<T>::infinity();
+    if (x < -big) return -std::numeric_limits<T>::infinity();
+    return T(x);
+}
+
+/// The box grown by `by` on every side, in W and rounded outward (by = 0 gives the box itself).
+template <class T>
+Aabb<T, 3> grown(const Aabb<T, 3>& box, T by) {
+    Aabb<T, 3> r = box;
+    for (std::size_t i = 0; i < 3; ++i)
+        r.min[i] = round_down<T>(AccurateScalar<T>(box.min[i]) - AccurateScalar<T>(by)),
+        r.max[i] = round_up<T>(AccurateScalar<T>(box.max[i]) + AccurateScalar<T>(by));
+    return r;
+}
+
+/// The rotation nearest to R (in the Frobenius norm: R's orthogonal polar factor), computed in W
+/// and rounded to T. Newton's iteration for the polar factor, X <- (X + X^-T) / 2, from X = R:
+/// it converges quadratically (a deviation e from orthogonality becomes about e^2 / 2), so from
+/// the 1e-4 that check_rigid_pose accepts it is below W's epsilon within four steps. The polar
+/// factor rather than Gram-Schmidt: it treats the three axes alike (Gram-Schmidt keeps the first
+/// column's direction and pushes all of the error into the others) and it is the nearest
+/// orthogonal matrix, so no point of a mesh moves by more than R's own distance from it. det R
+/// near +1 keeps X away from singular matrices, and the factor is then a proper rotation. A
+/// rotation that is already exact (the identity, a signed permutation) comes back unchanged.
+template <class W, class T>
+Mat3<T> nearest_rotation(const Mat3<T>& rotation) {
+    Mat3<W> x(rotation);
+    for (int step = 0; step < 8; ++step) {
+        // X^-T = cofactor(X) / det X; the cofactor matrix's rows are cross products of X's rows.
+        const Vec<W, 3> c0 = cross(x.row[1], x.row[2]), c1 = cross(x.row[2], x.row[0]),
+                        c2 = cross(x.row[0], x.row[1]);
+        const W det = dot(x.row[0], c0);
+        const Vec<W, 3> c[3] = {c0, c1, c2};
+        W change = 0;
+        for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t j = 0; j < 3; ++j) {
+                const W next = (x.row[i][j] + c[i][j] / det) / W(2);
+                change = std::max(change, W(std::fabs(next - x.row[i][j])));
+                x.row[i][j] = next;
+            }
+        if (change <= W(4) * std::numeric_limits<W>::epsilon()) break;
+    }
+    return Mat3<T>(x);
+}
+
+/// The pose as a Scene stores it: the translation as given, the rotation replaced by the nearest
+/// rotation (so R^T is R's inverse to T's rounding, and a relative pose R_a^T R_b is as rigid).
+template <class T>
+Transform<T> rigid_pose(const Transform<T>& pose) {
+    return {nearest_rotation<AccurateScalar<T>>(pose.rotation), pose.translation};
 }
 
 /// R x + t in W.
@@ -61,8 +125,8 @@ Vec<T, 3> to_local_point(const Transform<T>& pose, const Vec<T, 3>& x) {
                     W(x[2]) - W(pose.translation[2])};
     Vec<T, 3> r;
     for (std::size_t j = 0; j < 3; ++j)
-        r[j] = T(W(pose.rotation[0][j]) * d[0] + W(pose.rotation[1][j]) * d[1] +
-                 W(pose.rotation[2][j]) * d[2]);
+        r[j] = narrow<T>(W(pose.rotation[0][j]) * d[0] + W(pose.rotation[1][j]) * d[1] +
+                         W(pose.rotation[2][j]) * d[2]);
     return r;
 }
 
@@ -71,8 +135,8 @@ template <class W, class T>
 Vec<T, 3> to_local_vector(const Transform<T>& pose, const Vec<T, 3>& v) {
     Vec<T, 3> r;
     for (std::size_t j = 0; j < 3; ++j)
-        r[j] = T(W(pose.rotation[0][j]) * W(v[0]) + W(pose.rotation[1][j]) * W(v[1]) +
-                 W(pose.rotation[2][j]) * W(v[2]));
+        r[j] = narrow<T>(W(pose.rotation[0][j]) * W(v[0]) + W(pose.rotation[1][j]) * W(v[1]) +
+                         W(pose.rotation[2][j]) * W(v[2]));
     return r;
 }
 
@@ -81,8 +145,8 @@ template <class W, class T>
 Vec<T, 3> to_world_vector(const Transform<T>& pose, const Vec<T, 3>& v) {
     Vec<T, 3> r;
     for (std::size_t i = 0; i < 3; ++i)
-        r[i] = T(W(pose.rotation[i][0]) * W(v[0]) + W(pose.rotation[i][1]) * W(v[1]) +
-                 W(pose.rotation[i][2]) * W(v[2]));
+        r[i] = narrow<T>(W(pose.rotation[i][0]) * W(v[0]) + W(pose.rotation[i][1]) * W(v[1]) +
+                         W(pose.rotation[i][2]) * W(v[2]));
     return r;
 }
 
@@ -120,11 +184,16 @@ class SceneGeometry {
             mesh_.triangles[i] = {std::uint32_t(ids[0]), std::uint32_t(ids[1]),
                                   std::uint32_t(ids[2])};
         }
-        // The hull of the vertices that some triangle uses: a stray vertex bounds nothing.
+        // The hull of the corners of the triangles whose three corners are finite: a stray vertex
+        // bounds nothing, and neither does a finite corner of a triangle that the queries skip
+        // (one with a NaN or infinite corner).
         std::vector<Vec<T, 3>> used;
         used.reserve(3 * mesh_.triangles.size());
-        for (const auto& tri : mesh_.triangles)
-            for (const std::uint32_t k : tri) used.push_back(mesh_.vertices[k]);
+        for (const auto& tri : mesh_.triangles) {
+            const auto& v = mesh_.vertices;
+            if (!(is_finite(v[tri[0]]) && is_finite(v[tri[1]]) && is_finite(v[tri[2]]))) continue;
+            for (const std::uint32_t k : tri) used.push_back(v[k]);
+        }
         used = hull_detail::sorted_unique(std::move(used));
         if (!used.empty())
             for (const std::uint32_t k : quickhull_vertices<T>(used)) hull_.push_back(used[k]);
