@@ -211,6 +211,73 @@ TEST(ScenePoses, LargeMarginStaysWithItsInstance) {
     scene.validate();
 }
 
+// Far from the origin the pad no longer grows with |t|: each side of a world box is within T's
+// spacing there (plus a few epsilons of the mesh's size) of the exact extent, and the walks still
+// find what a loop over every instance finds with the same transforms into the instances' frames.
+template <class T>
+void far_boxes_are_tight(double offset, std::uint64_t seed) {
+    using W = AccurateScalar<T>;
+    SplitMix64 rng(seed);
+    Scene<T> scene;
+    const GeometryId g[2] = {scene.add_mesh(cube<T>(T(0.05))), scene.add_mesh(cube<T>(T(0.5)))};
+    std::vector<InstanceId> ids;
+    for (int i = 0; i < 300; ++i) {
+        Transform<T> p;
+        p.rotation = scene_test::random_rotation<T>(rng);
+        for (std::size_t a = 0; a < 3; ++a) p.translation[a] = T(offset + rng.uniform(-4.0, 4.0));
+        ids.push_back(scene.add_instance(g[i % 2], p));
+    }
+    scene.validate();
+    for (const InstanceId id : ids) {
+        const SceneInstance<T>& r = scene.instance(id);
+        const Aabb<T, 3>& box = scene.world_box(id);
+        for (std::size_t a = 0; a < 3; ++a) {
+            LD lo = INFINITY, hi = -INFINITY;
+            for (const auto& v : scene.geometry(r.geometry).mesh().vertices) {
+                const LD w = LD(r.pose.rotation[a][0]) * v[0] + LD(r.pose.rotation[a][1]) * v[1] +
+                             LD(r.pose.rotation[a][2]) * v[2] + LD(r.pose.translation[a]);
+                lo = std::min(lo, w), hi = std::max(hi, w);
+            }
+            const LD spacing =
+                LD(std::nextafter(T(hi), std::numeric_limits<T>::infinity())) - LD(T(hi));
+            // One spacing for the outward rounding, one more where the pad crosses a boundary.
+            const LD slack = 2 * spacing + 64 * LD(std::numeric_limits<T>::epsilon());
+            EXPECT_LE(LD(box.min[a]), lo);
+            EXPECT_GE(LD(box.max[a]), hi);
+            EXPECT_LE(lo - LD(box.min[a]), slack) << "offset " << offset;
+            EXPECT_LE(LD(box.max[a]) - hi, slack) << "offset " << offset;
+        }
+    }
+    for (int k = 0; k < 600; ++k) {
+        Vec<T, 3> o;
+        for (std::size_t a = 0; a < 3; ++a) o[a] = T(offset + rng.uniform(-6.0, 6.0));
+        const Vec<double, 3> d = rng.unit_vector();
+        const Ray<T, 3> ray(o, Vec<T, 3>(T(d[0]), T(d[1]), T(d[2])));
+        T best_t = std::numeric_limits<T>::infinity(), best_d = best_t;
+        for (const InstanceId id : ids) {
+            const SceneInstance<T>& r = scene.instance(id);
+            const SceneGeometry<T>& geo = scene.geometry(r.geometry);
+            const Hit<T> h =
+                geo.ray_tree().closest_hit(scene_detail::local_ray(r.pose, ray, ray.tmax));
+            if (h) best_t = std::min(best_t, h.t);
+            const MeshPoint<T> m =
+                geo.closest_point_tree().closest_point(scene_detail::to_local_point<W>(r.pose, o));
+            if (m) best_d = std::min(best_d, m.distance);
+        }
+        EXPECT_EQ(closest_hit(scene, ray).t, best_t) << "ray " << k << " offset " << offset;
+        EXPECT_EQ(closest_point(scene, o).distance, best_d)
+            << "point " << k << " offset " << offset;
+    }
+}
+
+TEST(ScenePoses, BoxesFarOutAreTightAndTheWalksAgree) {
+    far_boxes_are_tight<float>(0, 1);
+    far_boxes_are_tight<float>(1e5, 2);
+    far_boxes_are_tight<float>(1e6, 3);
+    far_boxes_are_tight<double>(1e6, 4);
+    far_boxes_are_tight<double>(1e12, 5);
+}
+
 // A batch whose later pose puts a box beyond float's range changes nothing; a displacement that
 // overflows (a jump across the whole range) is only the fat box's prediction, and is accepted.
 TEST(ScenePoses, SetPosesIsAllOrNothing) {

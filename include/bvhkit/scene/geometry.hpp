@@ -228,18 +228,42 @@ class SceneGeometry {
         return box;
     }
 
-    /// The pad for a pose: what the queries' roundings can move a point of the geometry by. A
-    /// query moves the world ray or point into the geometry's frame with R^T, rounding each
-    /// coordinate to T once (at most eps/2 of |x| each), and R may be up to rigid_tolerance() from
-    /// a rotation (then R^T is not exactly its inverse: a point moves by up to that deviation
-    /// times its distance from t). Eight epsilons of the geometry's and the translation's largest
-    /// coordinate cover the roundings with room to spare.
+    /// The pad for a pose: what the roundings of the box and of the queries' transforms can move
+    /// a point of the geometry by, so that the walks over the world boxes lose no instance that
+    /// the query in the instance's frame would find. With E = extent_ (the hull's largest
+    /// |coordinate|, so |x| <= sqrt(3) E for every point x of the mesh), tau = max |t_i|,
+    /// d = rigid_deviation(R) (a few eps_T for a stored pose: nearest_rotation) and eps_T, eps_W
+    /// the epsilons of T and of the wider type W:
+    ///
+    ///   pad = 16 eps_T E + 8 eps_W (tau + 2 E) + 6 d E.
+    ///
+    /// Why it suffices. (a) The box: each coordinate of R x + t is two products and three sums in
+    /// W of terms at most sqrt(3) E and tau, off by at most 3 eps_W (sqrt(3) E + tau) from the
+    /// exact value; rounding outward to T only grows the box; the second term covers it. (b) The
+    /// queries: a world point p goes to p' = R^T (p - t), the difference and the products taken
+    /// in W (off by at most 3 eps_W |p - t|: relative to the local distance, not to |t|, because
+    /// t is subtracted first) and rounded to T once (eps_T / 2 of each coordinate). A point
+    /// found in the instance's frame within the instance's reach (local coordinates within 4 E:
+    /// the query point, or the stretch of a ray's segment, near the instance, which is where a
+    /// hit or a nearest point on it is decided) is off from the exact image of the world point by
+    /// at most eps_T / 2 * sqrt(3) * 4 E per rounded point, twice for a ray (its origin and its
+    /// direction times t): under 7 eps_T E, and the triangle tests' own rounding of the local
+    /// coordinates stays within the rest of the first term. (c) R^T differs from R's inverse by
+    /// (I - R^T R) R^-1, of norm at most 3 d (1 + 3 d), so mapping back moves a point at
+    /// |x| <= sqrt(3) E by under 6 d E: the third term. Where W is no wider than T (long double
+    /// is double on some platforms), eps_W = eps_T and the second term is 8 eps_T (tau + 2 E),
+    /// the |t| term such a platform needs. The pad no longer grows with eps_T |t|: far from the
+    /// origin the box is as tight as T's spacing there allows. A query from farther out than
+    /// 4 E carries its own rounding, eps_T / 2 of its local coordinates, which the queries
+    /// already document as their accuracy.
     W pose_pad(const Transform<T>& pose) const {
-        W scale = extent_;
+        W tau = 0;
         for (std::size_t a = 0; a < 3; ++a)
-            scale = std::max(scale, W(std::fabs(W(pose.translation[a]))));
-        const W eps = W(std::numeric_limits<T>::epsilon());
-        return (W(8) * eps + W(rigid_deviation(pose.rotation))) * (scale + extent_);
+            tau = std::max(tau, W(std::fabs(W(pose.translation[a]))));
+        const W eps_t = W(std::numeric_limits<T>::epsilon());
+        const W eps_w = std::numeric_limits<W>::epsilon();
+        const W d = W(rigid_deviation(pose.rotation));
+        return W(16) * eps_t * extent_ + W(8) * eps_w * (tau + W(2) * extent_) + W(6) * d * extent_;
     }
 
     const TriangleBvh<T>& ray_tree() const {
