@@ -278,6 +278,41 @@ TEST(ScenePoses, BoxesFarOutAreTightAndTheWalksAgree) {
     far_boxes_are_tight<double>(1e12, 5);
 }
 
+// Conversions from the wider type to T beyond T's range are checked, not undefined: the rounding
+// helpers saturate to the infinity (or the largest value) on the value's side, and a ray or point
+// that leaves T's range in an instance's frame misses (or skips) that instance.
+TEST(ScenePoses, OutOfRangeLocalCoordinates) {
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    constexpr float big = std::numeric_limits<float>::max();
+    EXPECT_EQ(scene_detail::round_up<float>(1e39), inf);
+    EXPECT_EQ(scene_detail::round_down<float>(1e39), big);
+    EXPECT_EQ(scene_detail::round_down<float>(-1e39), -inf);
+    EXPECT_EQ(scene_detail::round_up<float>(-1e39), -big);
+    EXPECT_EQ(scene_detail::narrow<float>(1e39), inf);
+    EXPECT_EQ(scene_detail::narrow<float>(-1e39), -inf);
+    EXPECT_EQ(scene_detail::narrow<float>(0.5), 0.5f);
+
+    Scene<float> scene;
+    const GeometryId g = scene.add_mesh(cube<float>(1));
+    Transform<float> turned;
+    turned.rotation = rotation_about(Vec3f(0, 0, 1), 0.78539816f);
+    const InstanceId a = scene.add_instance(g, turned);
+    // R^T d of (3e38, 3e38, 0) is 4.2e38 along x: beyond float, so a miss of that instance.
+    const Ray3f huge({-10, -10, 0}, {3e38f, 3e38f, 0});
+    EXPECT_FALSE(closest_hit(scene, huge));
+    EXPECT_FALSE(any_hit(scene, huge));
+    std::vector<SceneHit<float>> hits;
+    all_hits(scene, huge, hits);
+    EXPECT_TRUE(hits.empty());
+    EXPECT_TRUE(closest_hit(scene, Ray3f({-10, -10, 0}, {1, 1, 0})));
+    // p - t is 6e38 for the instance at -3e38: skipped; the one at the origin is found.
+    scene.add_instance(g, translation_pose(-3e38f));
+    const ScenePoint<float> q = closest_point(scene, Vec3f(3e38f, 0, 0));
+    ASSERT_TRUE(q);
+    EXPECT_EQ(q.instance, a);
+    EXPECT_EQ(q.distance, 3e38f);  // 3e38 - 1 in float
+}
+
 // A batch whose later pose puts a box beyond float's range changes nothing; a displacement that
 // overflows (a jump across the whole range) is only the fat box's prediction, and is accepted.
 TEST(ScenePoses, SetPosesIsAllOrNothing) {
