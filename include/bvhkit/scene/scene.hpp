@@ -1,10 +1,11 @@
 #pragma once
 // Scene<T>: many posed instances of shared triangle meshes, for rays, closest points and collision
 // (docs/scenes.md). Two levels: geometry is added once (add_mesh) and shared by any number of
-// instances, each a rigid pose, an id, user data, a collision group and mask and a margin; the top
-// level is a DynamicTree over the instances' world boxes (fat boxes: a small pose change only
-// updates the tight box), the bottom level the per-geometry trees (scene/geometry.hpp), built the
-// first time a query family needs them and shared by all instances.
+// instances, each a rigid pose (stored with the nearest rotation), an id, user data, a collision
+// group and mask and a margin; the top level is a DynamicTree over the instances' world boxes,
+// each grown by the instance's own margin (fat boxes: a small pose change only updates the tight
+// box), the bottom level the per-geometry trees (scene/geometry.hpp), built the first time a query
+// family needs them and shared by all instances.
 //
 //   bvhkit::Scene<float> scene;
 //   GeometryId g = scene.add_mesh(mesh);
