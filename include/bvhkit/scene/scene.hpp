@@ -117,7 +117,9 @@ class Scene {
     /// (stretched along the translation's change). Error, and no change, on a stale id, a bad
     /// pose, or a world box beyond T's finite range.
     void set_pose(InstanceId id, const Pose& pose) {
-        set_poses(std::span<const InstanceId>(&id, 1), std::span<const Pose>(&pose, 1));
+        check_id(id, "Scene::set_pose");
+        check_rigid_pose(pose, "Scene::set_pose", "pose");
+        apply(id, plan_move(id, pose, "Scene::set_pose"));
     }
     /// set_pose for each (ids[i], poses[i]), in order. Every id, pose and new box is computed and
     /// checked first, so an Error leaves the scene as it was. Serial.
@@ -125,21 +127,14 @@ class Scene {
         if (ids.size() != poses.size())
             throw Error("Scene::set_poses: " + std::to_string(ids.size()) + " ids but " +
                         std::to_string(poses.size()) + " poses");
-        const char* where = ids.size() == 1 ? "Scene::set_pose" : "Scene::set_poses";
         std::vector<Move> moves(ids.size());
         for (std::size_t i = 0; i < ids.size(); ++i) {
-            check_id(ids[i], where);
-            check_rigid_pose(poses[i], where, "pose");
-            moves[i] = plan_move(ids[i], poses[i], where);
+            check_id(ids[i], "Scene::set_poses");
+            check_rigid_pose(poses[i], "Scene::set_poses", "pose");
+            moves[i] = plan_move(ids[i], poses[i], "Scene::set_poses");
         }
-        // Nothing below throws: the boxes and displacements are the ones checked above.
-        for (std::size_t i = 0; i < ids.size(); ++i) {
-            const Move& m = moves[i];
-            SceneInstance<T>& r = instances_[std::size_t(ids[i].index())];
-            tree_.move(ids[i].proxy(), m.top, m.displacement);
-            r.pose = m.pose;
-            r.box = m.box;
-        }
+        // No Error below: the boxes and displacements are the ones checked above.
+        for (std::size_t i = 0; i < ids.size(); ++i) apply(ids[i], moves[i]);
     }
     /// New options; a new margin regrows the instance's top-level box. Error, and no change, on a
     /// stale id, a bad margin, or a grown box beyond T's finite range.
@@ -243,6 +238,14 @@ class Scene {
     /// the tree will check them. The displacement is only the fat box's prediction of the next
     /// motion: taken from the pose before the call, in W, and clamped to T's finite range (a jump
     /// from -3e38 to 3e38 is a legal pose change, not an overflow).
+    /// Stores a planned move: the tree's move() checks only what plan_move() checked, so it
+    /// throws no Error here (an allocation failure inside the tree aside).
+    void apply(InstanceId id, const Move& m) {
+        SceneInstance<T>& r = instances_[std::size_t(id.index())];
+        tree_.move(id.proxy(), m.top, m.displacement);
+        r.pose = m.pose;
+        r.box = m.box;
+    }
     Move plan_move(InstanceId id, const Pose& pose, const char* where) const {
         using W = AccurateScalar<T>;
         const SceneInstance<T>& r = instances_[std::size_t(id.index())];
