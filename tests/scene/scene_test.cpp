@@ -140,6 +140,7 @@ TEST(Scene, WorldBoxesAreTheHullsExtent) {
         pose.rotation = scene_test::random_rotation<float>(rng);
         pose.translation = Vec3f(float(rng.uniform(-1e3, 1e3)), 2.f, -7.f);
         const InstanceId id = scene.add_instance(g, pose);
+        pose = scene.pose(id);  // as stored: the nearest rotation
         const Aabb<float, 3>& box = scene.world_box(id);
         LD lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (const auto& v : rod.vertices)

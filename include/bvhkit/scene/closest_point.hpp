@@ -28,7 +28,7 @@ struct ScenePoint {
 
 /// The point of the scene nearest to p (none for an empty scene or a point with a NaN or
 /// infinite coordinate). Of points at the same distance, the first instance the walk reaches
-/// wins.
+/// wins. An instance from which p is beyond T's range in the instance's frame is skipped.
 template <class T>
 ScenePoint<T> closest_point(const Scene<T>& scene, const Vec<T, 3>& p) {
     using W = AccurateScalar<T>;
@@ -43,6 +43,9 @@ ScenePoint<T> closest_point(const Scene<T>& scene, const Vec<T, 3>& p) {
         const SceneGeometry<T>& g = scene.geometry_at(r.geometry);
         if (!g.has_extent()) return std::numeric_limits<W>::infinity();
         const Vec<T, 3> local = scene_detail::to_local_point<W>(r.pose, p);
+        // Beyond T's range in the instance's frame (p 3e38 from an instance at -3e38): the
+        // instance is farther than any distance T holds, so it is skipped, not measured.
+        if (!is_finite(local)) return best_distance * best_distance;
         const MeshPoint<T> m = g.closest_point_tree().closest_point_within(local, best_distance,
                                                                            MeshPoint<T>{}, scratch);
         if (m && W(m.distance) < best_distance) {

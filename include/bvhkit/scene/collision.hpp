@@ -10,9 +10,14 @@
 // inverse(pose_a) * pose_b (taken in the wider type and rounded once), on the geometries' shared
 // collision models: no mesh is moved.
 //
-// The candidates come from the top-level tree: for each instance a, the instances whose world
-// boxes lie within margin_a + margin_b of a's box (a box query with a's box grown by margin_a plus
-// the largest margin of the scene, then the exact box gap with the pair's own margins).
+// The candidates come from the top-level tree, whose boxes are the world boxes grown by each
+// instance's own margin: for each instance a, a box query with a's grown box finds the instances
+// b whose world boxes lie within margin_a + margin_b of a's (then the exact box gap with the
+// pair's own margins). A large margin on one instance widens only the queries that involve it.
+//
+// Collision is surface contact, as in FCL: a mesh wholly inside another, with no triangle of one
+// meeting a triangle of the other and the margins not covering the gap between the surfaces, does
+// not collide.
 #include <algorithm>
 #include <span>
 #include <vector>
@@ -35,15 +40,6 @@ bool boxes_within(const Aabb<T, 3>& a, const Aabb<T, 3>& b, T gap) {
     return true;
 }
 
-template <class T>
-Aabb<T, 3> grown(const Aabb<T, 3>& box, T by) {
-    Aabb<T, 3> r = box;
-    for (std::size_t i = 0; i < 3; ++i)
-        r.min[i] = round_down<T>(AccurateScalar<T>(box.min[i]) - by),
-        r.max[i] = round_up<T>(AccurateScalar<T>(box.max[i]) + by);
-    return r;
-}
-
 /// Whether geometry ga at pose_a and geometry gb at pose_b come within `margin` of each other.
 template <class T>
 bool meshes_collide(const SceneGeometry<T>& ga, const Transform<T>& pose_a,
@@ -52,13 +48,6 @@ bool meshes_collide(const SceneGeometry<T>& ga, const Transform<T>& pose_a,
     const Transform<T> b_in_a = relative_pose<AccurateScalar<T>>(pose_a, pose_b);
     if (margin == T(0)) return collides(ga.collision_model(), gb.collision_model(), b_in_a);
     return distance(ga.collision_model(), gb.collision_model(), b_in_a).distance <= margin;
-}
-
-template <class T>
-T largest_margin(const Scene<T>& scene) {
-    T m = 0;
-    scene.for_each_instance([&](InstanceId id) { m = std::max(m, scene.options(id).margin); });
-    return m;
 }
 
 /// The ignore list as sorted (smaller bits, larger bits) pairs, for binary search.
@@ -83,15 +72,17 @@ template <class T, class F>
 void for_each_colliding_pair(const Scene<T>& scene, std::span<const InstancePair> ignore,
                              F&& on_pair) {
     const auto skip = ignore_set(ignore);
-    const T widest = largest_margin(scene);
     std::vector<InstanceId> candidates;
     bool go_on = true;
     scene.for_each_instance([&](InstanceId a) {
         if (!go_on) return;
         const SceneInstance<T>& ra = scene.instance(a);
-        const Aabb<T, 3>& box_a = scene.world_box(a);
+        const Aabb<T, 3>& box_a = ra.box;
         candidates.clear();
-        scene.top_level().query(grown(box_a, ra.options.margin + widest), [&](ProxyId proxy) {
+        // a's top-level box is its world box grown by margin_a, b's by margin_b: they overlap iff
+        // the world boxes' gap is within margin_a + margin_b on every axis (rounded outward, so
+        // never less), and no other instance's margin widens a's query.
+        scene.top_level().query(scene.top_level().box(a.proxy()), [&](ProxyId proxy) {
             if (proxy.index() > a.index()) candidates.push_back(InstanceId(proxy));
             return true;
         });
@@ -101,7 +92,7 @@ void for_each_colliding_pair(const Scene<T>& scene, std::span<const InstancePair
             const SceneInstance<T>& rb = scene.instance_at(b.proxy());
             if (!may_collide(ra.options, rb.options) || ignored(skip, a, b)) continue;
             const T margin = ra.options.margin + rb.options.margin;
-            if (!boxes_within(box_a, scene.world_box(b), margin)) continue;
+            if (!boxes_within(box_a, rb.box, margin)) continue;
             if (!meshes_collide(scene.geometry_at(ra.geometry), ra.pose,
                                 scene.geometry_at(rb.geometry), rb.pose, margin))
                 continue;
@@ -115,8 +106,9 @@ void for_each_colliding_pair(const Scene<T>& scene, std::span<const InstancePair
 
 }  // namespace scene_detail
 
-/// Every pair of instances that collide, (a, b) with a.index() < b.index(), sorted: `out` is
-/// cleared, then filled. Pairs in `ignore` (either order) are left out.
+/// Every pair of instances that collide, (a, b) with a.index() < b.index(), sorted by
+/// InstancePair's order (a's slot, then b's: live ids differ in their slots): `out` is cleared,
+/// then filled. Pairs in `ignore` (either order) are left out.
 template <class T>
 void colliding_pairs(const Scene<T>& scene, std::vector<InstancePair>& out,
                      std::span<const InstancePair> ignore = {}) {
@@ -142,18 +134,19 @@ bool any_collision(const Scene<T>& scene, std::span<const InstancePair> ignore =
 /// `options` (its group, mask and margin; user_data unused), in slot order: `out` is cleared,
 /// then filled. With stop_at_first, at most one. Error on a bad geometry id, pose or margin.
 template <class T>
-void colliding_instances(const Scene<T>& scene, GeometryId geometry, const Transform<T>& pose,
-                         const InstanceOptions<T>& options, std::vector<InstanceId>& out,
-                         bool stop_at_first = false) {
+void colliding_instances(const Scene<T>& scene, GeometryId geometry,
+                         const Transform<T>& caller_pose, const InstanceOptions<T>& options,
+                         std::vector<InstanceId>& out, bool stop_at_first = false) {
     out.clear();
     const SceneGeometry<T>& g = scene.geometry(geometry);
-    check_rigid_pose(pose, "colliding_instances(Scene)", "pose");
+    check_rigid_pose(caller_pose, "colliding_instances(Scene)", "pose");
     if (!(std::isfinite(options.margin) && options.margin >= T(0)))
         throw Error("colliding_instances(Scene): margin " + std::to_string(double(options.margin)) +
                     " must be finite and >= 0");
+    // As an instance's pose is stored: the nearest rotation, so that the relative poses are rigid.
+    const Transform<T> pose = scene_detail::rigid_pose(caller_pose);
     const Aabb<T, 3> box = g.world_box(pose, g.pose_pad(pose));
-    const T widest = scene_detail::largest_margin(scene);
-    scene.top_level().query(scene_detail::grown(box, options.margin + widest), [&](ProxyId proxy) {
+    scene.top_level().query(scene_detail::grown(box, options.margin), [&](ProxyId proxy) {
         out.push_back(InstanceId(proxy));
         return true;
     });
@@ -164,8 +157,7 @@ void colliding_instances(const Scene<T>& scene, GeometryId geometry, const Trans
         if (stop_at_first && kept == 1) break;
         const SceneInstance<T>& rb = scene.instance_at(b.proxy());
         const T margin = options.margin + rb.options.margin;
-        if (!may_collide(options, rb.options) ||
-            !scene_detail::boxes_within(box, scene.world_box(b), margin) ||
+        if (!may_collide(options, rb.options) || !scene_detail::boxes_within(box, rb.box, margin) ||
             !scene_detail::meshes_collide(g, pose, scene.geometry_at(rb.geometry), rb.pose, margin))
             continue;
         out[kept++] = b;

@@ -30,18 +30,82 @@ namespace bvhkit {
 
 namespace scene_detail {
 
-/// x rounded to T toward -inf (down) or +inf (up).
+/// x rounded to T toward -inf (down) or +inf (up). A value beyond T's finite range becomes the
+/// infinity on its side (or T's largest finite value, rounding toward zero): the conversion itself
+/// is only defined within the range, so the range is checked first.
 template <class T, class W>
 T round_down(W x) {
+    constexpr W big = W(std::numeric_limits<T>::max());
+    if (x > big) return std::numeric_limits<T>::max();
+    if (x < -big) return -std::numeric_limits<T>::infinity();
     T r = T(x);
     if (W(r) > x) r = std::nextafter(r, -std::numeric_limits<T>::infinity());
     return r;
 }
 template <class T, class W>
 T round_up(W x) {
+    constexpr W big = W(std::numeric_limits<T>::max());
+    if (x > big) return std::numeric_limits<T>::infinity();
+    if (x < -big) return -std::numeric_limits<T>::max();
     T r = T(x);
     if (W(r) < x) r = std::nextafter(r, std::numeric_limits<T>::infinity());
     return r;
+}
+/// x rounded to T to nearest, or the infinity on its side when beyond T's finite range (NaN stays
+/// NaN): the narrowing conversion without its undefined case.
+template <class T, class W>
+T narrow(W x) {
+    constexpr W big = W(std::numeric_limits<T>::max());
+    if (x > big) return std::numeric_limits<T>::infinity();
+    if (x < -big) return -std::numeric_limits<T>::infinity();
+    return T(x);
+}
+
+/// The box grown by `by` on every side, in W and rounded outward (by = 0 gives the box itself).
+template <class T>
+Aabb<T, 3> grown(const Aabb<T, 3>& box, T by) {
+    Aabb<T, 3> r = box;
+    for (std::size_t i = 0; i < 3; ++i)
+        r.min[i] = round_down<T>(AccurateScalar<T>(box.min[i]) - AccurateScalar<T>(by)),
+        r.max[i] = round_up<T>(AccurateScalar<T>(box.max[i]) + AccurateScalar<T>(by));
+    return r;
+}
+
+/// The rotation nearest to R (in the Frobenius norm: R's orthogonal polar factor), computed in W
+/// and rounded to T. Newton's iteration for the polar factor, X <- (X + X^-T) / 2, from X = R:
+/// it converges quadratically (a deviation e from orthogonality becomes about e^2 / 2), so from
+/// the 1e-4 that check_rigid_pose accepts it is below W's epsilon within four steps. The polar
+/// factor rather than Gram-Schmidt: it treats the three axes alike (Gram-Schmidt keeps the first
+/// column's direction and pushes all of the error into the others) and it is the nearest
+/// orthogonal matrix, so no point of a mesh moves by more than R's own distance from it. det R
+/// near +1 keeps X away from singular matrices, and the factor is then a proper rotation. A
+/// rotation that is already exact (the identity, a signed permutation) comes back unchanged.
+template <class W, class T>
+Mat3<T> nearest_rotation(const Mat3<T>& rotation) {
+    Mat3<W> x(rotation);
+    for (int step = 0; step < 8; ++step) {
+        // X^-T = cofactor(X) / det X; the cofactor matrix's rows are cross products of X's rows.
+        const Vec<W, 3> c0 = cross(x.row[1], x.row[2]), c1 = cross(x.row[2], x.row[0]),
+                        c2 = cross(x.row[0], x.row[1]);
+        const W det = dot(x.row[0], c0);
+        const Vec<W, 3> c[3] = {c0, c1, c2};
+        W change = 0;
+        for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t j = 0; j < 3; ++j) {
+                const W next = (x.row[i][j] + c[i][j] / det) / W(2);
+                change = std::max(change, W(std::fabs(next - x.row[i][j])));
+                x.row[i][j] = next;
+            }
+        if (change <= W(4) * std::numeric_limits<W>::epsilon()) break;
+    }
+    return Mat3<T>(x);
+}
+
+/// The pose as a Scene stores it: the translation as given, the rotation replaced by the nearest
+/// rotation (so R^T is R's inverse to T's rounding, and a relative pose R_a^T R_b is as rigid).
+template <class T>
+Transform<T> rigid_pose(const Transform<T>& pose) {
+    return {nearest_rotation<AccurateScalar<T>>(pose.rotation), pose.translation};
 }
 
 /// R x + t in W.
@@ -61,8 +125,8 @@ Vec<T, 3> to_local_point(const Transform<T>& pose, const Vec<T, 3>& x) {
                     W(x[2]) - W(pose.translation[2])};
     Vec<T, 3> r;
     for (std::size_t j = 0; j < 3; ++j)
-        r[j] = T(W(pose.rotation[0][j]) * d[0] + W(pose.rotation[1][j]) * d[1] +
-                 W(pose.rotation[2][j]) * d[2]);
+        r[j] = narrow<T>(W(pose.rotation[0][j]) * d[0] + W(pose.rotation[1][j]) * d[1] +
+                         W(pose.rotation[2][j]) * d[2]);
     return r;
 }
 
@@ -71,8 +135,8 @@ template <class W, class T>
 Vec<T, 3> to_local_vector(const Transform<T>& pose, const Vec<T, 3>& v) {
     Vec<T, 3> r;
     for (std::size_t j = 0; j < 3; ++j)
-        r[j] = T(W(pose.rotation[0][j]) * W(v[0]) + W(pose.rotation[1][j]) * W(v[1]) +
-                 W(pose.rotation[2][j]) * W(v[2]));
+        r[j] = narrow<T>(W(pose.rotation[0][j]) * W(v[0]) + W(pose.rotation[1][j]) * W(v[1]) +
+                         W(pose.rotation[2][j]) * W(v[2]));
     return r;
 }
 
@@ -81,8 +145,8 @@ template <class W, class T>
 Vec<T, 3> to_world_vector(const Transform<T>& pose, const Vec<T, 3>& v) {
     Vec<T, 3> r;
     for (std::size_t i = 0; i < 3; ++i)
-        r[i] = T(W(pose.rotation[i][0]) * W(v[0]) + W(pose.rotation[i][1]) * W(v[1]) +
-                 W(pose.rotation[i][2]) * W(v[2]));
+        r[i] = narrow<T>(W(pose.rotation[i][0]) * W(v[0]) + W(pose.rotation[i][1]) * W(v[1]) +
+                         W(pose.rotation[i][2]) * W(v[2]));
     return r;
 }
 
@@ -120,11 +184,16 @@ class SceneGeometry {
             mesh_.triangles[i] = {std::uint32_t(ids[0]), std::uint32_t(ids[1]),
                                   std::uint32_t(ids[2])};
         }
-        // The hull of the vertices that some triangle uses: a stray vertex bounds nothing.
+        // The hull of the corners of the triangles whose three corners are finite: a stray vertex
+        // bounds nothing, and neither does a finite corner of a triangle that the queries skip
+        // (one with a NaN or infinite corner).
         std::vector<Vec<T, 3>> used;
         used.reserve(3 * mesh_.triangles.size());
-        for (const auto& tri : mesh_.triangles)
-            for (const std::uint32_t k : tri) used.push_back(mesh_.vertices[k]);
+        for (const auto& tri : mesh_.triangles) {
+            const auto& v = mesh_.vertices;
+            if (!(is_finite(v[tri[0]]) && is_finite(v[tri[1]]) && is_finite(v[tri[2]]))) continue;
+            for (const std::uint32_t k : tri) used.push_back(v[k]);
+        }
         used = hull_detail::sorted_unique(std::move(used));
         if (!used.empty())
             for (const std::uint32_t k : quickhull_vertices<T>(used)) hull_.push_back(used[k]);
@@ -194,18 +263,43 @@ class SceneGeometry {
         return true;
     }
 
-    /// The pad for a pose: what the queries' roundings can move a point of the geometry by. A
-    /// query moves the world ray or point into the geometry's frame with R^T, rounding each
-    /// coordinate to T once (at most eps/2 of |x| each), and R may be up to rigid_tolerance() from
-    /// a rotation (then R^T is not exactly its inverse: a point moves by up to that deviation
-    /// times its distance from t). Eight epsilons of the geometry's and the translation's largest
-    /// coordinate cover the roundings with room to spare.
+    /// The pad for a pose: what the roundings of the box and of the queries' transforms can move
+    /// a point of the geometry by, so that the walks over the world boxes lose no instance that
+    /// the query in the instance's frame would find. With E = extent_ (the hull's largest
+    /// |coordinate|, so |x| <= sqrt(3) E for every point x of the mesh), tau = max |t_i|,
+    /// d = rigid_deviation(R) (a few eps_T for a stored pose: nearest_rotation) and eps_T, eps_W
+    /// the epsilons of T and of the wider type W:
+    ///
+    ///   pad = 16 eps_T E + 8 eps_W (tau + 2 E) + 6 d E.
+    ///
+    /// Why it suffices. (a) The box: extremes_in_double adds its own bound on its rounding; beyond
+    /// double's range each coordinate of R x + t is two products and three sums in W of terms at
+    /// most sqrt(3) E and tau, off by at most 3 eps_W (sqrt(3) E + tau) from the exact value,
+    /// which the second term covers; rounding outward to T only grows the box. (b) The
+    /// queries: a world point p goes to p' = R^T (p - t), the difference and the products taken
+    /// in W (off by at most 3 eps_W |p - t|: relative to the local distance, not to |t|, because
+    /// t is subtracted first) and rounded to T once (eps_T / 2 of each coordinate). A point
+    /// found in the instance's frame within the instance's reach (local coordinates within 4 E:
+    /// the query point, or the stretch of a ray's segment, near the instance, which is where a
+    /// hit or a nearest point on it is decided) is off from the exact image of the world point by
+    /// at most eps_T / 2 * sqrt(3) * 4 E per rounded point, twice for a ray (its origin and its
+    /// direction times t): under 7 eps_T E, and the triangle tests' own rounding of the local
+    /// coordinates stays within the rest of the first term. (c) R^T differs from R's inverse by
+    /// (I - R^T R) R^-1, of norm at most 3 d (1 + 3 d), so mapping back moves a point at
+    /// |x| <= sqrt(3) E by under 6 d E: the third term. Where W is no wider than T (long double
+    /// is double on some platforms), eps_W = eps_T and the second term is 8 eps_T (tau + 2 E),
+    /// the |t| term such a platform needs. The pad no longer grows with eps_T |t|: far from the
+    /// origin the box is as tight as T's spacing there allows. A query from farther out than
+    /// 4 E carries its own rounding, eps_T / 2 of its local coordinates, which the queries
+    /// already document as their accuracy.
     W pose_pad(const Transform<T>& pose) const {
-        W scale = extent_;
+        W tau = 0;
         for (std::size_t a = 0; a < 3; ++a)
-            scale = std::max(scale, W(std::fabs(W(pose.translation[a]))));
-        const W eps = W(std::numeric_limits<T>::epsilon());
-        return (W(8) * eps + W(rigid_deviation(pose.rotation))) * (scale + extent_);
+            tau = std::max(tau, W(std::fabs(W(pose.translation[a]))));
+        const W eps_t = W(std::numeric_limits<T>::epsilon());
+        const W eps_w = std::numeric_limits<W>::epsilon();
+        const W d = W(rigid_deviation(pose.rotation));
+        return W(16) * eps_t * extent_ + W(8) * eps_w * (tau + W(2) * extent_) + W(6) * d * extent_;
     }
 
     const TriangleBvh<T>& ray_tree() const {

@@ -45,7 +45,13 @@ class InstanceId {
     constexpr ProxyId proxy() const { return proxy_; }
     std::string text() const { return proxy_.text(); }
     friend constexpr bool operator==(InstanceId, InstanceId) = default;
-    friend constexpr auto operator<=>(InstanceId, InstanceId) = default;
+    /// By slot, then generation (not by bits(), whose high half is the generation): the order of
+    /// for_each_instance and of the collision queries' output, whatever slots were reused. The
+    /// null id (slot -1) comes first.
+    friend constexpr std::strong_ordering operator<=>(InstanceId x, InstanceId y) {
+        if (const auto by_slot = x.index() <=> y.index(); by_slot != 0) return by_slot;
+        return x.generation() <=> y.generation();
+    }
     template <class Os>
     friend auto operator<<(Os& os, InstanceId id) -> decltype(os << std::string()) {
         return os << id.text();
@@ -67,7 +73,7 @@ struct InstanceOptions {
     T margin = 0;
 };
 
-/// Two instances, a.index() < b.index().
+/// Two instances, a.index() < b.index(); ordered by a, then b (InstanceId's order: by slot).
 struct InstancePair {
     InstanceId a, b;
     friend constexpr bool operator==(const InstancePair&, const InstancePair&) = default;

@@ -14,7 +14,9 @@
 // (u, v) in that triangle, and the world-space geometric normal R n (n = (p1 - p0) x (p2 - p0) in
 // the mesh's frame: not normalised, its length twice the triangle's area). Rays that cannot be
 // traced (is_traceable: a NaN or infinite component, a zero direction, tmin > tmax) miss; a
-// negative tmin is an Error (the cast starts at the origin).
+// negative tmin is an Error (the cast starts at the origin). A ray whose origin or direction
+// leaves T's finite range in an instance's frame (a direction of 3e38 rotated 45 degrees, an
+// origin 3e38 from an instance at -3e38) misses that instance.
 #include <algorithm>
 #include <span>
 #include <string>
@@ -46,6 +48,9 @@ bool check_scene_ray(const Ray<T, 3>& ray, const char* where) {
     return true;
 }
 
+/// The ray in the instance's frame. A coordinate beyond T's range there comes out infinite (the
+/// conversion is checked: scene_detail::narrow), and the callers treat such a ray as a miss of
+/// that instance (is_traceable) rather than trace it.
 template <class T>
 Ray<T, 3> local_ray(const Transform<T>& pose, const Ray<T, 3>& ray, T tmax) {
     using W = AccurateScalar<T>;
@@ -81,7 +86,9 @@ SceneHit<T> closest_hit(const Scene<T>& scene, const Ray<T, 3>& ray) {
         const SceneInstance<T>& r = scene.instance_at(proxy);
         const SceneGeometry<T>& g = scene.geometry_at(r.geometry);
         if (!g.has_extent()) return T(-1);
-        const Hit<T> h = g.ray_tree().closest_hit(scene_detail::local_ray(r.pose, ray, max_t));
+        const Ray<T, 3> local = scene_detail::local_ray(r.pose, ray, max_t);
+        if (!is_traceable(local)) return T(-1);  // overflowed in the instance's frame: a miss
+        const Hit<T> h = g.ray_tree().closest_hit(local);
         if (!h || !(h.t < best_local.t)) return T(-1);
         best_local = h;
         best_proxy = proxy;
@@ -100,7 +107,8 @@ bool any_hit(const Scene<T>& scene, const Ray<T, 3>& ray) {
         const SceneInstance<T>& r = scene.instance_at(proxy);
         const SceneGeometry<T>& g = scene.geometry_at(r.geometry);
         if (!g.has_extent()) return T(-1);
-        if (!g.ray_tree().any_hit(scene_detail::local_ray(r.pose, ray, ray.tmax))) return T(-1);
+        const Ray<T, 3> local = scene_detail::local_ray(r.pose, ray, ray.tmax);
+        if (!is_traceable(local) || !g.ray_tree().any_hit(local)) return T(-1);
         hit = true;
         return T(0);
     });
@@ -117,7 +125,9 @@ void all_hits(const Scene<T>& scene, const Ray<T, 3>& ray, std::vector<SceneHit<
         const SceneInstance<T>& r = scene.instance_at(proxy);
         const SceneGeometry<T>& g = scene.geometry_at(r.geometry);
         if (!g.has_extent()) return T(-1);
-        g.ray_tree().all_hits(scene_detail::local_ray(r.pose, ray, ray.tmax), [&](const Hit<T>& h) {
+        const Ray<T, 3> local = scene_detail::local_ray(r.pose, ray, ray.tmax);
+        if (!is_traceable(local)) return T(-1);
+        g.ray_tree().all_hits(local, [&](const Hit<T>& h) {
             out.push_back(scene_detail::scene_hit(scene, proxy, h));
             return true;
         });
