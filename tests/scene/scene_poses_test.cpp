@@ -240,8 +240,12 @@ void far_boxes_are_tight(double offset, std::uint64_t seed) {
             }
             const LD spacing =
                 LD(std::nextafter(T(hi), std::numeric_limits<T>::infinity())) - LD(T(hi));
-            // One spacing for the outward rounding, one more where the pad crosses a boundary.
-            const LD slack = 2 * spacing + 64 * LD(std::numeric_limits<T>::epsilon());
+            // One spacing for the outward rounding, one more where the pad crosses a boundary,
+            // and the bound the box adds for its extremes taken in double (4 eps_d of
+            // 3.01 E + |t|: a few double spacings far out, below a float's).
+            const LD slack = 2 * spacing + 64 * LD(std::numeric_limits<T>::epsilon()) +
+                             8 * LD(std::numeric_limits<double>::epsilon()) *
+                                 (std::fabs(LD(r.pose.translation[a])) + 4);
             EXPECT_LE(LD(box.min[a]), lo);
             EXPECT_GE(LD(box.max[a]), hi);
             EXPECT_LE(lo - LD(box.min[a]), slack) << "offset " << offset;
