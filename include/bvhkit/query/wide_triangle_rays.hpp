@@ -98,7 +98,8 @@ class WideTriangleRays {
     }
 
     /// hits[i] = closest_hit(rays[i]); the spans are of one length.
-    void trace_on_calling_thread(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits) const {
+    void trace_on_calling_thread(std::span<const Ray<float, 3>> rays,
+                                 std::span<Hit<float>> hits) const {
 #if BVHKIT_RAY_AVX2
         if (streams_traces()) {
             stream<false>(
