@@ -15,6 +15,7 @@
 #include "bvhkit/query/winding_number.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "random_geometry.hpp"
+#include "test_support.hpp"
 
 namespace bvhkit {
 namespace {
@@ -105,7 +106,9 @@ void expect_dense_windings(const TriangleMesh& mesh, std::uint64_t seed) {
     const double size = length(Vec3d(e));
     test::Random rng(seed);
     int decided = 0, tested = 0, inside = 0;
-    for (int i = 0; i < 3000; ++i) {
+    // Each point's reference sums every triangle: fewer points under the sanitizers.
+    const int count = int(test::scaled(3000, 5));
+    for (int i = 0; i < count; ++i) {
         const Vec3f q = rng.point_in(Aabb3f(box.min - e * 0.2f, box.max + e * 0.2f));
         // A point on the surface (float points far from the origin can land on a face) is on
         // neither side.
@@ -119,8 +122,8 @@ void expect_dense_windings(const TriangleMesh& mesh, std::uint64_t seed) {
             EXPECT_EQ(*got, int(std::round(w))) << "point " << q[0] << " " << q[1] << " " << q[2];
         }
     }
-    EXPECT_GT(tested, 2500);
-    EXPECT_GT(inside, 100);
+    EXPECT_GT(tested, count * 5 / 6);
+    EXPECT_GT(inside, count / 30);
     EXPECT_GE(decided, tested - 3);  // an exact edge or vertex hit is rare on random points
 }
 
