@@ -95,19 +95,52 @@ bool valid(const Transform<T>& pose, bool check_rotation) {
 template <class T>
 void check_poses(const PoseValues<T>& r, const PoseValues<T>& t) {
     for (std::size_t i = 0; i < 3 * t.count(); ++i)
-        if (!std::isfinite(t[i]))
-            throw Error("translations: row " + std::to_string(i / 3) +
-                        " has a NaN or infinite coordinate");
+        if (!std::isfinite(t[i])) throw_bad_translation(i / 3);
     if (!r) return;
     for (std::size_t i = 0; i < 9 * r.count(); ++i)
-        if (!std::isfinite(r[i]))
-            throw Error("rotations: rotation " + std::to_string(i / 9) +
-                        " has a NaN or infinite entry");
+        if (!std::isfinite(r[i])) throw_bad_rotation_entry(i / 9);
     for (std::size_t i = 0; i < r.count(); ++i)
-        if (!(rigid_deviation(r.matrix(i)) <= rigid_tolerance<T>()))
-            throw Error("rotations: rotation " + std::to_string(i) +
-                        " is not a rotation matrix (R^T R must be the identity and det R = +1, "
-                        "to 1e-4)");
+        if (!(rigid_deviation(r.matrix(i)) <= rigid_tolerance<T>())) throw_not_a_rotation(i);
+}
+
+/// The number of poses: the translations' rows, which the rotations (when given) must match.
+template <class T>
+std::size_t pose_count(const PoseValues<T>& r, const PoseValues<T>& t) {
+    const std::size_t k = t.count();
+    if (r && r.count() != k) {
+        check_poses(r, t);
+        throw Error("translations: " + std::to_string(k) + " rows, rotations has " +
+                    std::to_string(r.count()));
+    }
+    return k;
+}
+
+/// Calls per_pose(i, pose) for every pose, `grain` poses a chunk over `threads` threads (the
+/// caller has released the GIL). Each pose is checked where it is used, so a batch reads its
+/// poses once; a bad pose stops the batch, and the poses are then scanned in order for the error
+/// bvhkit/_collision.py documents (check_poses).
+template <class T, class PerPose>
+void run_poses(const PoseValues<T>& r, const PoseValues<T>& t, std::size_t grain, unsigned threads,
+               PerPose&& per_pose) {
+    std::atomic<bool> bad{false};
+    run_batch(t.count(), grain, threads, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end && !bad.load(std::memory_order_relaxed); ++i) {
+            Transform<T> pose;  // the identity rotation where none was given
+            if (r) pose.rotation = r.matrix(i);
+            pose.translation = t.row(i);
+            if (!valid(pose, bool(r))) {
+                bad.store(true, std::memory_order_relaxed);
+                return;
+            }
+            per_pose(i, pose);
+        }
+    });
+    if (bad.load()) {
+        check_poses(r, t);
+        // Only another thread writing the arrays during the call gets here: a pose read as bad
+        // was good when scanned again. The outputs are not whole, so the call fails.
+        throw Error("translations: the poses changed while the call read them");
+    }
 }
 
 template <class V>
@@ -187,46 +220,21 @@ class Model {
         refit_vertices(mesh_.vertices, v, [&] { model_.refit(mesh_); });
     }
 
-    /// Calls per_pose(i, pose) for every pose of B in A's frame (this is A), without the GIL.
-    /// `rotations` is (k, 3, 3) or None for the identity, `translations` (k, 3); a single pose
-    /// may also come as (3, 3) and (3,). Each pose is checked where it is used, so a batch reads
-    /// its poses once; a bad pose stops the batch, and the poses are then scanned in order for
-    /// the error bvhkit/_collision.py documents (check_poses).
+    /// Calls per_pose(i, pose) for every pose of B in A's frame (this is A), without the GIL
+    /// (run_poses). `rotations` is (k, 3, 3) or None for the identity, `translations` (k, 3); a
+    /// single pose may also come as (3, 3) and (3,).
     template <class PerPose>
     void poses(const Model& b, const std::optional<PoseArray>& rotations,
                const PoseArray& translations, unsigned threads, PerPose&& per_pose) const {
         const PoseValues<T> t(translations, 1, "translations");
         const PoseValues<T> r =
             rotations ? PoseValues<T>(*rotations, 2, "rotations") : PoseValues<T>();
-        const std::size_t k = t.count();
-        if (r && r.count() != k) {
-            check_poses(r, t);
-            throw Error("translations: " + std::to_string(k) + " rows, rotations has " +
-                        std::to_string(r.count()));
-        }
+        pose_count(r, t);
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock_a(mutex_);
         std::shared_lock<std::shared_mutex> lock_b;
         if (&b != this) lock_b = std::shared_lock<std::shared_mutex>(b.mutex_);
-        std::atomic<bool> bad{false};
-        run_batch(k, 1, threads, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end && !bad.load(std::memory_order_relaxed); ++i) {
-                Transform<T> pose;  // the identity rotation where none was given
-                if (r) pose.rotation = r.matrix(i);
-                pose.translation = t.row(i);
-                if (!valid(pose, bool(r))) {
-                    bad.store(true, std::memory_order_relaxed);
-                    return;
-                }
-                per_pose(i, pose);
-            }
-        });
-        if (bad.load()) {
-            check_poses(r, t);
-            // Only another thread writing the arrays during the call gets here: a pose read as
-            // bad was good when scanned again. The outputs are not whole, so the call fails.
-            throw Error("translations: the poses changed while the call read them");
-        }
+        run_poses(r, t, 1, threads, per_pose);
     }
 
     void collides(const Model& b, const std::optional<PoseArray>& rotations,

@@ -49,6 +49,33 @@ void expect_rows(const A& a, std::size_t rows, const char* name) {
                     std::to_string(rows));
 }
 
+/// The errors of a bad pose in row i, worded as bvhkit/_collision.py documents them.
+[[noreturn]] inline void throw_bad_translation(std::size_t i) {
+    throw Error("translations: row " + std::to_string(i) + " has a NaN or infinite coordinate");
+}
+[[noreturn]] inline void throw_bad_rotation_entry(std::size_t i) {
+    throw Error("rotations: rotation " + std::to_string(i) + " has a NaN or infinite entry");
+}
+[[noreturn]] inline void throw_not_a_rotation(std::size_t i) {
+    throw Error("rotations: rotation " + std::to_string(i) +
+                " is not a rotation matrix (R^T R must be the identity and det R = +1, to 1e-4)");
+}
+
+/// A batch of rays' [tmin, tmax]: one array each, or one pair for every ray (the one-ray calls'
+/// usual form, which then converts no array for them).
+template <class T>
+struct PerRayLimits {
+    const T *t0, *t1;
+    T tmin(std::size_t i) const { return t0[i]; }
+    T tmax(std::size_t i) const { return t1[i]; }
+};
+template <class T>
+struct SharedLimits {
+    T t0, t1;
+    T tmin(std::size_t) const { return t0; }
+    T tmax(std::size_t) const { return t1; }
+};
+
 /// The vertices and faces as the library's mesh (one copy: the library keeps its own).
 template <class T>
 BasicTriangleMesh<T> make_mesh(const Rows<T, 3>& vertices, const Faces& faces) {

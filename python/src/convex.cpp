@@ -66,40 +66,18 @@ class Convex {
 };
 
 /// Calls per_pose(i, pose) for every pose of B in A's frame, over `threads` threads without the
-/// GIL, as Model::poses does (collision.hpp): each pose checked as it is read, and on a bad one the
-/// poses scanned in order for the documented error.
+/// GIL (collision.hpp's run_poses, as Model::poses).
 template <class PerPose>
 void each_pose(const std::optional<PoseArray>& rotations, const PoseArray& translations,
                unsigned threads, PerPose&& per_pose) {
     const PoseValues<double> t(translations, 1, "translations");
     const PoseValues<double> r =
         rotations ? PoseValues<double>(*rotations, 2, "rotations") : PoseValues<double>();
-    const std::size_t k = t.count();
-    if (r && r.count() != k) {
-        check_poses(r, t);
-        throw Error("translations: " + std::to_string(k) + " rows, rotations has " +
-                    std::to_string(r.count()));
-    }
+    pose_count(r, t);
     nb::gil_scoped_release release;
-    std::atomic<bool> bad{false};
     // A query is a few microseconds: chunks of several poses keep the shared counter off the
     // critical path. Each pose is still answered by one thread alone.
-    run_batch(k, 16, threads, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end && !bad.load(std::memory_order_relaxed); ++i) {
-            Transform<double> pose;  // the identity rotation where none was given
-            if (r) pose.rotation = r.matrix(i);
-            pose.translation = t.row(i);
-            if (!valid(pose, bool(r))) {
-                bad.store(true, std::memory_order_relaxed);
-                return;
-            }
-            per_pose(i, pose);
-        }
-    });
-    if (bad.load()) {
-        check_poses(r, t);
-        throw Error("translations: the poses changed while the call read them");
-    }
+    run_poses(r, t, 16, threads, per_pose);
 }
 
 void put(double* out, std::size_t i, const Vec<double, 3>& v) {

@@ -126,19 +126,12 @@ class InstancedScene {
             const Pose& p = poses[i];
             bool finite = true;
             for (std::size_t a = 0; a < 3; ++a) {
-                if (!std::isfinite(p.translation[a]))
-                    throw Error("translations: row " + std::to_string(i) +
-                                " has a NaN or infinite coordinate");
+                if (!std::isfinite(p.translation[a])) throw_bad_translation(i);
                 for (std::size_t b = 0; b < 3; ++b)
                     finite = finite && std::isfinite(p.rotation[a][b]);
             }
-            if (!finite)
-                throw Error("rotations: rotation " + std::to_string(i) +
-                            " has a NaN or infinite entry");
-            if (!(rigid_deviation(p.rotation) <= rigid_tolerance<T>()))
-                throw Error("rotations: rotation " + std::to_string(i) +
-                            " is not a rotation matrix (R^T R must be the identity and det R = "
-                            "+1, to 1e-4)");
+            if (!finite) throw_bad_rotation_entry(i);
+            if (!(rigid_deviation(p.rotation) <= rigid_tolerance<T>())) throw_not_a_rotation(i);
         }
     }
 
@@ -263,18 +256,8 @@ class InstancedScene {
 
     // ---------------------------------------------------------------- rays
 
-    /// The rays' [tmin, tmax]: one array each, or one pair for every ray (the one-ray call's
-    /// usual form, which then converts no array for them).
-    struct PerRayLimits {
-        const T *t0, *t1;
-        T tmin(std::size_t i) const { return t0[i]; }
-        T tmax(std::size_t i) const { return t1[i]; }
-    };
-    struct SharedLimits {
-        T t0, t1;
-        T tmin(std::size_t) const { return t0; }
-        T tmax(std::size_t) const { return t1; }
-    };
+    using PerRayLimits = bvhkit::python::PerRayLimits<T>;
+    using SharedLimits = bvhkit::python::SharedLimits<T>;
     static PerRayLimits limits(const Column<T>& tmin, const Column<T>& tmax, std::size_t k) {
         expect_rows(tmin, k, "tmin");
         expect_rows(tmax, k, "tmax");

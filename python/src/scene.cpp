@@ -140,18 +140,8 @@ class Scene {
     /// Calls per_chunk(first, rays) for runs of up to ray_chunk rays, rays[j] the batch's ray
     /// first + j: the tree's stream calls walk several at once (query/ray_stream.hpp).
     static constexpr std::size_t ray_chunk = 256;
-    /// The rays' [tmin, tmax]: one array each, or one pair for every ray (the one-ray calls'
-    /// usual form, which then converts no array for them).
-    struct PerRayLimits {
-        const T *t0, *t1;
-        T tmin(std::size_t i) const { return t0[i]; }
-        T tmax(std::size_t i) const { return t1[i]; }
-    };
-    struct SharedLimits {
-        T t0, t1;
-        T tmin(std::size_t) const { return t0; }
-        T tmax(std::size_t) const { return t1; }
-    };
+    using PerRayLimits = bvhkit::python::PerRayLimits<T>;
+    using SharedLimits = bvhkit::python::SharedLimits<T>;
     template <class PerChunk>
     void ray_chunks(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
                     const Column<T>& tmax, unsigned threads, PerChunk&& per_chunk) const {

@@ -4,20 +4,9 @@ import numpy as np
 import pytest
 
 import bvhkit
-from reference import random_soup, triangle_distance, triangles_intersect
+from reference import random_rotations, random_soup, triangle_distance, triangles_intersect
 
 VOLUMES = ["obb", "rss", "obbrss", "aabb", "sphere", "kdop18", "hull"]
-
-
-def random_rotations(rng, k):
-    q = rng.normal(size=(k, 4))
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    w, x, y, z = q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
-    ], axis=1)
 
 
 def setup(seed, k=40):
