@@ -15,7 +15,7 @@ namespace bvhkit::tools {
 
 namespace {
 
-void usage(std::FILE* out) {
+void bench_dynamic_usage(std::FILE* out) {
     std::fprintf(
         out,
         "usage: bvhkit bench dynamic [--json] [--n N] [--steps S] [--reps R] [--only D1|D2|D3|D4]\n"
@@ -31,7 +31,7 @@ void usage(std::FILE* out) {
 int bench_dynamic_command(int argc, char** argv) {
     const Args args(argc, argv, {"--n", "--steps", "--reps", "--only"}, {"--json"});
     if (args.help()) {
-        usage(stdout);
+        bench_dynamic_usage(stdout);
         return 0;
     }
     if (!args.positional().empty())

@@ -17,7 +17,7 @@
 namespace bvhkit::tools {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kBspHelp =
     R"(usage: bvhkit bsp MESH [--split-weight W] [--max-depth D] [--leaf-size N]
                        [--candidates polygon|axis|both] [--compare] [--json]
 
@@ -116,7 +116,7 @@ int bsp_command(int argc, char** argv) {
     const Args args(argc, argv, {"--split-weight", "--max-depth", "--leaf-size", "--candidates"},
                     {"--json", "--compare"});
     if (args.help()) {
-        std::fputs(kHelp, stdout);
+        std::fputs(kBspHelp, stdout);
         return 0;
     }
     if (args.positional().size() != 1) throw Error("bsp takes one mesh (see --help)");

@@ -16,7 +16,7 @@
 namespace bvhkit::tools {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kClosestHelp =
     R"(usage: bvhkit closest MESH --points FILE --out FILE [--format 1|2] [--builder NAME]
                        [--threads N]
 
@@ -48,7 +48,7 @@ std::vector<Vec3f> read_points(const std::string& path) {
 int closest_command(int argc, char** argv) {
     const Args args(argc, argv, {"--points", "--out", "--format", "--builder", "--threads"}, {});
     if (args.help()) {
-        std::fputs(kHelp, stdout);
+        std::fputs(kClosestHelp, stdout);
         return 0;
     }
     if (args.positional().size() != 1) throw Error("closest takes one mesh (see --help)");

@@ -16,7 +16,7 @@
 namespace bvhkit::tools {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kDistanceHelp =
     R"(usage: bvhkit distance MESH_A MESH_B --poses FILE --out FILE [--bv rss|obbrss|obb|aabb|sphere|kdop18|hull]
 
 For each pose (12 float32: row-major rotation R, translation t; B placed at x' = R x + t in A's
@@ -43,16 +43,16 @@ void distance_all(const TriangleMesh& ma, const TriangleMesh& mb,
 int distance_command(int argc, char** argv) {
     const Args args(argc, argv, {"--poses", "--out", "--bv"}, {});
     if (args.help()) {
-        std::fputs(kHelp, stdout);
+        std::fputs(kDistanceHelp, stdout);
         return 0;
     }
     if (args.positional().size() != 2)
         return usage_error(
             "distance",
             "takes two meshes MESH_A MESH_B, got " + std::to_string(args.positional().size()),
-            kHelp);
+            kDistanceHelp);
     if (!args.has("--poses") || !args.has("--out"))
-        return usage_error("distance", "--poses FILE and --out FILE are required", kHelp);
+        return usage_error("distance", "--poses FILE and --out FILE are required", kDistanceHelp);
     const TriangleMesh ma = load_mesh(args.positional()[0]);
     const TriangleMesh mb = load_mesh(args.positional()[1]);
     const auto poses = read_pose_file(args.value("--poses"));

@@ -40,7 +40,7 @@ void append(std::string& out, const char* format, ...) {
     va_end(again);
 }
 
-void usage(std::FILE* out) {
+void draw_tree_usage(std::FILE* out) {
     std::fprintf(
         out,
         "usage: bvhkit draw-tree [-o FILE.svg] [--n N] [--seed S] [--scene random|battle]\n"
@@ -74,7 +74,7 @@ std::vector<Aabb2f> battle_scene(std::mt19937& rng) {
 int draw_tree_command(int argc, char** argv) {
     const Args args(argc, argv, {"-o", "--n", "--seed", "--moves", "--scene", "--strategy"}, {});
     if (args.help()) {
-        usage(stdout);
+        draw_tree_usage(stdout);
         return 0;
     }
     if (!args.positional().empty())

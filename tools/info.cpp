@@ -12,7 +12,7 @@
 namespace bvhkit::tools {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kInfoHelp =
     R"(usage: bvhkit info MESH [--builder NAME | --all-builders] [--spatial-splits]
                    [--json]
 
@@ -28,7 +28,7 @@ MESH is a file (OBJ, PLY, STL) or a generator spec such as sphere:subdiv=7.
 int info_command(int argc, char** argv) {
     const Args args(argc, argv, {"--builder"}, {"--all-builders", "--json", "--spatial-splits"});
     if (args.help()) {
-        std::fputs(kHelp, stdout);
+        std::fputs(kInfoHelp, stdout);
         return 0;
     }
     if (args.positional().size() != 1) throw Error("info takes one mesh (see --help)");

@@ -19,7 +19,7 @@
 namespace bvhkit::tools {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kRenderHelp =
     R"(usage: bvhkit render [MESH] -o IMAGE.png [--heatmap [--scale N]] [--size WxH] [--builder NAME]
                      [--structure bvh|bsp]
 
@@ -124,7 +124,7 @@ int render_command(int argc, char** argv) {
     const Args args(argc, argv, {"-o", "--size", "--builder", "--scale", "--turn", "--structure"},
                     {"--heatmap"});
     if (args.help()) {
-        std::fputs(kHelp, stdout);
+        std::fputs(kRenderHelp, stdout);
         return 0;
     }
     if (!args.has("-o")) throw Error("missing -o IMAGE.png (see --help)");

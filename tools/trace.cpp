@@ -16,7 +16,7 @@
 namespace bvhkit::tools {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kTraceHelp =
     R"(usage: bvhkit trace MESH --rays FILE --out FILE [--any-hit] [--builder NAME]
                     [--structure bvh|bsp] [--threads N]
 
@@ -62,7 +62,7 @@ int trace_command(int argc, char** argv) {
     const Args args(argc, argv, {"--rays", "--out", "--builder", "--structure", "--threads"},
                     {"--any-hit"});
     if (args.help()) {
-        std::fputs(kHelp, stdout);
+        std::fputs(kTraceHelp, stdout);
         return 0;
     }
     if (args.positional().size() != 1) throw Error("trace takes one mesh (see --help)");

@@ -35,11 +35,6 @@ bool have_fcl() {
 
 namespace {
 
-std::string mesh_name(const std::string& arg) {
-    const auto slash = arg.find_last_of('/');
-    return slash == std::string::npos ? arg : arg.substr(slash + 1);
-}
-
 /// What one library with one volume type does for the three workloads. Each function runs the
 /// whole pose list and records its answers (per pose) so the libraries can be compared.
 struct Runner {
@@ -157,7 +152,7 @@ std::vector<Row> run_collide_bench(const CollideBenchOptions& options, std::FILE
     std::vector<Row> rows;
     for (const auto& arg : options.meshes) {
         const TriangleMesh mesh = load_mesh(arg);
-        const std::string name = mesh_name(arg);
+        const std::string name = mesh_label(arg);
         const auto poses = random_rigid_poses(mesh.bounds(), options.poses, options.seed);
         std::vector<Runner> runners;
         runners.push_back(bvhkit_runner<Aabb3f>(mesh, "aabb"));

@@ -1,7 +1,6 @@
 #include "nearest_bench.hpp"
 
 #include <cmath>
-#include <filesystem>
 
 #include "bvhkit/exec/parallel.hpp"
 #include "bvhkit/math/random.hpp"
@@ -26,10 +25,6 @@ bool have_cgal() {
 }
 
 namespace {
-
-std::string mesh_name(const std::string& m) {
-    return std::filesystem::exists(m) ? std::filesystem::path(m).filename().string() : m;
-}
 
 /// N1's points: uniform in the mesh's box grown by 10% (5% of its extent on every side).
 std::vector<Vec3f> n1_points(const TriangleMesh& mesh, std::size_t count) {
@@ -57,7 +52,7 @@ std::vector<Row> run_nearest_bench(const NearestBenchOptions& o, std::FILE* prog
     const BuildOptions build = parse_builder(o.builder);
     for (const std::string& m : o.meshes) {
         const TriangleMesh mesh = load_mesh(m);
-        const std::string name = mesh_name(m);
+        const std::string name = mesh_label(m);
         if (progress)
             std::fprintf(progress, "%s: %zu triangles\n", name.c_str(), mesh.triangles.size());
         const std::vector<Vec3f> points = n1_points(mesh, o.points);

@@ -21,11 +21,6 @@ bool have_embree() {
 
 namespace {
 
-std::string mesh_name(const std::string& arg) {
-    const auto slash = arg.find_last_of('/');
-    return slash == std::string::npos ? arg : arg.substr(slash + 1);
-}
-
 struct Workload {
     const char* name;
     const std::vector<Ray3f>* rays;
@@ -130,7 +125,7 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
         1;  // single thread, as Embree is run here (the workload compares one thread each)
     for (const std::string& arg : options.meshes) {
         const TriangleMesh mesh = load_mesh(arg);
-        const std::string name = mesh_name(arg);
+        const std::string name = mesh_label(arg);
         if (progress)
             std::fprintf(progress, "%s: %zu triangles\n", name.c_str(), mesh.triangle_count());
         const auto row_for = [&](const char* workload, const char* library) {

@@ -1,9 +1,14 @@
 #include "report.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <string_view>
 
 namespace bvhkit::bench {
+
+std::string mesh_label(const std::string& arg) {
+    return std::filesystem::exists(arg) ? std::filesystem::path(arg).filename().string() : arg;
+}
 
 double median(std::vector<double> values) {
     if (values.empty()) return 0.0;

@@ -11,6 +11,10 @@
 
 namespace bvhkit::bench {
 
+/// A mesh argument as the tables name it: a file's name without its folders, a generator's
+/// spec (sphere:subdiv=5) as given.
+std::string mesh_label(const std::string& arg);
+
 /// Milliseconds taken by f(), median over `repetitions` runs (after one untimed warm-up when
 /// asked).
 double median_ms(int repetitions, const std::function<void()>& f, bool warm_up = true);
