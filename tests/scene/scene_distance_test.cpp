@@ -14,7 +14,7 @@
 #include "bvhkit/scene/distance.hpp"
 #include "scene_support.hpp"
 
-namespace bvhkit {
+namespace bvhkit::distance_test {
 namespace {
 
 using scene_test::LD;
@@ -417,4 +417,4 @@ TEST(SceneDistance, TwoScenesAgainstEveryPair) {
 }
 
 }  // namespace
-}  // namespace bvhkit
+}  // namespace bvhkit::distance_test

@@ -20,7 +20,7 @@
 #include "scene_support.hpp"
 #include "test_support.hpp"
 
-namespace bvhkit {
+namespace bvhkit::file_test {
 namespace {
 
 template <class T>
@@ -236,4 +236,4 @@ TEST(SceneFile, ByteFlipsAreErrorsOrUsableScenes) {
 }
 
 }  // namespace
-}  // namespace bvhkit
+}  // namespace bvhkit::file_test
