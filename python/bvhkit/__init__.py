@@ -58,6 +58,7 @@ __all__ = [
     "SceneHits",
     "SceneIntersections",
     "SceneClosest",
+    "SceneDistances",
     "pinhole_rays",
     "MissingFileError",
 ]
@@ -460,6 +461,7 @@ from ._dynamic import DynamicTree2D, DynamicTree3D  # noqa: E402
 from ._instances import (  # noqa: E402
     Scene,
     SceneClosest,
+    SceneDistances,
     SceneHits,
     SceneIntersections,
 )

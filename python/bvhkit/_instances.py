@@ -8,7 +8,8 @@ work without the GIL.
 from __future__ import annotations
 
 import math
-from typing import Any, NamedTuple, Optional, Tuple
+import os
+from typing import Any, NamedTuple, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -74,6 +75,23 @@ class SceneClosest(NamedTuple):
     """(k,) int64 index of the face in that mesh; -1 where there is none."""
     barycentric: np.ndarray
     """(k, 3) weights of the face's vertices at the point."""
+
+
+class SceneDistances(NamedTuple):
+    """What :meth:`Scene.pairs_within` returns (and :meth:`Scene.closest_pair` and
+    :meth:`Scene.closest_instance`, with at most one entry), one entry per pair."""
+
+    distance: np.ndarray
+    """(p,) the meshes' distance less both margins (<= 0: the pair collides, with a margin)."""
+    pairs: np.ndarray
+    """(p, 2) int64 ids, the first the lower slot; -1 first for :meth:`Scene.closest_instance`
+    (the posed mesh)."""
+    point_a: np.ndarray
+    """(p, 3) the closest point on the first's mesh, world space."""
+    point_b: np.ndarray
+    """(p, 3) the closest point on the second's mesh, world space."""
+    faces: np.ndarray
+    """(p, 2) int64 the faces the two points lie on."""
 
 
 def _index(name: str, value: Any, top: int) -> int:
@@ -538,6 +556,128 @@ class Scene:
         if not 0 <= m < math.inf:
             raise ValueError(f"margin: must be finite and >= 0, not {margin}")
         return self._impl.colliding_instances(g, r, t, gr, ma, m, first)
+
+    # ------------------------------------------------------------------ saving and loading
+
+    def to_bytes(self) -> bytes:
+        """The scene as bytes (the library's scene file, docs/serialization.md kind 7): each
+        mesh once, every instance with its id, pose and options, and the top-level tree as
+        built. :meth:`from_bytes` gives a scene with the same ids that answers every query bit
+        for bit as this one; its per-mesh trees are built again at the first query that needs
+        them (or by :meth:`prepare`)."""
+        return self._impl.to_bytes()
+
+    @classmethod
+    def from_bytes(cls, data: Union[bytes, bytearray, memoryview]) -> "Scene":
+        """A scene from :meth:`to_bytes`'s bytes (its dtype is the saved one). Everything is
+        checked (a checksum over the whole, every count, id, pose and box); damaged or foreign
+        data raises ValueError."""
+        return cls._from_bytes(data, "data")
+
+    def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Writes :meth:`to_bytes` to the file ``path`` (beside and renamed: a failed write
+        leaves no partial file)."""
+        _bvhkit.write_file(_a.path("path", path), self.to_bytes())
+
+    @classmethod
+    def load(cls, path: Union[str, "os.PathLike[str]"]) -> "Scene":
+        """A scene from a file written by :meth:`save` (ValueError naming the file if damaged)."""
+        p = _a.path("path", path)
+        return cls._from_bytes(_bvhkit.read_file(p), p)
+
+    @classmethod
+    def _from_bytes(cls, data: Any, what: str) -> "Scene":
+        self = cls.__new__(cls)
+        self._load(data, what)
+        return self
+
+    def _load(self, data: Any, what: str) -> None:
+        if not isinstance(data, (bytes, bytearray, memoryview)):
+            raise TypeError(f"{what}: must be bytes, not {type(data).__name__}")
+        b = bytes(data)
+        # The envelope's scalar byte (docs/serialization.md) picks the type; the loader checks
+        # everything else, this byte included.
+        dtype = np.dtype(np.float64) if len(b) > 16 and b[16] == 2 else np.dtype(np.float32)
+        impl = (_bvhkit.InstancedScene32 if dtype == np.float32 else _bvhkit.InstancedScene64)()
+        try:
+            impl.load_bytes(b)
+        except ValueError as e:
+            raise ValueError(f"{what}: {e}") from None
+        self.dtype = dtype
+        self._impl = impl
+
+    def __getstate__(self) -> dict:
+        """Pickles through :meth:`to_bytes`."""
+        return {"bvhkit.Scene": self.to_bytes()}
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickles through :meth:`from_bytes`."""
+        if not isinstance(state, dict) or "bvhkit.Scene" not in state:
+            raise ValueError("state: not a pickled bvhkit.Scene")
+        self._load(state["bvhkit.Scene"], "pickled Scene")
+
+    def _other(self, other: Any) -> Any:
+        if not isinstance(other, Scene):
+            raise TypeError(f"other: must be a bvhkit.Scene, not {type(other).__name__}")
+        if other.dtype != self.dtype:
+            raise TypeError(f"other: dtype {other.dtype} is not this scene's {self.dtype}")
+        return other._impl
+
+    def colliding_pairs_with(self, other: "Scene", ignore: Optional[npt.ArrayLike] = None
+                             ) -> np.ndarray:
+        """Every pair (a of this scene, b of ``other``) that collides, by the rule of
+        :meth:`colliding_pairs`: (p, 2) int64 ids, sorted by a's slot then b's. ``other``: a
+        Scene of the same dtype (this scene itself compares every instance with every one,
+        itself included). ``ignore``: (q, 2) rows (id of this scene, id of other)."""
+        o = self._other(other)
+        return self._impl.colliding_pairs_with(o, self._ignore(ignore))
+
+    def any_collision_with(self, other: "Scene", ignore: Optional[npt.ArrayLike] = None) -> bool:
+        """Whether any pair (a of this scene, b of ``other``) collides (stops at the first)."""
+        o = self._other(other)
+        return bool(self._impl.any_collision_with(o, self._ignore(ignore)))
+
+    # ------------------------------------------------------------------ distance
+
+    def closest_pair(self, ignore: Optional[npt.ArrayLike] = None) -> SceneDistances:
+        """The closest pair of instances that may collide (the group/mask filter, not in
+        ``ignore``): :class:`SceneDistances` with one entry, or none when no pair has triangles.
+        The distance is the meshes' less both margins; the points lie on the meshes. Of pairs at
+        the same distance, the lowest slots win."""
+        return SceneDistances(*self._impl.closest_pair(self._ignore(ignore)))
+
+    def pairs_within(self, threshold: float, ignore: Optional[npt.ArrayLike] = None
+                     ) -> SceneDistances:
+        """Every pair that may collide whose distance (less both margins) is at most
+        ``threshold``, sorted by slots: :class:`SceneDistances`."""
+        t = _a.number("threshold", threshold)
+        if math.isnan(t):
+            raise ValueError("threshold: must not be NaN")
+        return SceneDistances(*self._impl.pairs_within(t, self._ignore(ignore)))
+
+    def closest_instance(
+        self,
+        geometry: int,
+        rotation: Optional[npt.ArrayLike] = None,
+        translation: Optional[npt.ArrayLike] = None,
+        *,
+        group: int = 1,
+        mask: int = 0xFFFFFFFF,
+        margin: float = 0.0,
+    ) -> SceneDistances:
+        """The instance nearest to mesh ``geometry`` placed at (rotation, translation), with
+        the filter and margin an instance with that group, mask and margin would have:
+        :class:`SceneDistances` with one entry (pairs[0] = (-1, id); point_a on the posed mesh)
+        or none."""
+        g = _index("geometry", geometry, _I64)
+        r = _rotations("rotation", _one_rotation(rotation), 1, self.dtype)
+        t = _translations("translation", _one_translation(translation), 1, self.dtype)
+        gr = _index("group", group, _U32)
+        ma = _index("mask", mask, _U32)
+        m = _a.number("margin", margin)
+        if not 0 <= m < math.inf:
+            raise ValueError(f"margin: must be finite and >= 0, not {margin}")
+        return SceneDistances(*self._impl.closest_instance(g, r, t, gr, ma, m))
 
 
 def _one_rotation(value: Any) -> Any:

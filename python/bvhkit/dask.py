@@ -1,15 +1,19 @@
 """bvhkit's point and ray queries over dask arrays, partition by partition.
 
-Each function takes a :class:`bvhkit.TriangleMesh` (or the :class:`SharedScene` that :func:`share`
-returns) and a dask array of points (n, 3), or of ray origins and directions (n, 3) each, and
-returns dask arrays chunked as the input's rows; ``.compute()`` gives exactly the arrays the
-single-process call gives (every point and ray is answered on its own).
+Each function takes a :class:`bvhkit.TriangleMesh` or a :class:`bvhkit.Scene` (or the
+:class:`SharedScene` that :func:`share` returns) and a dask array of points (n, 3), or of ray
+origins and directions (n, 3) each, and returns dask arrays chunked as the input's rows;
+``.compute()`` gives exactly the arrays the single-process call gives (every point and ray is
+answered on its own).
 
 The scene reaches each worker once, not once per partition: with a distributed Client active it
 is scattered to every worker (``client.scatter(scene, broadcast=True)``); without one it is a
-single key of the graph, which the local threaded scheduler uses in place. It travels in
-TriangleMesh's file format, trees included, so no worker rebuilds them (docs/scale-out.md; a
-ray tree with spatial splits alone is rebuilt by each worker that loads the scene).
+single key of the graph, which the local threaded scheduler uses in place. A TriangleMesh travels
+in its file format, trees included, so no worker rebuilds them (docs/scale-out.md; a ray tree
+with spatial splits alone is rebuilt by each worker that loads the scene); a Scene in the scene
+file format, its top-level tree included, its per-mesh trees built by each worker at its first
+query. A Scene answers closest_point (SceneClosest), intersect (SceneHits) and occluded; the
+other functions are TriangleMesh's alone.
 To reuse one shipment for several calls, pass ``share(scene)`` instead of the scene.
 
 ``threads`` is per partition and defaults to 1: dask already runs partitions in parallel.
@@ -33,7 +37,7 @@ except ImportError as e:  # pragma: no cover - exercised where dask is absent
         'bvhkit.dask needs dask: pip install "dask[array]" (or "dask[distributed]" for a cluster)'
     ) from e
 
-from . import ClosestPoints, RayHits, TriangleMesh
+from . import ClosestPoints, RayHits, Scene, SceneClosest, SceneHits, TriangleMesh
 from . import _arrays as _a
 
 __all__ = [
@@ -53,16 +57,17 @@ class SharedScene:
     """A scene shipped to the workers once (see :func:`share`); pass it to the functions of this
     module in place of the scene. ``ref`` is a distributed Future or a dask Delayed."""
 
-    def __init__(self, ref: Any, dtype: np.dtype) -> None:
+    def __init__(self, ref: Any, dtype: np.dtype, of_scene: bool = False) -> None:
         self.ref = ref
         self.dtype = dtype
+        self.of_scene = of_scene  # a bvhkit.Scene (else a TriangleMesh)
 
     def __repr__(self) -> str:
         """The reference."""
         return f"SharedScene({self.ref!r})"
 
 
-_Scene = Union[TriangleMesh, SharedScene]
+_Scene = Union[TriangleMesh, Scene, SharedScene]
 
 
 def _active_client() -> Any:
@@ -82,15 +87,17 @@ def share(scene: _Scene, client: Any = None) -> SharedScene:
     The scene is copied as it is now; a later ``refit`` of it is not seen by the shared copy."""
     if isinstance(scene, SharedScene):
         return scene
-    if not isinstance(scene, TriangleMesh):
-        raise TypeError(f"scene: must be a bvhkit.TriangleMesh, not {type(scene).__name__}")
+    if not isinstance(scene, (TriangleMesh, Scene)):
+        raise TypeError(
+            f"scene: must be a bvhkit.TriangleMesh or Scene, not {type(scene).__name__}"
+        )
     client = client if client is not None else _active_client()
     if client is not None:
         ref = client.scatter(scene, broadcast=True, hash=False)
     else:
         # An explicit name: dask would otherwise tokenize the scene by pickling it.
         ref = dask.delayed(scene, name=f"bvhkit-scene-{uuid.uuid4().hex}", traverse=False)
-    return SharedScene(ref, scene.dtype)
+    return SharedScene(ref, scene.dtype, isinstance(scene, Scene))
 
 
 def _rows(name: str, value: Any, like: Optional[da.Array] = None) -> da.Array:
@@ -127,20 +134,42 @@ def _map(
 
 
 def _dtype(scene: Any) -> np.dtype:
-    if isinstance(scene, (TriangleMesh, SharedScene)):
+    if isinstance(scene, (TriangleMesh, Scene, SharedScene)):
         return scene.dtype
     raise TypeError(
-        f"scene: must be a bvhkit.TriangleMesh or SharedScene, not {type(scene).__name__}"
+        f"scene: must be a bvhkit.TriangleMesh, Scene or SharedScene, not {type(scene).__name__}"
     )
+
+
+def _is_scene(scene: Any) -> bool:
+    """Whether ``scene`` is (or shares) a bvhkit.Scene."""
+    return isinstance(scene, Scene) or (isinstance(scene, SharedScene) and scene.of_scene)
+
+
+def _mesh_only(scene: Any, name: str) -> None:
+    if _is_scene(scene):
+        raise TypeError(f"scene: {name} is a TriangleMesh query; a bvhkit.Scene has none")
 
 
 def closest_point(
     scene: _Scene, points: npt.ArrayLike, max_distance: Optional[float] = np.inf, threads: int = 1
 ) -> ClosestPoints:
-    """:meth:`TriangleMesh.closest_point` on each partition: ClosestPoints of dask arrays."""
+    """:meth:`TriangleMesh.closest_point` on each partition: ClosestPoints of dask arrays; for a
+    :class:`bvhkit.Scene`, :meth:`Scene.closest_point`'s SceneClosest (``max_distance`` must
+    then be inf)."""
     t, md = _a.threads(threads), _a.limit("max_distance", max_distance)
     dt = _dtype(scene)
     p = _rows("points", points)
+    if _is_scene(scene):
+        if md != _a.INF:
+            raise ValueError("max_distance: a bvhkit.Scene's closest_point has no limit: give inf")
+
+        def scene_block(s: Scene, b: np.ndarray) -> tuple:
+            return tuple(s.closest_point(b, threads=t))
+
+        i64 = np.int64
+        souts = [((), dt), ((3,), dt), ((), i64), ((), i64), ((), i64), ((3,), dt)]
+        return SceneClosest(*_map(scene, [p], scene_block, souts))  # type: ignore[return-value]
 
     def block(s: TriangleMesh, b: np.ndarray) -> tuple:
         return tuple(s.closest_point(b, md, threads=t))
@@ -153,6 +182,7 @@ def signed_distance(
     scene: _Scene, points: npt.ArrayLike, sign: _a.Sign = "pseudonormal", threads: int = 1
 ) -> da.Array:
     """:meth:`TriangleMesh.signed_distance` on each partition."""
+    _mesh_only(scene, "signed_distance")
     t = _a.threads(threads)
     _a.option("sign", sign, _a.SIGNS)
     p = _rows("points", points)
@@ -167,6 +197,7 @@ def winding_number(
     scene: _Scene, points: npt.ArrayLike, exact: bool = False, beta: float = 2.0, threads: int = 1
 ) -> da.Array:
     """:meth:`TriangleMesh.winding_number` on each partition."""
+    _mesh_only(scene, "winding_number")
     t, e, b_ = _a.threads(threads), _a.flag("exact", exact), _a.number("beta", beta)
     if not 0 < b_ < _a.INF:
         raise ValueError(f"beta: must be a positive finite number, not {beta}")
@@ -200,10 +231,18 @@ def intersect(
     threads: int = 1,
 ) -> RayHits:
     """:meth:`TriangleMesh.intersect` on each partition (``tmin``, ``tmax``: scalars): RayHits of
-    dask arrays."""
+    dask arrays; for a :class:`bvhkit.Scene`, :meth:`Scene.intersect`'s SceneHits."""
     t = _a.threads(threads)
     o, d, t0, t1 = _ray_args(scene, origins, directions, tmin, tmax)
     dt = _dtype(scene)
+    if _is_scene(scene):
+
+        def scene_block(s: Scene, bo: np.ndarray, bd: np.ndarray) -> tuple:
+            return tuple(s.intersect(bo, bd, t0, t1, threads=t))
+
+        i64 = np.int64
+        souts = [((), dt), ((), i64), ((), i64), ((), i64), ((3,), dt), ((3,), dt)]
+        return SceneHits(*_map(scene, [o, d], scene_block, souts))  # type: ignore[return-value]
 
     def block(s: TriangleMesh, bo: np.ndarray, bd: np.ndarray) -> tuple:
         return tuple(s.intersect(bo, bd, t0, t1, threads=t))
@@ -232,6 +271,7 @@ def count_intersections(
     threads: int = 1,
 ) -> da.Array:
     """:meth:`TriangleMesh.count_intersections` on each partition: (n,) int64."""
+    _mesh_only(scene, "count_intersections")
     return _per_ray(
         scene, origins, directions, tmin, tmax, threads, "count_intersections", np.int64
     )

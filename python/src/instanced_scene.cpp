@@ -21,8 +21,10 @@
 
 #include "bvhkit/scene/closest_point.hpp"
 #include "bvhkit/scene/collision.hpp"
+#include "bvhkit/scene/distance.hpp"
 #include "bvhkit/scene/rays.hpp"
 #include "bvhkit/scene/scene.hpp"
+#include "bvhkit/scene/scene_file.hpp"
 #include "common.hpp"
 
 namespace bvhkit::python {
@@ -466,6 +468,107 @@ class InstancedScene {
         return owned_array(std::move(flat), n, 0);
     }
 
+    /// The pairs of this scene (a) and `other` (b) that collide, (p, 2) ids sorted by a's slot
+    /// then b's. `ignore` rows are (id of this scene, id of other).
+    nb::ndarray<nb::numpy, std::int64_t> colliding_pairs_with(const InstancedScene& other,
+                                                              const IdPairs& ignore) const {
+        std::vector<std::int64_t> flat;
+        {
+            const std::vector<InstancePair> skip = pairs_of(ignore);
+            nb::gil_scoped_release release;
+            const Both lock(*this, other);
+            check_cross_pairs(other, ignore);
+            std::vector<InstancePair> out;
+            bvhkit::colliding_pairs(scene_, other.scene_, out, skip);
+            flat.reserve(2 * out.size());
+            for (const InstancePair& p : out) flat.insert(flat.end(), {bits_of(p.a), bits_of(p.b)});
+        }
+        const std::size_t n = flat.size() / 2;
+        return owned_array(std::move(flat), n, 2);
+    }
+    bool any_collision_with(const InstancedScene& other, const IdPairs& ignore) const {
+        const std::vector<InstancePair> skip = pairs_of(ignore);
+        nb::gil_scoped_release release;
+        const Both lock(*this, other);
+        check_cross_pairs(other, ignore);
+        return bvhkit::any_collision(scene_, other.scene_, skip);
+    }
+
+    // ---------------------------------------------------------------- distance
+
+    /// The closest pair: pack() of none or one.
+    nb::tuple closest_pair(const IdPairs& ignore) const {
+        std::vector<SceneDistance<T>> found;
+        {
+            const std::vector<InstancePair> skip = pairs_of(ignore);
+            nb::gil_scoped_release release;
+            const std::shared_lock<std::shared_mutex> lock(mutex_);
+            check_pairs(ignore);
+            if (const SceneDistance<T> d = bvhkit::closest_pair(scene_, skip)) found.push_back(d);
+        }
+        return pack(found);
+    }
+    nb::tuple pairs_within(T threshold, const IdPairs& ignore) const {
+        std::vector<SceneDistance<T>> found;
+        {
+            const std::vector<InstancePair> skip = pairs_of(ignore);
+            nb::gil_scoped_release release;
+            const std::shared_lock<std::shared_mutex> lock(mutex_);
+            check_pairs(ignore);
+            bvhkit::pairs_within(scene_, threshold, found, skip);
+        }
+        return pack(found);
+    }
+    /// The instance nearest geometry `geometry` at the one pose given: pack() of none or one,
+    /// its a -1.
+    nb::tuple closest_instance(std::int64_t geometry, const Mats<T>& rotation,
+                               const Rows<T, 3>& translation, std::uint32_t group,
+                               std::uint32_t mask, T margin) const {
+        expect_rows(rotation, 1, "rotation");
+        expect_rows(translation, 1, "translation");
+        const Pose pose = pose_at(rotation, translation, 0);
+        InstanceOptions<T> options;
+        options.group = group;
+        options.mask = mask;
+        options.margin = margin;
+        std::vector<SceneDistance<T>> found;
+        {
+            nb::gil_scoped_release release;
+            const std::shared_lock<std::shared_mutex> lock(mutex_);
+            if (geometry < 0 || std::size_t(geometry) >= scene_.geometry_count())
+                throw Error("geometry: " + std::to_string(geometry) +
+                            " is not one of the scene's " +
+                            std::to_string(scene_.geometry_count()) + " meshes");
+            if (const SceneDistance<T> d = bvhkit::closest_instance(
+                    scene_, GeometryId(std::uint32_t(geometry)), pose, options))
+                found.push_back(d);
+        }
+        return pack(found);
+    }
+
+    // ---------------------------------------------------------------- saving and loading
+
+    /// The scene in the library's file format (scene/scene_file.hpp, kind 7).
+    nb::bytes to_bytes() const {
+        std::vector<std::uint8_t> out;
+        {
+            nb::gil_scoped_release release;
+            const std::shared_lock<std::shared_mutex> lock(mutex_);
+            out = bvhkit::to_bytes(scene_);
+        }
+        return nb::bytes(reinterpret_cast<const char*>(out.data()), out.size());
+    }
+    /// Replaces the scene with the one `data` holds (everything checked first: an Error leaves
+    /// the scene as it was).
+    void load_bytes(nb::bytes data) {
+        const auto* p = reinterpret_cast<const std::uint8_t*>(data.c_str());
+        const std::size_t n = data.size();
+        nb::gil_scoped_release release;  // bytes are immutable: no one changes them meanwhile
+        bvhkit::Scene<T> loaded = scene_from_bytes<T>(std::span<const std::uint8_t>(p, n));
+        const std::unique_lock<std::shared_mutex> lock(mutex_);
+        scene_ = std::move(loaded);
+    }
+
   private:
     /// Throws naming the first id of `ids` that names no live instance (the caller holds a lock).
     void check_ids(const Ids& ids, const char* name) const {
@@ -489,6 +592,46 @@ class InstancedScene {
                             "] = " + std::to_string(pairs.data()[i]) +
                             " names no live instance of this scene (removed, stale or never "
                             "added)");
+    }
+    /// Both scenes' shared locks (one when they are the same object: a shared_mutex is not to be
+    /// locked twice by one thread), taken in address order so that two calls with the scenes in
+    /// either order cannot wait for each other behind a writer.
+    struct Both {
+        std::shared_lock<std::shared_mutex> first, second;
+        Both(const InstancedScene& x, const InstancedScene& y) {
+            const InstancedScene* lo = &x < &y ? &x : &y;
+            const InstancedScene* hi = &x < &y ? &y : &x;
+            first = std::shared_lock<std::shared_mutex>(lo->mutex_);
+            if (hi != lo) second = std::shared_lock<std::shared_mutex>(hi->mutex_);
+        }
+    };
+    void check_cross_pairs(const InstancedScene& other, const IdPairs& pairs) const {
+        for (std::size_t i = 0; i < 2 * pairs.shape(0); ++i) {
+            const bool mine = i % 2 == 0;
+            if (!(mine ? scene_ : other.scene_).contains(id_of(pairs.data()[i])))
+                throw Error(
+                    "ignore[" + std::to_string(i / 2) + ", " + std::to_string(i % 2) +
+                    "] = " + std::to_string(pairs.data()[i]) + " names no live instance of " +
+                    (mine ? "this scene" : "the other scene") + " (removed, stale or never added)");
+        }
+    }
+    /// (distance (p,), ids (p, 2), point_a (p, 3), point_b (p, 3), faces (p, 2)); a null id -1.
+    static nb::tuple pack(const std::vector<SceneDistance<T>>& v) {
+        const std::size_t n = v.size();
+        std::vector<T> d(n), pa(3 * n), pb(3 * n);
+        std::vector<std::int64_t> ids(2 * n), faces(2 * n);
+        for (std::size_t i = 0; i < n; ++i) {
+            d[i] = v[i].distance;
+            ids[2 * i] = v[i].a.is_null() ? -1 : bits_of(v[i].a);
+            ids[2 * i + 1] = bits_of(v[i].b);
+            faces[2 * i] = std::int64_t(v[i].face_a);
+            faces[2 * i + 1] = std::int64_t(v[i].face_b);
+            for (std::size_t a = 0; a < 3; ++a)
+                pa[3 * i + a] = v[i].point_a[a], pb[3 * i + a] = v[i].point_b[a];
+        }
+        return nb::make_tuple(owned_array(std::move(d), n, 0), owned_array(std::move(ids), n, 2),
+                              owned_array(std::move(pa), n, 3), owned_array(std::move(pb), n, 3),
+                              owned_array(std::move(faces), n, 2));
     }
     /// The hit's world normal at unit length, computed in double (zeros for a miss, and where the
     /// triangle's normal underflowed).
@@ -545,7 +688,15 @@ void bind_instanced_type(nb::module_& m, const char* name) {
         .def("any_collision", &S::any_collision, nb::arg("ignore"))
         .def("colliding_instances", &S::colliding_instances, nb::arg("geometry"),
              nb::arg("rotation"), nb::arg("translation"), nb::arg("group"), nb::arg("mask"),
-             nb::arg("margin"), nb::arg("stop_at_first"));
+             nb::arg("margin"), nb::arg("stop_at_first"))
+        .def("colliding_pairs_with", &S::colliding_pairs_with, nb::arg("other"), nb::arg("ignore"))
+        .def("any_collision_with", &S::any_collision_with, nb::arg("other"), nb::arg("ignore"))
+        .def("to_bytes", &S::to_bytes)
+        .def("load_bytes", &S::load_bytes, nb::arg("data"))
+        .def("closest_pair", &S::closest_pair, nb::arg("ignore"))
+        .def("pairs_within", &S::pairs_within, nb::arg("threshold"), nb::arg("ignore"))
+        .def("closest_instance", &S::closest_instance, nb::arg("geometry"), nb::arg("rotation"),
+             nb::arg("translation"), nb::arg("group"), nb::arg("mask"), nb::arg("margin"));
 }
 
 }  // namespace

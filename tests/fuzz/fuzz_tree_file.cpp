@@ -1,6 +1,6 @@
 // libFuzzer target: the TriangleBvh (copied and in place), ClosestPointMesh, SignedDistanceMesh,
-// WindingNumberMesh, DynamicTree and CollisionModel loaders on arbitrary bytes, as they come and
-// again with the checksum recomputed (random bytes almost never carry a valid checksum, and the
+// WindingNumberMesh, DynamicTree, CollisionModel and Scene loaders on arbitrary bytes, as they come
+// and again with the checksum recomputed (random bytes almost never carry a valid checksum, and the
 // checks behind it are the ones worth fuzzing). A load may throw bvhkit::Error; a structure it
 // accepts, with or without validate(), must answer queries with indices in range (ASan and UBSan
 // watch the walks).
@@ -21,6 +21,11 @@
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 #include "bvhkit/query/self_collision.hpp"
+#include "bvhkit/scene/closest_point.hpp"
+#include "bvhkit/scene/collision.hpp"
+#include "bvhkit/scene/distance.hpp"
+#include "bvhkit/scene/rays.hpp"
+#include "bvhkit/scene/scene_file.hpp"
 
 namespace {
 
@@ -116,6 +121,30 @@ void load_winding_number_mesh_and_query(std::span<const std::uint8_t> bytes) {
         } catch (const bvhkit::Error&) {
         }
     }
+}
+
+/// A Scene the loader accepts answers every query family with live ids, and validates.
+template <class T>
+void load_scene_and_query(std::span<const std::uint8_t> bytes) {
+    std::optional<bvhkit::Scene<T>> scene;
+    try {
+        scene.emplace(bvhkit::scene_from_bytes<T>(bytes));
+    } catch (const bvhkit::Error&) {
+        return;
+    }
+    const bvhkit::Scene<T>& s = *scene;
+    s.validate();
+    const bvhkit::Ray<T, 3> ray({T(-2), T(0.1), T(0.2)}, {T(1), T(0), T(0)});
+    const auto hit = bvhkit::closest_hit(s, ray);
+    if (hit && !s.contains(hit.instance)) std::abort();
+    const auto near = bvhkit::closest_point(s, bvhkit::Vec<T, 3>(T(0.3), T(0.2), T(0.1)));
+    if (near && !s.contains(near.instance)) std::abort();
+    std::vector<bvhkit::InstancePair> pairs;
+    bvhkit::colliding_pairs(s, pairs);
+    for (const auto& p : pairs)
+        if (!s.contains(p.a) || !s.contains(p.b)) std::abort();
+    const auto d = bvhkit::closest_pair(s);
+    if (d && (!s.contains(d.a) || !s.contains(d.b))) std::abort();
 }
 
 /// A DynamicTree the loader accepts must keep working: queries, moves, a pair step, validate().
@@ -239,6 +268,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (flat && !as_double) load_dynamic_tree_and_use<float, 2>(resealed);
         if (!flat && as_double) load_dynamic_tree_and_use<double, 3>(resealed);
         if (!flat && !as_double) load_dynamic_tree_and_use<float, 3>(resealed);
+    } else if (size > 17 && data[12] == 7) {
+        load_scene_and_query<float>(raw);
+        if (as_double)
+            load_scene_and_query<double>(resealed);
+        else
+            load_scene_and_query<float>(resealed);
     } else if (size > 17 && data[12] == 6) {
         load_collision_model_and_query<bvhkit::Obb<float>>(raw);
         if (as_double)

@@ -14,6 +14,7 @@
 #include "bvhkit/io/signed_distance_mesh_file.hpp"
 #include "bvhkit/io/triangle_bvh_file.hpp"
 #include "bvhkit/io/winding_number_mesh_file.hpp"
+#include "bvhkit/scene/scene_file.hpp"
 
 namespace {
 
@@ -95,6 +96,30 @@ int main(int argc, char** argv) {
         solid.create(bvhkit::Aabb<double, 3>({0, double(i), 0}, {1, double(i) + 1.5, 1}));
     solid.enlarge(bvhkit::ProxyId(2, 0), bvhkit::Aabb<double, 3>({5, 5, 5}, {6, 6, 6}));
     bvhkit::save(solid, dir / "dynamic_3d_double.bvh");
+    // Scenes: two meshes, instances with margins and filters, one removed (a later generation).
+    for (const bool wide : {false, true}) {
+        const auto build = [&](auto scalar) {
+            using T = decltype(scalar);
+            bvhkit::Scene<T> scene;
+            const bvhkit::GeometryId g = scene.add_mesh(octahedron);
+            bvhkit::Transform<T> pose;
+            std::vector<bvhkit::InstanceId> ids;
+            for (int i = 0; i < 5; ++i) {
+                pose.translation = bvhkit::Vec<T, 3>(T(1.5 * i), T(0), T(0));
+                bvhkit::InstanceOptions<T> o;
+                o.margin = T(0.1 * (i % 2));
+                o.group = 1u << (i % 2);
+                ids.push_back(scene.add_instance(g, pose, o));
+            }
+            scene.remove(ids[2]);
+            (void)scene.add_instance(g, pose);
+            bvhkit::save(scene, dir / (wide ? "scene_double.bvh" : "scene_float.bvh"));
+        };
+        if (wide)
+            build(0.0);
+        else
+            build(0.0f);
+    }
     // Collision models: every volume type over the octahedron, one over a grid with skipped
     // triangles, one in double.
     bvhkit::save(bvhkit::CollisionModel<bvhkit::Aabb<float, 3>>(octahedron),

@@ -46,7 +46,8 @@ enum class FileKind : std::uint32_t {
     SignedDistanceMesh = 3,
     WindingNumberMesh = 4,
     DynamicTree = 5,
-    CollisionModel = 6
+    CollisionModel = 6,
+    Scene = 7
 };
 enum class ScalarCode : std::uint8_t { Float32 = 1, Float64 = 2 };
 enum class VolumeCode : std::uint8_t {

@@ -1,6 +1,7 @@
 #pragma once
 // Collision within a Scene (scene.hpp): the pairs of instances that collide, whether any pair
-// does, and the instances that collide with one more posed mesh.
+// does, the instances that collide with one more posed mesh, and the pairs of two scenes that
+// collide (an instance of one against an instance of the other).
 //
 // Two instances collide when the group/mask filter lets them (may_collide, instance.hpp), the pair
 // is not in the caller's ignore list, and their meshes come within margin_a + margin_b of each
@@ -172,6 +173,65 @@ bool collides_with(const Scene<T>& scene, GeometryId geometry, const Transform<T
     thread_local std::vector<InstanceId> found;
     colliding_instances(scene, geometry, pose, options, found, true);
     return !found.empty();
+}
+
+/// Every pair (a of `first`, b of `second`) that collides, by the rule above (the group/mask
+/// filter, the margins, the exact test), sorted by a's slot then b's: `out` is cleared, then
+/// filled. The two scenes share no ids: a pair's a is an id of `first`, its b one of `second`
+/// (InstancePair's a.index() < b.index() does not hold here). Pairs in `ignore`, given in the same
+/// (first, second) order, are left out. The candidates come from one walk over both top-level
+/// trees at once (DynamicTree::query_tree: boxes grown by each instance's margin overlap iff the
+/// world boxes come within the margins' sum on every axis). Passing one scene as both compares
+/// every instance with every instance, itself included.
+template <class T>
+void colliding_pairs(const Scene<T>& first, const Scene<T>& second, std::vector<InstancePair>& out,
+                     std::span<const InstancePair> ignore = {}) {
+    out.clear();
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> skip;
+    for (const InstancePair& p : ignore) skip.emplace_back(p.a.bits(), p.b.bits());
+    std::sort(skip.begin(), skip.end());
+    first.top_level().query_tree(second.top_level(), [&](ProxyId pa, ProxyId pb) {
+        out.push_back({InstanceId(pa), InstanceId(pb)});
+        return true;
+    });
+    std::sort(out.begin(), out.end());
+    std::size_t kept = 0;
+    for (const InstancePair& p : out) {
+        const SceneInstance<T>& ra = first.instance_at(p.a.proxy());
+        const SceneInstance<T>& rb = second.instance_at(p.b.proxy());
+        const T margin = ra.options.margin + rb.options.margin;
+        if (!may_collide(ra.options, rb.options) ||
+            std::binary_search(skip.begin(), skip.end(), std::pair(p.a.bits(), p.b.bits())) ||
+            !scene_detail::boxes_within(ra.box, rb.box, margin) ||
+            !scene_detail::meshes_collide(first.geometry_at(ra.geometry), ra.pose,
+                                          second.geometry_at(rb.geometry), rb.pose, margin))
+            continue;
+        out[kept++] = p;
+    }
+    out.resize(kept);
+}
+
+/// Whether any pair (a of `first`, b of `second`) collides: stops at the first found, in the
+/// walk's order. `ignore` as for colliding_pairs(first, second, ...).
+template <class T>
+bool any_collision(const Scene<T>& first, const Scene<T>& second,
+                   std::span<const InstancePair> ignore = {}) {
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> skip;
+    for (const InstancePair& p : ignore) skip.emplace_back(p.a.bits(), p.b.bits());
+    std::sort(skip.begin(), skip.end());
+    bool found = false;
+    first.top_level().query_tree(second.top_level(), [&](ProxyId pa, ProxyId pb) {
+        const SceneInstance<T>& ra = first.instance_at(pa);
+        const SceneInstance<T>& rb = second.instance_at(pb);
+        const T margin = ra.options.margin + rb.options.margin;
+        found = may_collide(ra.options, rb.options) &&
+                !std::binary_search(skip.begin(), skip.end(), std::pair(pa.bits(), pb.bits())) &&
+                scene_detail::boxes_within(ra.box, rb.box, margin) &&
+                scene_detail::meshes_collide(first.geometry_at(ra.geometry), ra.pose,
+                                             second.geometry_at(rb.geometry), rb.pose, margin);
+        return !found;
+    });
+    return found;
 }
 
 }  // namespace bvhkit

@@ -73,7 +73,9 @@ struct InstanceOptions {
     T margin = 0;
 };
 
-/// Two instances, a.index() < b.index(); ordered by a, then b (InstanceId's order: by slot).
+/// Two instances, a.index() < b.index(); ordered by a, then b (InstanceId's order: by slot). For
+/// the pairs between two scenes (collision.hpp), a is of the first scene and b of the second, and
+/// their slots may be in either order.
 struct InstancePair {
     InstanceId a, b;
     friend constexpr bool operator==(const InstancePair&, const InstancePair&) = default;

@@ -33,6 +33,10 @@
 
 namespace bvhkit {
 
+namespace serial_detail {
+struct SceneAccess;  // scene/scene_file.hpp
+}
+
 template <class T>
 struct SceneOptions {
     /// The top-level tree's fat boxes: each instance's box grown by a tenth of its largest extent,
@@ -229,6 +233,7 @@ class Scene {
     }
 
   private:
+    friend struct serial_detail::SceneAccess;
     struct Move {
         Pose pose;
         Box box, top;
