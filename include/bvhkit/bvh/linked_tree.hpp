@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/linked_rebuild.hpp"
 #include "bvhkit/bvh/linked_tree_sah.hpp"
 #include "bvhkit/error.hpp"
 
@@ -194,9 +195,48 @@ class LinkedTree {
     }
 
     /// Rebuilds the internal nodes above a set of kept subtrees: the leaves when `full`, otherwise
-    /// every subtree that enlarge() did not touch, kept as it is. `build(std::span<const Box>)`
-    /// returns a Bvh over those subtrees' boxes (any builder: DynamicTree passes the top-down
-    /// core's binned SAH); its leaves may hold several, which are then paired up in halves.
+    /// every subtree that enlarge() did not touch, kept as it is. The new nodes come from
+    /// linked::build_binned (binned SAH, in place), made directly in the pool.
+    void rebuild(bool full) {
+        if (root_ == null) return;
+        std::vector<linked::RebuildItem<T, N>>& items = rebuild_items_;
+        std::vector<std::int32_t>& spare = rebuild_kept_;
+        items.clear();
+        spare.clear();
+        // Walked down from the root, the kept subtrees come in the old tree's order, which is
+        // spatial: the builder's partitions then find most of them on their side already (a scan
+        // of the pool in index order would hand them over shuffled, and cost more than it saves).
+        collect_kept(
+            full,
+            [&items](std::int32_t i, const Box& box) {
+                items.push_back({box, i});
+            },
+            [&spare](std::int32_t i) { spare.push_back(i); });
+        // The old internal nodes are exactly as many as the new ones: each new one takes the next
+        // of them, which spares the pool's free list (a chain of dependent loads) both ways.
+        std::size_t next = 0;
+        Node* nodes = nodes_.data();
+        root_ = linked::build_binned(
+            std::span(items), rebuild_bins_,
+            [nodes, &spare, &next](std::int32_t a, std::int32_t b, const Box& box,
+                                   std::int32_t height) {
+                const std::int32_t p = spare[next++];
+                Node& n = nodes[p];
+                n.box = box;
+                n.parent = null;
+                n.child1 = a;
+                n.child2 = b;
+                n.height = height;
+                n.enlarged = 0;
+                nodes[a].parent = nodes[b].parent = p;
+                return p;
+            },
+            [nodes](std::int32_t i) { return std::int32_t(nodes[i].height); });
+    }
+
+    /// As rebuild(full), with the internal nodes laid out as `build(std::span<const Box>)` says:
+    /// it returns a Bvh over the kept subtrees' boxes (any builder); its leaves may hold several,
+    /// which are then paired up in halves.
     template <class BuildFn>
     void rebuild(bool full, BuildFn&& build) {
         if (root_ == null) return;
@@ -204,25 +244,14 @@ class LinkedTree {
         std::vector<Box>& boxes = rebuild_boxes_;
         kept.clear();
         boxes.clear();
-        std::vector<std::int32_t>& stack = rebuild_stack_;
-        stack.assign(1, root_);
-        while (!stack.empty()) {
-            const std::int32_t i = stack.back();
-            stack.pop_back();
-            Node& n = nodes_[std::size_t(i)];
-            if (n.is_leaf() || (!full && !n.enlarged)) {
-                n.enlarged = 0;
-                n.parent = null;
+        collect_kept(
+            full,
+            [&](std::int32_t i, const Box& box) {
                 kept.push_back(i);
-                boxes.push_back(n.box);
-            } else {
-                stack.push_back(n.child1);
-                stack.push_back(n.child2);
-                free_node(i);
-            }
-        }
+                boxes.push_back(box);
+            },
+            [this](std::int32_t i) { free_node(i); });
         const Bvh<Box> layout = build(std::span<const Box>(boxes));
-        // The freed internal nodes are exactly as many as the new ones: the pool does not grow.
         root_ = link_layout(layout, kept);
     }
 
@@ -280,6 +309,8 @@ class LinkedTree {
         release(rebuild_boxes_);
         release(rebuild_stack_);
         release(rebuild_order_);
+        release(rebuild_items_);
+        release(rebuild_bins_);
     }
 
     // ---------------------------------------------------------------- checks and measures
@@ -305,7 +336,8 @@ class LinkedTree {
                float_heap_.capacity() * sizeof(float_heap_[0]) +
                (rebuild_kept_.capacity() + rebuild_stack_.capacity() + rebuild_order_.capacity()) *
                    sizeof(std::int32_t) +
-               rebuild_boxes_.capacity() * sizeof(Box);
+               rebuild_boxes_.capacity() * sizeof(Box) +
+               rebuild_items_.capacity() * sizeof(rebuild_items_[0]) + rebuild_bins_.capacity();
     }
 
   private:
@@ -390,6 +422,32 @@ class LinkedTree {
         }
     }
 
+    /// Hands keep(node, box) every subtree a rebuild keeps, detached (no parent, enlarged mark
+    /// cleared), and drop(node) every internal node above them, which it replaces.
+    template <class Keep, class Drop>
+    void collect_kept(bool full, Keep&& keep, Drop&& drop) {
+        std::vector<std::int32_t>& stack = rebuild_stack_;
+        stack.assign(1, root_);
+        while (!stack.empty()) {
+            const std::int32_t i = stack.back();
+            stack.pop_back();
+            Node& n = nodes_[std::size_t(i)];
+            if (n.is_leaf() || (!full && !n.enlarged)) {
+                n.enlarged = 0;
+                n.parent = null;
+                keep(i, n.box);
+            } else {
+                // The children are fetched together: the second is on its way while the first
+                // (often a leaf, anywhere in the pool) is read.
+                __builtin_prefetch(&nodes_[std::size_t(n.child1)]);
+                __builtin_prefetch(&nodes_[std::size_t(n.child2)]);
+                stack.push_back(n.child2);
+                stack.push_back(n.child1);
+                drop(i);
+            }
+        }
+    }
+
     /// Links a Bvh over the kept subtrees (kept[k] is the subtree of box k) with fresh internal
     /// nodes; returns its root. A Bvh leaf over several subtrees is paired up by halving.
     std::int32_t link_layout(const Bvh<Box>& layout, std::span<const std::int32_t> kept);
@@ -418,6 +476,8 @@ class LinkedTree {
     std::vector<std::int32_t> rebuild_kept_, rebuild_stack_;
     std::vector<std::uint32_t> rebuild_order_;
     std::vector<Box> rebuild_boxes_;
+    std::vector<linked::RebuildItem<T, N>> rebuild_items_;
+    std::vector<std::uint8_t> rebuild_bins_;
 };
 
 template <class T, std::size_t N>

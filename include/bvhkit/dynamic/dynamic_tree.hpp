@@ -363,7 +363,6 @@ class DynamicTree {
         return tree_.memory_bytes() + proxies_.capacity() * sizeof(Proxy) +
                move_buffer_.capacity() * sizeof(std::int32_t) +
                pair_scratch_.capacity() * sizeof(ProxyPair) +
-               rebuild_centroids_.capacity() * sizeof(VecT) +
                optimize_scratch_.capacity() * sizeof(optimize_scratch_[0]) +
                (pairs_.capacity() + pending_ends_.capacity() + pair_next_.capacity() +
                 pair_ends_.capacity() + pair_begins_.capacity()) *
@@ -470,7 +469,6 @@ class DynamicTree {
     void release_scratch() {
         tree_.release_scratch();
         release(pair_scratch_);
-        release(rebuild_centroids_);
         release(optimize_scratch_);
         release(pair_next_);
         release(pair_ends_);
@@ -535,7 +533,6 @@ class DynamicTree {
     std::size_t proxy_count_ = 0;
     // Scratch storage kept between calls so that steady use allocates nothing.
     std::vector<ProxyPair> pair_scratch_;
-    std::vector<VecT> rebuild_centroids_;
     std::vector<std::pair<double, std::int32_t>> optimize_scratch_;
     // update_pairs(): the persistent pair set, whether it is current (find_pairs() makes it
     // stale), ends owed for ids shrink_to_fit() dropped, and scratch.

@@ -17,17 +17,7 @@ namespace bvhkit {
 template <class T, std::size_t N, class UserData>
 void DynamicTree<T, N, UserData>::rebuild(bool full) {
     check_not_walking("DynamicTree::rebuild");
-    tree_.rebuild(full, [this](std::span<const Box> boxes) {
-        // The library's top-down core with binned SAH, one subtree per leaf.
-        auto& centroids = rebuild_centroids_;
-        centroids.resize(boxes.size());
-        for (std::size_t k = 0; k < boxes.size(); ++k) centroids[k] = safe_centroid(boxes[k]);
-        BuildOptions o;
-        o.builder = Builder::BinnedSah;
-        o.max_leaf_size = 1;
-        o.threads = 1;
-        return build_bvh(boxes, std::span<const VecT>(centroids), o);
-    });
+    tree_.rebuild(full);
 }
 
 template <class T, std::size_t N, class UserData>
