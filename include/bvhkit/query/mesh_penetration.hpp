@@ -16,8 +16,8 @@
 //   the solids; the answer is exact up to EPA's tolerance (quality Exact).
 // - otherwise: a local optimisation over directions in the spirit of PolyDepth (Je, Tang, Lee,
 //   Kim 2012, "PolyDepth: Real-time penetration depth computation using iterative contact-space
-//   projection"): seeds (26 lattice directions, the hulls' EPA normal, the centres' direction,
-//   the contact faces' normals), then from the best, projection steps along the contact-space
+//   projection"): seeds (the hulls' EPA normal, then the 26 directions of a cube's faces, edges
+//   and corners), then from the best, projection steps along the contact-space
 //   normal at the touching configuration (the closest pair's direction just past contact: the
 //   optimum translation is parallel to it), then a pattern search over directions with a
 //   halving angle. The result is a proven upper bound on the depth (it separates) and a local
@@ -263,8 +263,7 @@ class DepthSearch {
     T best_t_ = 0;
 };
 
-/// A seed direction when the solids overlap: the hulls' EPA normal, else the centres' direction,
-/// else +z.
+/// The first seed direction: the hulls' EPA normal (+z when EPA gives none).
 template <BoundingVolume V>
 Vec<typename V::Scalar, 3> seed_direction(const SolidModel<V>& a, const SolidModel<V>& b,
                                           const Transform<typename V::Scalar>& pose,
