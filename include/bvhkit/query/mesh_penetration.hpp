@@ -16,8 +16,9 @@
 //   the solids; the answer is exact up to EPA's tolerance (quality Exact).
 // - otherwise: a local optimisation over directions in the spirit of PolyDepth (Je, Tang, Lee,
 //   Kim 2012, "PolyDepth: Real-time penetration depth computation using iterative contact-space
-//   projection"): seeds (the hulls' EPA normal, then the 26 directions of a cube's faces, edges
-//   and corners), then from the best, projection steps along the contact-space
+//   projection"): seeds (the hulls' EPA normal, the 26 directions of a cube's faces, edges and
+//   corners, 64 more spread on the sphere), then from the best, projection steps along the
+//   contact-space
 //   normal at the touching configuration (the closest pair's direction just past contact: the
 //   optimum translation is parallel to it), then a pattern search over directions with a
 //   halving angle. The result is a proven upper bound on the depth (it separates) and a local
@@ -180,6 +181,13 @@ class DepthSearch {
             for (int y = -1; y <= 1; ++y)
                 for (int z = -1; z <= 1; ++z)
                     if (x || y || z) improve(Vec3{T(x), T(y), T(z)}, 1e-6);
+        // A Fibonacci lattice on the sphere fills the lattice's gaps: each costs one test unless
+        // it is better.
+        for (int k = 0; k < fibonacci_seeds; ++k) {
+            const double z = 1 - (2 * k + 1) / double(fibonacci_seeds);
+            const double rho = std::sqrt(1 - z * z), phi = k * 2.399963229728653;
+            improve(Vec3{T(rho * std::cos(phi)), T(rho * std::sin(phi)), T(z)}, 1e-6);
+        }
         // Projection steps: toward the contact-space normal.
         for (int k = 0; k < 16 && !out_of_budget(); ++k) {
             Vec3 n;
@@ -243,9 +251,12 @@ class DepthSearch {
     }
 
     const Vec3& direction() const { return best_d_; }
+    T depth() const { return best_t_; }
     T scale() const { return a_.collision().scale() + b_.collision().scale(); }
 
   private:
+    static constexpr int fibonacci_seeds = 64;
+
     static Vec3 any_perpendicular(const Vec3& d) {
         const T ax = std::abs(d[0]), ay = std::abs(d[1]), az = std::abs(d[2]);
         if (ax <= ay && ax <= az) return cross(d, Vec3{T(1), T(0), T(0)});
