@@ -344,6 +344,20 @@ TEST(MeshPenetration, ContinuityThroughContact) {
         const auto r = signed_distance_between(l, cube, shift({xmin, 0.8, 0.25}));
         EXPECT_NEAR(-r.signed_distance, std::min(0.2, 3 - xmin), 1e-4) << xmin;
     }
+    // The same slide with the last normal as the hint: the normal stays +y until the way out
+    // through +x is shorter, then stays +x (one switch, where the geometry forces it).
+    MeshPenetrationOptions o;
+    int switches = 0;
+    V3 last_normal(0.0);
+    for (int k = 0; k <= 44; ++k) {
+        const double xmin = 1.8 + k * 0.025;
+        const auto r = signed_distance_between(l, cube, shift({xmin, 0.8, 0.25}), o);
+        EXPECT_NEAR(-r.signed_distance, std::min(0.2, 3 - xmin), 1e-4) << xmin;
+        if (k > 0 && dot(r.normal, last_normal) < 0.99) ++switches;
+        last_normal = r.normal;
+        o.hint = {r.normal[0], r.normal[1], r.normal[2]};
+    }
+    EXPECT_EQ(switches, 1);
 }
 
 template <class M>

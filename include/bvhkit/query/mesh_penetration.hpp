@@ -69,6 +69,9 @@ struct MeshPenetrationOptions {
     double smallest_angle = 1e-4;        // radians: the pattern search's last step
     double search_precision = 1e-6;      // relative bracket of the bisections while searching
     double final_precision = 1.0 / 8e6;  // relative bracket of the answer's bisection
+    /// A direction to try first besides the seeds (A's frame; zero: none), such as the last
+    /// query's normal in a loop over moving solids, so that the answer follows its optimum.
+    std::array<double, 3> hint{0, 0, 0};
 };
 
 namespace penetration_detail {
@@ -177,6 +180,8 @@ class DepthSearch {
     void search(const Vec3& seed_hint) {
         // Seeds.
         start(seed_hint);
+        const Vec3 hint{T(options_.hint[0]), T(options_.hint[1]), T(options_.hint[2])};
+        if (length_squared(hint) > T(0)) improve(hint, 1e-6);
         for (int x = -1; x <= 1; ++x)
             for (int y = -1; y <= 1; ++y)
                 for (int z = -1; z <= 1; ++z)
