@@ -1,8 +1,8 @@
 #pragma once
 // Everything in one include: the static trees and their builders, rays, proximity (closest point,
-// k nearest, radius, signed distance, winding number), collision and distance between meshes, the
-// convex shapes' distance and penetration, the dynamic tree, the BSP tree, the mesh readers and
-// generators. The finer headers stay for those who want less.
+// k nearest, radius, signed distance, winding number), collision, distance and penetration depth
+// between meshes, the convex shapes' distance and penetration, the dynamic tree, the BSP tree, the
+// mesh readers and generators. The finer headers stay for those who want less.
 #include "bvhkit/bsp/bsp.hpp"
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/refit.hpp"
@@ -29,6 +29,7 @@
 #include "bvhkit/query/closest_point_mesh.hpp"
 #include "bvhkit/query/crossings.hpp"
 #include "bvhkit/query/distance.hpp"
+#include "bvhkit/query/mesh_penetration.hpp"
 #include "bvhkit/query/overlap.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 #include "bvhkit/query/ray.hpp"

@@ -5,6 +5,8 @@
   winding numbers and inside/outside on one triangle mesh.
 - :class:`CollisionModel` with :func:`collide`, :func:`distance` and :func:`self_intersections`:
   mesh against mesh over batches of rigid poses.
+- :class:`Solid` with :func:`signed_distance_between`: the distance, or the penetration depth,
+  between two closed meshes over batches of rigid poses.
 - :class:`Sphere`, :class:`Box`, :class:`Capsule`, :class:`Cylinder`, :class:`Cone` and
   :class:`ConvexHull` with :func:`convex_distance` (GJK) and :func:`convex_signed_distance` (EPA).
 - :class:`DynamicTree2D` and :class:`DynamicTree3D`: a dynamic AABB tree for moving boxes.
@@ -41,6 +43,9 @@ __all__ = [
     "distance",
     "Distances",
     "self_intersections",
+    "Solid",
+    "signed_distance_between",
+    "MeshSignedDistances",
     "ConvexShape",
     "Sphere",
     "Box",
@@ -458,6 +463,7 @@ from ._convex import (  # noqa: E402
     convex_signed_distance,
 )
 from ._dynamic import DynamicTree2D, DynamicTree3D  # noqa: E402
+from ._solid import MeshSignedDistances, Solid, signed_distance_between  # noqa: E402
 from ._instances import (  # noqa: E402
     Scene,
     SceneClosest,

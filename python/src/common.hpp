@@ -146,5 +146,6 @@ void bind_collision32(nb::module_& m);
 void bind_collision64(nb::module_& m);
 void bind_dynamic(nb::module_& m);
 void bind_instanced_scene(nb::module_& m);
+void bind_solid(nb::module_& m);
 
 }  // namespace bvhkit::python

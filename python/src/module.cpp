@@ -86,4 +86,5 @@ NB_MODULE(_bvhkit, m) {
     bind_collision64(m);
     bind_dynamic(m);
     bind_instanced_scene(m);
+    bind_solid(m);  // closed meshes as solids: penetration depth (solid.cpp)
 }
