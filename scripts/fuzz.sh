@@ -39,7 +39,7 @@ if ! fuzzer_runtime_works; then
     fi
 fi
 
-CXX=clang++ cmake -S "$repo" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+CXX=clang++ cmake -S "$repo" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DBVHKIT_BUILD_FUZZ=ON -DBVHKIT_BUILD_TESTS=OFF -DBVHKIT_BUILD_TOOLS=OFF -DBVHKIT_BUILD_BENCH=OFF \
     > "$build.configure.log" 2>&1 || { cat "$build.configure.log"; exit 1; }
 cmake --build "$build" --target fuzz_obj fuzz_ply fuzz_stl fuzz_tree_file tree_file_seeds
