@@ -147,8 +147,8 @@ TEST(ContactManifold, BoxIntoBoxTinyAndFar) {
 }
 
 // Two long boxes crossed at right angles, overlapping by delta in z: no vertex of either lies
-// inside the other, so the region has depth 0 (documented); its contacts are the overlap's
-// corners on the intersection curve, with normals that never pull A into B.
+// inside the other; the edges passing through the other box (a's bottom edges, b's top edges)
+// carry the depth, exactly delta along +z, and the curve points mark the crossing's corners.
 TEST(ContactManifold, CrossedBoxesWithNoVertexInside) {
     const double delta = 0.05;
     const Pair p(box_mesh({-2, -0.3, -delta}, {2, 0.3, 1}), box_mesh({-0.3, -2, -1}, {0.3, 2, 0}));
@@ -156,20 +156,31 @@ TEST(ContactManifold, CrossedBoxesWithNoVertexInside) {
     all.max_points_per_region = 0;
     const ContactManifold<double> r = p.run(Transform<double>{}, all);
     ASSERT_TRUE(r.colliding);
-    ASSERT_FALSE(r.points.empty());
+    EXPECT_EQ(r.region_count(), 1u);
+    EXPECT_EQ(r.region_depths[0], delta);
+    EXPECT_EQ(r.region_normals[0], V3(0, 0, 1));
+    int edges = 0;
     for (const auto& c : r.points) {
-        EXPECT_EQ(c.kind, ContactKind::Curve);
-        EXPECT_EQ(c.depth, 0.0);
+        EXPECT_NE(c.kind, ContactKind::VertexOfA);
+        EXPECT_NE(c.kind, ContactKind::VertexOfB);
         EXPECT_GE(c.normal[2], 0.0);
         EXPECT_LE(std::fabs(c.point[0]), 0.3 + 1e-15);
         EXPECT_LE(std::fabs(c.point[1]), 0.3 + 1e-15);
         EXPECT_GE(c.point[2], -delta - 1e-15);
         EXPECT_LE(c.point[2], 1e-15);
+        if (c.kind == ContactKind::Curve) {
+            EXPECT_EQ(c.depth, 0.0);
+        } else {
+            ++edges;
+            EXPECT_NEAR(c.depth, delta, 1e-15);
+            EXPECT_NEAR(c.normal[2], 1, 1e-15);
+        }
     }
-    EXPECT_EQ(r.region_count(), 1u);
+    EXPECT_GE(edges, 4);  // a's two bottom edges, b's two top edges at least
     const ContactManifold<double> four = p.run(Transform<double>{});
     EXPECT_EQ(four.points.size(), 4u);
-    EXPECT_NEAR(footprint_area(four.points), 0.36, 1e-12);  // the 0.6 x 0.6 crossing
+    EXPECT_NEAR(four.points[0].depth, delta, 1e-15);
+    EXPECT_GT(footprint_area(four.points), 0.18);  // over half the 0.6 x 0.6 crossing
 }
 
 // A box resting on another (touching, faces coplanar and facing each other; equal footprints, so

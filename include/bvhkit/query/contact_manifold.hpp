@@ -10,14 +10,17 @@
 //   vertex contacts  each vertex of A strictly inside B (and of B inside A): depth is its distance
 //                    to the other surface, the normal points from the vertex to its closest point
 //                    there (for A's vertices; the opposite for B's).
+//   edge contacts    the middle of each piece of an intersecting face's edge that runs inside the
+//                    other mesh from a crossing of its surface to another crossing or to a vertex
+//                    inside, with depth and normal as a vertex's: where no vertex is inside (two
+//                    crossed bars) these carry the depth.
 // Every normal points from B into A: moving A along it (or B against it) by the depth separates
 // that contact. Vertices inside are found from the intersection curve: the corners of the
 // intersecting faces are tested (pseudonormal sign, query/signed_distance.hpp), and from each one
 // inside the walk goes over the mesh's edges to every vertex it reaches without touching a face
 // that meets the other mesh: such an edge cannot cross the other surface, so those vertices are
 // inside too. A closed component of one mesh wholly inside the other meets no face and gives no
-// contact, and a region where no vertex lies inside the other mesh (edges passing through faces
-// only, as two crossed bars) has depth 0.
+// contact.
 // Regions: the union of the intersecting face pairs' corners (of both meshes) and of the walks'
 // edges; each connected part is one region. Reduction per region (the four-point rule of game
 // engines' contact caches): the deepest point, the point farthest from it, the point making the
@@ -41,6 +44,8 @@ enum class ContactKind : std::uint8_t {
     Curve,      // on the intersection curve of triangle_a and triangle_b
     VertexOfA,  // a vertex of A (of triangle_a) inside B; triangle_b holds its closest point
     VertexOfB,  // a vertex of B (of triangle_b) inside A; triangle_a holds its closest point
+    EdgeOfA,    // the middle of a piece of an edge of A (of triangle_a) inside B
+    EdgeOfB,    // the middle of a piece of an edge of B (of triangle_b) inside A
 };
 
 template <class T>
@@ -61,6 +66,17 @@ struct ContactOptions {
 
 namespace detail {
 
+/// An edge of an intersecting face crossing a face of the other mesh: the edge's end nodes (the
+/// smaller in the high half), the crossing's parameter from the smaller end, the edge's face.
+struct EdgeCrossing {
+    std::uint64_t key;
+    double t;
+    std::uint32_t face;
+    friend bool operator<(const EdgeCrossing& x, const EdgeCrossing& y) {
+        return x.key != y.key ? x.key < y.key : x.t < y.t;
+    }
+};
+
 /// Reused storage of contact_manifold: every array grows to the largest meshes seen and is never
 /// cleared between queries; an entry is valid when its stamp equals the query's epoch.
 template <class T>
@@ -73,7 +89,10 @@ struct ContactWorkspace {
     std::vector<std::uint32_t> seen;    // epoch at which a vertex was reached by a walk
     std::vector<std::uint32_t> region;  // region index of a root (valid with the root's stamp)
     std::vector<std::uint32_t> numbered;  // epoch at which a root got its region index
-    std::vector<std::uint32_t> corner_list, queue, order, counts, region_index;
+    std::vector<std::uint32_t> inside;    // epoch at which a vertex was found inside the other
+    std::vector<EdgeCrossing> crossings;  // where the intersecting faces' edges cross
+    std::vector<std::uint32_t> corners_a, corners_b;  // corners of the intersecting faces
+    std::vector<std::uint32_t> queue, order, counts, region_index;
     std::vector<std::uint8_t> chosen;
     std::vector<double> gap;  // reduction: distance to the nearest point chosen
     NearestScratch<T> scratch;
@@ -86,6 +105,7 @@ struct ContactWorkspace {
             curve.assign(nodes, 0);
             seen.assign(nodes, 0);
             numbered.assign(nodes, 0);
+            inside.assign(nodes, 0);
             region.resize(nodes);
         }
         if (++epoch == 0) {  // wrapped: old stamps could match again
@@ -93,11 +113,14 @@ struct ContactWorkspace {
             std::fill(curve.begin(), curve.end(), 0);
             std::fill(seen.begin(), seen.end(), 0);
             std::fill(numbered.begin(), numbered.end(), 0);
+            std::fill(inside.begin(), inside.end(), 0);
             epoch = 1;
         }
         all.clear();
         node.clear();
-        corner_list.clear();
+        corners_a.clear();
+        corners_b.clear();
+        crossings.clear();
     }
     std::uint32_t find(std::uint32_t x) {
         if (stamp[x] != epoch) {
@@ -148,68 +171,137 @@ inline Vec3d unit_or(const Vec3d& v, const Vec3d& fallback) {
     return l > 0 && std::isfinite(l) ? v / l : fallback;
 }
 
-/// Contacts of one mesh's vertices inside the other: `self` is the mesh whose vertices are
-/// tested, `other` the one they may be inside; `to_other` carries self's frame into other's,
-/// `to_a` other's directions into A's frame. `of_a`: self is A. Node ids of self's vertices are
-/// offset by `base`.
+/// One mesh probed against the other: `self` is the mesh whose points are tested, `other` the
+/// one they may be inside; `to_other` carries self's frame into other's, `self_to_a` self's into
+/// A's, `other_to_a` other's directions into A's. Node ids of self's vertices are offset by
+/// `base`; `tiny` is the distance below which a direction to the closest point is noise.
 template <class T>
-void inside_vertex_contacts(const ContactMesh<T>& self, const ContactMesh<T>& other,
-                            const Transform<double>& to_other, const Transform<double>& self_to_a,
-                            const Mat3<double>& other_to_a, bool of_a, std::uint32_t base,
-                            double tiny, std::size_t first_corner, std::size_t end_corner,
+struct Side {
+    const ContactMesh<T>& self;
+    const ContactMesh<T>& other;
+    Transform<double> to_other, self_to_a;
+    Mat3<double> other_to_a;
+    bool of_a;
+    std::uint32_t base;
+    double tiny;
+};
+
+/// Tests point x of self (in self's frame) against the other mesh and, when it is inside (or
+/// `known_inside`), adds its contact; `own` is self's face it belongs to, `node` its region node.
+template <class T>
+bool probe(const Side<T>& s, const Vec3d& x, bool known_inside, std::uint32_t own,
+           std::uint32_t node, bool vertex, MeshPoint<T>& near, ContactWorkspace<T>& w) {
+    if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2])))
+        return false;  // a vertex of faces the models left out
+    const Vec<T, 3> q(s.to_other.apply(x));
+    const SignedDistance<T> sd = s.other.surface().signed_distance(q, near, w.scratch);
+    if (!sd.closest) return false;
+    near = sd.closest;
+    if (!known_inside && !(sd.distance < T(0))) return false;
+    // From the point to its closest point: the way out of the other mesh. Where the distance is
+    // within rounding of zero its direction is noise, and the face normal stands in.
+    const Vec3d face = s.other.normal(sd.closest.triangle);
+    const double d = double(sd.closest.distance);
+    const Vec3d out =
+        s.other_to_a * (d > s.tiny ? unit_or(Vec3d(sd.closest.point) - Vec3d(q), face) : face);
+    ContactPoint<T> c;
+    c.point = Vec<T, 3>(s.self_to_a.apply(x));
+    c.depth = sd.closest.distance;
+    if (s.of_a) {
+        c.normal = Vec<T, 3>(out);
+        c.kind = vertex ? ContactKind::VertexOfA : ContactKind::EdgeOfA;
+        c.triangle_a = own;
+        c.triangle_b = sd.closest.triangle;
+    } else {
+        c.normal = Vec<T, 3>(-out);
+        c.kind = vertex ? ContactKind::VertexOfB : ContactKind::EdgeOfB;
+        c.triangle_a = sd.closest.triangle;
+        c.triangle_b = own;
+    }
+    w.all.push_back(c);
+    w.node.push_back(node);
+    return true;
+}
+
+/// Contacts of self's vertices inside the other mesh, from the corners of its intersecting faces
+/// (`corners`, in self's own ids): each is tested, and from each one inside a walk reaches the
+/// vertices joined to it by faces that meet nothing of the other mesh.
+template <class T>
+void inside_vertex_contacts(const Side<T>& s, const std::vector<std::uint32_t>& corners,
                             ContactWorkspace<T>& w) {
     MeshPoint<T> near;  // each search starts from the previous closest point
     const auto add = [&](std::uint32_t v, bool known_inside) {
-        const Vec<T, 3>& own_point = self.vertex(v);
-        if (!(std::isfinite(own_point[0]) && std::isfinite(own_point[1]) &&
-              std::isfinite(own_point[2])))
-            return false;  // a vertex of faces the models left out
-        const Vec<T, 3> q(to_other.apply(Vec3d(own_point)));
-        const SignedDistance<T> sd = other.surface().signed_distance(q, near, w.scratch);
-        if (!sd.closest) return false;
-        near = sd.closest;
-        if (!known_inside && !(sd.distance < T(0))) return false;
-        const double d = double(sd.closest.distance);
-        // From the vertex to its closest point: the way out of the other mesh. Where the distance
-        // is within rounding of zero its direction is noise, and the face normal stands in.
-        const Vec3d face = other.normal(sd.closest.triangle);
-        Vec3d out = d > tiny ? unit_or(Vec3d(sd.closest.point) - Vec3d(q), face) : face;
-        out = other_to_a * out;
-        ContactPoint<T> c;
-        c.point = Vec<T, 3>(self_to_a.apply(Vec3d(self.vertex(v))));
-        c.depth = sd.closest.distance;
-        const std::uint32_t own = self.faces_at(v).empty() ? 0 : self.faces_at(v)[0];
-        if (of_a) {
-            c.normal = Vec<T, 3>(out);
-            c.kind = ContactKind::VertexOfA;
-            c.triangle_a = own;
-            c.triangle_b = sd.closest.triangle;
-        } else {
-            c.normal = Vec<T, 3>(-out);
-            c.kind = ContactKind::VertexOfB;
-            c.triangle_a = sd.closest.triangle;
-            c.triangle_b = own;
-        }
-        w.all.push_back(c);
-        w.node.push_back(base + v);
+        const std::span<const std::uint32_t> at = s.self.faces_at(v);
+        if (!probe(s, Vec3d(s.self.vertex(v)), known_inside, at.empty() ? 0 : at[0], s.base + v,
+                   true, near, w))
+            return false;
+        w.inside[s.base + v] = w.epoch;
         return true;
     };
-    for (std::size_t i = first_corner; i < end_corner; ++i) {
-        const std::uint32_t start = w.corner_list[i];
+    for (const std::uint32_t start : corners) {
         if (!add(start, false)) continue;
         w.queue.clear();
         w.queue.push_back(start);
         for (std::size_t head = 0; head < w.queue.size(); ++head) {
             const std::uint32_t x = w.queue[head];
-            for (const std::uint32_t f : self.faces_at(x))
-                for (const std::uint32_t u : self.corners(f)) {
+            for (const std::uint32_t f : s.self.faces_at(x))
+                for (const std::uint32_t u : s.self.corners(f)) {
                     // A corner of a face meeting the other mesh is tested on its own.
-                    if (w.curve[base + u] == w.epoch || w.seen[base + u] == w.epoch) continue;
-                    w.seen[base + u] = w.epoch;
-                    w.unite(base + x, base + u);
+                    const std::uint32_t n = s.base + u;
+                    if (w.curve[n] == w.epoch || w.seen[n] == w.epoch) continue;
+                    w.seen[n] = w.epoch;
+                    w.unite(s.base + x, n);
                     if (add(u, true)) w.queue.push_back(u);
                 }
         }
+    }
+}
+
+/// Records where the edges of triangle p (welded ids `ids`, region nodes offset by `base`, face
+/// `face`) cross triangle q of unit normal nq (right-handed on q's corners), all in A's frame.
+/// Each edge is taken from its smaller id, so the two faces sharing it give the same parameter.
+template <class T>
+void record_crossings(const Vec3d* p, const std::array<std::uint32_t, 3>& ids, std::uint32_t base,
+                      std::uint32_t face, const Vec3d* q, const Vec3d& nq, ContactWorkspace<T>& w) {
+    for (int k = 0; k < 3; ++k) {
+        const int i = ids[k] < ids[(k + 1) % 3] ? k : (k + 1) % 3;
+        const int j = i == k ? (k + 1) % 3 : k;
+        if (ids[i] == ids[j]) continue;
+        const double si = dot(nq, p[i] - q[0]), sj = dot(nq, p[j] - q[0]);
+        if (!((si < 0 && sj > 0) || (si > 0 && sj < 0))) continue;
+        const double t = si / (si - sj);
+        const Vec3d x = p[i] + (p[j] - p[i]) * t;
+        bool in = true;
+        for (int m = 0; m < 3 && in; ++m) in = dot(cross(q[(m + 1) % 3] - q[m], x - q[m]), nq) >= 0;
+        if (in)
+            w.crossings.push_back({std::uint64_t(base + ids[i]) << 32 | (base + ids[j]), t, face});
+    }
+}
+
+/// Contacts in the middle of each piece of an intersecting face's edge that runs inside the other
+/// mesh from a crossing to another crossing or to a vertex inside (the crossings sorted along
+/// each edge): where no vertex is inside (two crossed bars), these carry the depth.
+template <class T>
+void edge_contacts(const Side<T>& sa, const Side<T>& sb, ContactWorkspace<T>& w) {
+    std::sort(w.crossings.begin(), w.crossings.end());
+    MeshPoint<T> near_a, near_b;
+    for (std::size_t g = 0; g < w.crossings.size();) {
+        std::size_t e = g;
+        while (e < w.crossings.size() && w.crossings[e].key == w.crossings[g].key) ++e;
+        const std::uint32_t lo = std::uint32_t(w.crossings[g].key >> 32);
+        const std::uint32_t hi = std::uint32_t(w.crossings[g].key);
+        const Side<T>& s = lo < sb.base ? sa : sb;
+        MeshPoint<T>& near = lo < sb.base ? near_a : near_b;
+        const Vec3d p0(s.self.vertex(lo - s.base)), p1(s.self.vertex(hi - s.base));
+        const auto piece = [&](double t0, double t1, std::uint32_t face) {
+            if (!(t1 - t0 > 1e-9)) return;  // one crossing found twice (at an edge of the other)
+            probe(s, p0 + (p1 - p0) * ((t0 + t1) / 2), false, face, lo, false, near, w);
+        };
+        if (w.inside[lo] == w.epoch) piece(0, w.crossings[g].t, w.crossings[g].face);
+        for (std::size_t i = g; i + 1 < e; ++i)
+            piece(w.crossings[i].t, w.crossings[i + 1].t, w.crossings[i].face);
+        if (w.inside[hi] == w.epoch) piece(w.crossings[e - 1].t, 1, w.crossings[e - 1].face);
+        g = e;
     }
 }
 
@@ -321,11 +413,11 @@ bool contact_manifold(const CollisionModel<V>& a, const ContactMesh<typename V::
     w.begin(std::size_t(na) + cb.vertex_count());
     const Transform<double> pose(pose_of_b_in_a), inverse = pose.inverse(), identity{};
 
-    // Curve contacts, and the corners of the intersecting faces.
-    const auto mark = [&](std::uint32_t n) {
+    // Curve contacts, the corners of the intersecting faces, and where their edges cross.
+    const auto mark = [&](std::uint32_t n, std::vector<std::uint32_t>& list, std::uint32_t v) {
         if (w.curve[n] != w.epoch) {
             w.curve[n] = w.epoch;
-            w.corner_list.push_back(n);
+            list.push_back(v);
         }
     };
     for (const Contact<T>& pair : result.pairs.contacts) {
@@ -356,28 +448,25 @@ bool contact_manifold(const CollisionModel<V>& a, const ContactMesh<typename V::
             w.node.push_back(fa[0]);
         }
         for (int k = 0; k < 3; ++k) {
-            mark(fa[k]);
-            mark(na + fb[k]);
+            mark(fa[k], w.corners_a, fa[k]);
+            mark(na + fb[k], w.corners_b, fb[k]);
             w.unite(fa[0], fa[k]);
             w.unite(fa[0], na + fb[k]);
         }
+        if (options.inside_vertices) {
+            detail::record_crossings(pa, fa, 0, pair.triangle_a, pb, nb_, w);
+            detail::record_crossings(pb, fb, na, pair.triangle_b, pa, na_, w);
+        }
     }
     if (options.inside_vertices) {
-        // The corner list holds A's corners and B's (offset by na) interleaved: split it.
-        std::stable_partition(w.corner_list.begin(), w.corner_list.end(),
-                              [&](std::uint32_t n) { return n < na; });
-        const std::size_t split =
-            std::size_t(std::find_if(w.corner_list.begin(), w.corner_list.end(),
-                                     [&](std::uint32_t n) { return n >= na; }) -
-                        w.corner_list.begin());
-        for (std::size_t i = split; i < w.corner_list.size(); ++i) w.corner_list[i] -= na;
         const double eps = double(std::numeric_limits<T>::epsilon());
-        detail::inside_vertex_contacts(ca, cb, inverse, identity, pose.rotation, true, 0,
-                                       64 * eps * double(b.scale()), 0, split, w);
-        // B's vertices: its curve and seen stamps live at offset na.
-        detail::inside_vertex_contacts(cb, ca, pose, pose, identity.rotation, false, na,
-                                       64 * eps * double(a.scale()), split, w.corner_list.size(),
-                                       w);
+        const detail::Side<T> side_a{
+            ca, cb, inverse, identity, pose.rotation, true, 0, 64 * eps * double(b.scale())};
+        const detail::Side<T> side_b{
+            cb, ca, pose, pose, identity.rotation, false, na, 64 * eps * double(a.scale())};
+        detail::inside_vertex_contacts(side_a, w.corners_a, w);
+        detail::inside_vertex_contacts(side_b, w.corners_b, w);
+        detail::edge_contacts(side_a, side_b, w);
     }
 
     // Regions, numbered in the order of their first contact.
