@@ -166,8 +166,9 @@ void time_contacts(const TriangleMesh& mesh, const std::string& name,
     if (hit.empty()) return;
     CollideResult<float> pairs;
     ContactManifold<float> manifold;
-    ContactOptions every;
+    ContactOptions every, local;
     every.max_points_per_region = 0;
+    local.walk_inside = false;
     long long pair_count = 0, points = 0, all_points = 0, regions = 0;
     for (const auto& p : hit) {
         contact_manifold(model, contact, model, contact, p, ContactOptions{}, manifold);
@@ -195,9 +196,11 @@ void time_contacts(const TriangleMesh& mesh, const std::string& name,
             }
         };
     };
-    const std::vector<std::function<void()>> jobs = {
-        pair_job(false), pair_job(true), manifold_job(ContactOptions{}), manifold_job(every)};
-    const char* modes[] = {"pairs", "pairs_segments", "manifold4", "manifold_all"};
+    const std::vector<std::function<void()>> jobs = {pair_job(false), pair_job(true),
+                                                     manifold_job(ContactOptions{}),
+                                                     manifold_job(every), manifold_job(local)};
+    const char* modes[] = {"pairs", "pairs_segments", "manifold4", "manifold_all",
+                           "manifold4_no_walk"};
     const auto ms = interleaved(repetitions, jobs);
     for (std::size_t j = 0; j < jobs.size(); ++j) {
         Row row;
@@ -206,7 +209,7 @@ void time_contacts(const TriangleMesh& mesh, const std::string& name,
         row.set("queries_per_s", double(hit.size()) / (ms[j] / 1000.0));
         row.set("pairs", pair_count);
         if (j >= 2) {
-            row.set("points", j == 2 ? points : all_points).set("regions", regions);
+            if (j != 4) row.set("points", j == 2 ? points : all_points).set("regions", regions);
             row.set("vs_pairs", ms[j] / ms[0]);
         }
         rows.push_back(row);

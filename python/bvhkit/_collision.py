@@ -322,6 +322,7 @@ def contacts(
     translations: npt.ArrayLike,
     max_points: int = 4,
     inside_vertices: bool = True,
+    walk_inside: bool = True,
     threads: int = 0,
 ) -> List[Contacts]:
     """The contact manifold of ``a`` and ``b`` placed at each pose (poses as in :func:`collide`):
@@ -332,7 +333,9 @@ def contacts(
     closed, outward-oriented meshes; with
     ``inside_vertices=False`` only the curve points, for open meshes). They are grouped into
     connected overlap regions and reduced to at most ``max_points`` well-spread points per region,
-    the deepest first (0: keep every contact). The first call on a model builds what the inside
+    the deepest first (0: keep every contact). ``walk_inside=False`` tests only the corners of the
+    intersecting faces (work in proportion to the intersecting pairs; a deep overlap's inner
+    vertices are then not seen). The first call on a model builds what the inside
     test needs (a signed-distance tree, kept until :meth:`CollisionModel.refit`).
     """
     r, t, k = _poses(a, b, rotations, translations)
@@ -341,9 +344,10 @@ def contacts(
     if not 0 <= max_points < 2**32:
         raise ValueError(f"max_points: must be >= 0 (0 keeps every contact), not {max_points}")
     inside = _a.flag("inside_vertices", inside_vertices)
+    walk = _a.flag("walk_inside", walk_inside)
     n = threads if type(threads) is int and 0 <= threads <= _a.THREADS_MAX else _a.threads(threads)
     faces, points, normals, depths, regions, kinds, offsets = a._impl.manifold(
-        b._impl, r, t, max_points, inside, n)
+        b._impl, r, t, max_points, inside, walk, n)
     out = []
     for i in range(k):
         s = slice(offsets[i], offsets[i + 1])

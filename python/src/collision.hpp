@@ -279,12 +279,13 @@ class Model {
     /// contacts are rows offsets[i] .. offsets[i + 1], region by region, each deepest first.
     nb::tuple manifold(const Model& b, const std::optional<PoseArray>& rotations,
                        const PoseArray& translations, std::uint32_t max_points,
-                       bool inside_vertices, unsigned threads) const {
+                       bool inside_vertices, bool walk_inside, unsigned threads) const {
         const std::size_t k = PoseValues<T>(translations, 1, "translations").count();
         std::vector<std::vector<ContactPoint<T>>> per(k);
         ContactOptions options;
         options.max_points_per_region = max_points;
         options.inside_vertices = inside_vertices;
+        options.walk_inside = walk_inside;
         poses(b, rotations, translations, threads, [&](std::size_t i, const Transform<T>& pose) {
             // One result a thread, kept across calls: its workspace grows to the largest meshes
             // once instead of being allocated and cleared at every pose.
@@ -403,7 +404,7 @@ void bind_model(nb::module_& m, const char* name) {
              "(pairs (p, 2), offsets (k + 1)): the intersecting face pairs at each pose.")
         .def("manifold", &M::manifold, nb::arg("b"), nb::arg("rotations").none(),
              nb::arg("translations"), nb::arg("max_points"), nb::arg("inside_vertices"),
-             nb::arg("threads"),
+             nb::arg("walk_inside"), nb::arg("threads"),
              "(faces, points, normals, depths, regions, kinds, offsets): the contact manifold "
              "at each pose.")
         .def("distance", &M::distance, nb::arg("b"), nb::arg("rotations").none(),

@@ -289,6 +289,32 @@ TEST(ContactManifold, SpheresMatchThePolytopes) {
     }
 }
 
+// Without the walk only the corners of intersecting faces are tested: every vertex contact is one
+// of them, each also found (same depth) by the full query, and the box case is unchanged.
+TEST(ContactManifold, WithoutTheWalk) {
+    const Mesh s = sphere_mesh(3, 1.0);
+    const Pair p(s, s);
+    const Transform<double> pose = moved({1.4, 0.02, 0.01});
+    ContactOptions all, near;
+    all.max_points_per_region = near.max_points_per_region = 0;
+    near.walk_inside = false;
+    const ContactManifold<double> full = p.run(pose, all), local = p.run(pose, near);
+    std::vector<std::pair<double, double>> full_vertices;
+    for (const auto& c : full.points)
+        if (c.kind == ContactKind::VertexOfA) full_vertices.push_back({c.point[0], c.depth});
+    std::size_t local_vertices = 0;
+    for (const auto& c : local.points) {
+        if (c.kind != ContactKind::VertexOfA) continue;
+        ++local_vertices;
+        EXPECT_NE(std::find(full_vertices.begin(), full_vertices.end(),
+                            std::pair<double, double>(c.point[0], c.depth)),
+                  full_vertices.end());
+    }
+    EXPECT_GT(local_vertices, 0u);
+    EXPECT_LT(local_vertices, full_vertices.size());  // deep vertices are left out
+    EXPECT_LT(local.region_depths[0], full.region_depths[0]);
+}
+
 // Two spheres in each model, each pair overlapping apart from the other: two regions.
 TEST(ContactManifold, SeparateRegions) {
     Mesh two = sphere_mesh(2, 1.0);

@@ -61,6 +61,10 @@ struct ContactPoint {
 struct ContactOptions {
     std::uint32_t max_points_per_region = 4;  // 0: every contact of every region
     bool inside_vertices = true;  // false: curve contacts only (for meshes that are not closed)
+    /// false: of the vertices inside, only the corners of intersecting faces (no walk to the
+    /// vertices beyond): the work stays proportional to the intersecting pairs, and a deep
+    /// overlap's depth is then only what the curve's neighbourhood shows.
+    bool walk_inside = true;
     DescentRule rule = DescentRule::Larger;
 };
 
@@ -227,7 +231,7 @@ bool probe(const Side<T>& s, const Vec3d& x, bool known_inside, std::uint32_t ow
 /// (`corners`, in self's own ids): each is tested, and from each one inside a walk reaches the
 /// vertices joined to it by faces that meet nothing of the other mesh.
 template <class T>
-void inside_vertex_contacts(const Side<T>& s, const std::vector<std::uint32_t>& corners,
+void inside_vertex_contacts(const Side<T>& s, const std::vector<std::uint32_t>& corners, bool walk,
                             ContactWorkspace<T>& w) {
     MeshPoint<T> near;  // each search starts from the previous closest point
     const auto add = [&](std::uint32_t v, bool known_inside) {
@@ -239,7 +243,7 @@ void inside_vertex_contacts(const Side<T>& s, const std::vector<std::uint32_t>& 
         return true;
     };
     for (const std::uint32_t start : corners) {
-        if (!add(start, false)) continue;
+        if (!add(start, false) || !walk) continue;
         w.queue.clear();
         w.queue.push_back(start);
         for (std::size_t head = 0; head < w.queue.size(); ++head) {
@@ -464,8 +468,8 @@ bool contact_manifold(const CollisionModel<V>& a, const ContactMesh<typename V::
             ca, cb, inverse, identity, pose.rotation, true, 0, 64 * eps * double(b.scale())};
         const detail::Side<T> side_b{
             cb, ca, pose, pose, identity.rotation, false, na, 64 * eps * double(a.scale())};
-        detail::inside_vertex_contacts(side_a, w.corners_a, w);
-        detail::inside_vertex_contacts(side_b, w.corners_b, w);
+        detail::inside_vertex_contacts(side_a, w.corners_a, options.walk_inside, w);
+        detail::inside_vertex_contacts(side_b, w.corners_b, options.walk_inside, w);
         detail::edge_contacts(side_a, side_b, w);
     }
 
