@@ -67,10 +67,10 @@ def polytope_depth(points, vertices, faces):
 
 
 def test_spheres_against_the_polytope_planes():
-    mesh = bvhkit.load_mesh("sphere:subdiv=3")
-    v = np.asarray(mesh.vertices, np.float64)
+    v, f = bvhkit.load_mesh("sphere:subdiv=3")
+    v = np.asarray(v, np.float64)
     v /= np.linalg.norm(v, axis=1, keepdims=True)
-    f = np.asarray(mesh.faces, np.int64)
+    f = np.asarray(f, np.int64)
     a = bvhkit.CollisionModel(v, f, dtype=np.float64)
     t = np.array([1.7, 0.05, -0.02])
     c = bvhkit.contacts(a, a, None, t, max_points=0)[0]
@@ -86,6 +86,9 @@ def test_spheres_against_the_polytope_planes():
     assert abs(c.depths.max() - 0.3) < 0.02
     four = bvhkit.contacts(a, a, None, t)[0]
     assert len(four.depths) == 4 and four.depths[0] == c.depths.max()
+    local = bvhkit.contacts(a, a, None, t, max_points=0, walk_inside=False)[0]
+    assert 0 < (local.kinds == 1).sum() < (c.kinds == 1).sum()
+    assert local.depths.max() < c.depths.max()
 
 
 def test_refit_and_open_meshes():
@@ -110,6 +113,8 @@ def test_bad_arguments():
         bvhkit.contacts(a, b, None, z, max_points=4.0)
     with pytest.raises(TypeError, match="inside_vertices"):
         bvhkit.contacts(a, b, None, z, inside_vertices="yes")
+    with pytest.raises(TypeError, match="walk_inside"):
+        bvhkit.contacts(a, b, None, z, walk_inside=None)
     with pytest.raises(TypeError, match="b:"):
         bvhkit.contacts(a, c32, None, z)
     with pytest.raises(TypeError, match="a:"):
