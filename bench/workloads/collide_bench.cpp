@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "bvhkit/mesh/load_mesh.hpp"
+#include "bvhkit/query/contact_manifold.hpp"
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/convex_hull.hpp"
@@ -146,6 +147,70 @@ std::vector<double> interleaved(int repetitions, const std::vector<std::function
     return out;
 }
 
+/// K2: the contact manifold (query/contact_manifold.hpp) at the colliding poses, OBB models as the
+/// Python package's default, against the pair query on the same model (without and with the
+/// intersection segments, which the manifold computes), all interleaved.
+void time_contacts(const TriangleMesh& mesh, const std::string& name,
+                   const std::vector<Transform<float>>& poses, const std::vector<char>& colliding,
+                   int repetitions, std::vector<Row>& rows) {
+    const CollisionModel<Obb<float>> model(mesh);
+    const ContactMesh<float> contact(mesh);
+    std::vector<Transform<float>> hit;
+    for (std::size_t i = 0; i < poses.size(); ++i)
+        if (colliding[i]) hit.push_back(poses[i]);
+    if (hit.empty()) return;
+    CollideResult<float> pairs;
+    ContactManifold<float> manifold;
+    ContactOptions every, local;
+    every.max_points_per_region = 0;
+    local.walk_inside = false;
+    long long pair_count = 0, points = 0, all_points = 0, regions = 0;
+    for (const auto& p : hit) {
+        contact_manifold(model, contact, model, contact, p, ContactOptions{}, manifold);
+        pair_count += (long long)manifold.pairs.contacts.size();
+        points += (long long)manifold.points.size();
+        regions += (long long)manifold.region_count();
+        all_points += (long long)manifold.candidate_count;
+    }
+    volatile std::size_t sink = 0;
+    const auto pair_job = [&](bool segments) {
+        return [&, segments] {
+            CollideOptions o;
+            o.segments = segments;
+            for (const auto& p : hit) {
+                collide(model, model, p, o, pairs);
+                sink = sink + pairs.contacts.size();
+            }
+        };
+    };
+    const auto manifold_job = [&](const ContactOptions& o) {
+        return [&, o] {
+            for (const auto& p : hit) {
+                contact_manifold(model, contact, model, contact, p, o, manifold);
+                sink = sink + manifold.points.size();
+            }
+        };
+    };
+    const std::vector<std::function<void()>> jobs = {pair_job(false), pair_job(true),
+                                                     manifold_job(ContactOptions{}),
+                                                     manifold_job(every), manifold_job(local)};
+    const char* modes[] = {"pairs", "pairs_segments", "manifold4", "manifold_all",
+                           "manifold4_no_walk"};
+    const auto ms = interleaved(repetitions, jobs);
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+        Row row;
+        row.set("workload", "K2").set("library", "bvhkit").set("bv", "obb").set("mesh", name);
+        row.set("mode", modes[j]).set("queries", (long long)hit.size()).set("ms", ms[j]);
+        row.set("queries_per_s", double(hit.size()) / (ms[j] / 1000.0));
+        row.set("pairs", pair_count);
+        if (j >= 2) {
+            if (j != 4) row.set("points", j == 2 ? points : all_points).set("regions", regions);
+            row.set("vs_pairs", ms[j] / ms[0]);
+        }
+        rows.push_back(row);
+    }
+}
+
 }  // namespace
 
 std::vector<Row> run_collide_bench(const CollideBenchOptions& options, std::FILE* progress) {
@@ -268,6 +333,8 @@ std::vector<Row> run_collide_bench(const CollideBenchOptions& options, std::FILE
             "C2", "distance",
             [](Runner& r, const Transform<float>& p) { return std::size_t(r.distance(p) > 0); },
             apart, true);
+        time_contacts(mesh, name, poses, flags[0], options.repetitions, rows);
+        if (progress) std::fprintf(progress, "  K2 contacts timed\n");
     }
     return rows;
 }

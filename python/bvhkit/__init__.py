@@ -3,7 +3,8 @@
 - :func:`load_mesh` reads OBJ, PLY and STL files, or generates a mesh from a spec.
 - :class:`TriangleMesh`: rays (closest hit, occlusion, hit counts), closest points, signed distance,
   winding numbers and inside/outside on one triangle mesh.
-- :class:`CollisionModel` with :func:`collide`, :func:`distance` and :func:`self_intersections`:
+- :class:`CollisionModel` with :func:`collide`, :func:`contacts`, :func:`distance` and
+  :func:`self_intersections`:
   mesh against mesh over batches of rigid poses.
 - :class:`Solid` with :func:`signed_distance_between`: the distance, or the penetration depth,
   between two closed meshes over batches of rigid poses.
@@ -40,6 +41,8 @@ __all__ = [
     "ClosestPoints",
     "CollisionModel",
     "collide",
+    "contacts",
+    "Contacts",
     "distance",
     "Distances",
     "self_intersections",
@@ -444,8 +447,10 @@ class TriangleMesh:
 
 from ._collision import (  # noqa: E402
     CollisionModel,
+    Contacts,
     Distances,
     collide,
+    contacts,
     distance,
     self_intersections,
 )

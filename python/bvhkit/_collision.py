@@ -295,6 +295,66 @@ def collide(
     return [pairs[offsets[i] : offsets[i + 1]] for i in range(k)]
 
 
+class Contacts(NamedTuple):
+    """What :func:`contacts` returns for one pose: p contacts, region by region (each region's
+    deepest first), all in a's frame. docs/collision.md defines each quantity."""
+
+    faces: np.ndarray
+    """(p, 2) int64 (face of a, face of b) of each contact."""
+    points: np.ndarray
+    """(p, 3) the contact points."""
+    normals: np.ndarray
+    """(p, 3) unit normals from b into a: moving a along one by its depth separates that contact."""
+    depths: np.ndarray
+    """(p,) depths >= 0: a vertex's (or edge point's) distance to the other surface, 0 on the
+    intersection curve."""
+    regions: np.ndarray
+    """(p,) int64 index of the connected overlap region each contact belongs to."""
+    kinds: np.ndarray
+    """(p,) int8: 0 on the intersection curve, 1 a vertex of a inside b, 2 a vertex of b inside a,
+    3 a point of an edge of a inside b, 4 of an edge of b inside a."""
+
+
+def contacts(
+    a: CollisionModel,
+    b: CollisionModel,
+    rotations: Optional[npt.ArrayLike],
+    translations: npt.ArrayLike,
+    max_points: int = 4,
+    inside_vertices: bool = True,
+    walk_inside: bool = True,
+    threads: int = 0,
+) -> List[Contacts]:
+    """The contact manifold of ``a`` and ``b`` placed at each pose (poses as in :func:`collide`):
+    a list of k :class:`Contacts`, empty arrays where they do not meet.
+
+    The contacts are the ends of the intersection segments of the intersecting face pairs, the
+    vertices of each mesh inside the other and the middles of edge pieces inside the other (for
+    closed, outward-oriented meshes; with
+    ``inside_vertices=False`` only the curve points, for open meshes). They are grouped into
+    connected overlap regions and reduced to at most ``max_points`` well-spread points per region,
+    the deepest first (0: keep every contact). ``walk_inside=False`` tests only the corners of the
+    intersecting faces (work in proportion to the intersecting pairs; a deep overlap's inner
+    vertices are then not seen). The first call on a model builds what the inside
+    test needs (a signed-distance tree, kept until :meth:`CollisionModel.refit`).
+    """
+    r, t, k = _poses(a, b, rotations, translations)
+    if type(max_points) is not int or isinstance(max_points, bool):
+        raise TypeError(f"max_points: must be an int, not {type(max_points).__name__}")
+    if not 0 <= max_points < 2**32:
+        raise ValueError(f"max_points: must be >= 0 (0 keeps every contact), not {max_points}")
+    inside = _a.flag("inside_vertices", inside_vertices)
+    walk = _a.flag("walk_inside", walk_inside)
+    n = threads if type(threads) is int and 0 <= threads <= _a.THREADS_MAX else _a.threads(threads)
+    faces, points, normals, depths, regions, kinds, offsets = a._impl.manifold(
+        b._impl, r, t, max_points, inside, walk, n)
+    out = []
+    for i in range(k):
+        s = slice(offsets[i], offsets[i + 1])
+        out.append(Contacts(faces[s], points[s], normals[s], depths[s], regions[s], kinds[s]))
+    return out
+
+
 class Distances(NamedTuple):
     """What :func:`distance` returns, one entry per pose."""
 

@@ -6,12 +6,14 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
 #include <span>
 
 #include "bvhkit/io/collision_model_file.hpp"
+#include "bvhkit/query/contact_manifold.hpp"
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 #include "bvhkit/query/self_collision.hpp"
@@ -218,6 +220,8 @@ class Model {
         nb::gil_scoped_release release;
         const std::unique_lock<std::shared_mutex> lock(mutex_);
         refit_vertices(mesh_.vertices, v, [&] { model_.refit(mesh_); });
+        const std::lock_guard<std::mutex> contact_lock(contact_mutex_);
+        contact_.reset();  // rebuilt from the new vertices when next asked for
     }
 
     /// Calls per_pose(i, pose) for every pose of B in A's frame (this is A), without the GIL
@@ -270,6 +274,52 @@ class Model {
                               owned_array(std::move(offsets), k + 1, 0));
     }
 
+    /// The contact manifold at every pose (query/contact_manifold.hpp): (faces (p, 2), points
+    /// (p, 3), normals (p, 3), depths (p,), regions (p,), kinds (p,), offsets (k + 1)); pose i's
+    /// contacts are rows offsets[i] .. offsets[i + 1], region by region, each deepest first.
+    nb::tuple manifold(const Model& b, const std::optional<PoseArray>& rotations,
+                       const PoseArray& translations, std::uint32_t max_points,
+                       bool inside_vertices, bool walk_inside, unsigned threads) const {
+        const std::size_t k = PoseValues<T>(translations, 1, "translations").count();
+        std::vector<std::vector<ContactPoint<T>>> per(k);
+        ContactOptions options;
+        options.max_points_per_region = max_points;
+        options.inside_vertices = inside_vertices;
+        options.walk_inside = walk_inside;
+        poses(b, rotations, translations, threads, [&](std::size_t i, const Transform<T>& pose) {
+            // One result a thread, kept across calls: its workspace grows to the largest meshes
+            // once instead of being allocated and cleared at every pose.
+            thread_local ContactManifold<T> result;
+            contact_manifold(model_, contact_mesh(), b.model_, b.contact_mesh(), pose, options,
+                             result);
+            per[i] = result.points;
+        });
+        std::size_t total = 0;
+        for (const auto& v : per) total += v.size();
+        std::vector<std::int64_t> faces, regions, offsets(k + 1, 0);
+        std::vector<T> points, normals, depths;
+        std::vector<std::int8_t> kinds;
+        faces.reserve(2 * total);
+        points.reserve(3 * total);
+        normals.reserve(3 * total);
+        for (std::size_t i = 0; i < k; ++i) {
+            offsets[i + 1] = offsets[i] + std::int64_t(per[i].size());
+            for (const ContactPoint<T>& c : per[i]) {
+                faces.insert(faces.end(), {c.triangle_a, c.triangle_b});
+                points.insert(points.end(), {c.point[0], c.point[1], c.point[2]});
+                normals.insert(normals.end(), {c.normal[0], c.normal[1], c.normal[2]});
+                depths.push_back(c.depth);
+                regions.push_back(c.region);
+                kinds.push_back(std::int8_t(c.kind));
+            }
+        }
+        return nb::make_tuple(
+            owned_array(std::move(faces), total, 2), owned_array(std::move(points), total, 3),
+            owned_array(std::move(normals), total, 3), owned_array(std::move(depths), total, 0),
+            owned_array(std::move(regions), total, 0), owned_array(std::move(kinds), total, 0),
+            owned_array(std::move(offsets), k + 1, 0));
+    }
+
     void distance(const Model& b, const std::optional<PoseArray>& rotations,
                   const PoseArray& translations, T absolute_tolerance, T relative_tolerance,
                   OutColumn<T> dist, OutRows<T, 3> point_a, OutRows<T, 3> point_b,
@@ -320,9 +370,18 @@ class Model {
     std::size_t node_count() const { return model_.bvh().nodes.size(); }
 
   private:
+    /// The model's ContactMesh, built at its first use (the caller holds mutex_, shared or not).
+    const ContactMesh<T>& contact_mesh() const {
+        const std::lock_guard<std::mutex> lock(contact_mutex_);
+        if (!contact_) contact_ = std::make_unique<ContactMesh<T>>(mesh_);
+        return *contact_;
+    }
+
     BasicTriangleMesh<T> mesh_;
     CollisionModel<V> model_;
     mutable std::shared_mutex mutex_;
+    mutable std::mutex contact_mutex_;
+    mutable std::unique_ptr<ContactMesh<T>> contact_;
 };
 
 template <class V>
@@ -343,6 +402,11 @@ void bind_model(nb::module_& m, const char* name) {
         .def("contacts", &M::contacts, nb::arg("b"), nb::arg("rotations").none(),
              nb::arg("translations"), nb::arg("threads"),
              "(pairs (p, 2), offsets (k + 1)): the intersecting face pairs at each pose.")
+        .def("manifold", &M::manifold, nb::arg("b"), nb::arg("rotations").none(),
+             nb::arg("translations"), nb::arg("max_points"), nb::arg("inside_vertices"),
+             nb::arg("walk_inside"), nb::arg("threads"),
+             "(faces, points, normals, depths, regions, kinds, offsets): the contact manifold "
+             "at each pose.")
         .def("distance", &M::distance, nb::arg("b"), nb::arg("rotations").none(),
              nb::arg("translations"), nb::arg("absolute_tolerance"), nb::arg("relative_tolerance"),
              nb::arg("distance"), nb::arg("point_a"), nb::arg("point_b"), nb::arg("face_a"),
