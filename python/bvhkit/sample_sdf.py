@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import copy
 import errno
 import hashlib
 import json
@@ -306,7 +307,18 @@ def _client(scheduler: str, stack: contextlib.ExitStack) -> Any:
             LocalCluster(n_workers=k, threads_per_worker=1, processes=True, dashboard_address=None)
         )
         return stack.enter_context(Client(cluster))
-    return stack.enter_context(Client(scheduler))
+    import dask
+
+    # A Client that cannot connect may already have made itself dask's scheduler (a config change
+    # its close() would undo, but close() never runs): put the config back, so that the caller's
+    # later dask work does not go to a scheduler that is not there.
+    saved = copy.deepcopy(dask.config.config)
+    try:
+        return stack.enter_context(Client(scheduler))
+    except BaseException:
+        dask.config.config.clear()
+        dask.config.config.update(saved)
+        raise
 
 
 def _scheduler(value: str) -> str:
