@@ -76,9 +76,11 @@ def _active_client() -> Any:
     except ImportError:
         return None
     try:
-        return default_client()
+        client = default_client()
     except ValueError:  # no client in this process
         return None
+    # A Client that failed to connect, or was closed, can still be the default one: not active.
+    return client if getattr(client, "status", None) == "running" else None
 
 
 def share(scene: _Scene, client: Any = None) -> SharedScene:

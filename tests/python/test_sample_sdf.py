@@ -286,6 +286,11 @@ def test_a_scheduler_that_cannot_be_reached(mesh_dir, tmp_path, capsys):
         assert e.value.code == 2
         assert "argument --scheduler: cannot connect" in capsys.readouterr().err
         assert os.listdir(tmp_path) == []
+    # The failed clients leave no scheduler behind for the process's later dask work.
+    import bvhkit.dask
+
+    assert bvhkit.dask._active_client() is None
+    assert dask.config.get("scheduler", None) != "dask.distributed"
 
 
 def test_samples_beyond_float32_are_refused(tmp_path, capsys):
