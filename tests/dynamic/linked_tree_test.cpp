@@ -102,14 +102,7 @@ TEST(LinkedTree, RandomInsertDetachRebuildKeepsEveryLeaf) {
                     t.free_leaf(leaf_of[std::size_t(v)]);
                     in_tree[v] = false;
                 } else {
-                    t.rebuild(rng.below(2) == 0, [](std::span<const Box> boxes) {
-                        std::vector<Vec<double, 3>> c(boxes.size());
-                        for (std::size_t k = 0; k < boxes.size(); ++k)
-                            c[k] = boxes[k].min * 0.5 + boxes[k].max * 0.5;
-                        BuildOptions b;
-                        b.max_leaf_size = 1;
-                        return build_bvh(boxes, std::span<const Vec<double, 3>>(c), b);
-                    });
+                    t.rebuild(rng.below(2) == 0);
                 }
                 if (op % 97 == 0) t.validate("test");
             }
@@ -226,7 +219,7 @@ TEST(LinkedTree, EmptyAndSingleLeaf) {
     Tree t;
     t.validate("test");
     EXPECT_EQ(t.height(), 0);
-    t.rebuild(true, [](std::span<const Box>) -> Bvh<Box> { throw Error("not called"); });
+    t.rebuild(true);
     const auto leaf = t.make_leaf(Box({0, 0, 0}, {0, 0, 0}), 5);
     t.insert(leaf, {});
     EXPECT_EQ(t.root(), leaf);

@@ -234,27 +234,6 @@ class LinkedTree {
             [nodes](std::int32_t i) { return std::int32_t(nodes[i].height); });
     }
 
-    /// As rebuild(full), with the internal nodes laid out as `build(std::span<const Box>)` says:
-    /// it returns a Bvh over the kept subtrees' boxes (any builder); its leaves may hold several,
-    /// which are then paired up in halves.
-    template <class BuildFn>
-    void rebuild(bool full, BuildFn&& build) {
-        if (root_ == null) return;
-        std::vector<std::int32_t>& kept = rebuild_kept_;
-        std::vector<Box>& boxes = rebuild_boxes_;
-        kept.clear();
-        boxes.clear();
-        collect_kept(
-            full,
-            [&](std::int32_t i, const Box& box) {
-                kept.push_back(i);
-                boxes.push_back(box);
-            },
-            [this](std::int32_t i) { free_node(i); });
-        const Bvh<Box> layout = build(std::span<const Box>(boxes));
-        root_ = link_layout(layout, kept);
-    }
-
     /// Applies f(Box&) to every node's box in use (an internal node's must stay the union of its
     /// children's, a leaf's as its owner needs: DynamicTree shifts them all by one vector).
     template <class F>
@@ -306,9 +285,7 @@ class LinkedTree {
         release(heap_);
         release(float_heap_);
         release(rebuild_kept_);
-        release(rebuild_boxes_);
         release(rebuild_stack_);
-        release(rebuild_order_);
         release(rebuild_items_);
         release(rebuild_bins_);
     }
@@ -334,9 +311,7 @@ class LinkedTree {
     std::size_t memory_bytes() const {
         return nodes_.capacity() * sizeof(Node) + heap_.capacity() * sizeof(heap_[0]) +
                float_heap_.capacity() * sizeof(float_heap_[0]) +
-               (rebuild_kept_.capacity() + rebuild_stack_.capacity() + rebuild_order_.capacity()) *
-                   sizeof(std::int32_t) +
-               rebuild_boxes_.capacity() * sizeof(Box) +
+               (rebuild_kept_.capacity() + rebuild_stack_.capacity()) * sizeof(std::int32_t) +
                rebuild_items_.capacity() * sizeof(rebuild_items_[0]) + rebuild_bins_.capacity();
     }
 
@@ -448,23 +423,6 @@ class LinkedTree {
         }
     }
 
-    /// Links a Bvh over the kept subtrees (kept[k] is the subtree of box k) with fresh internal
-    /// nodes; returns its root. A Bvh leaf over several subtrees is paired up by halving.
-    std::int32_t link_layout(const Bvh<Box>& layout, std::span<const std::int32_t> kept);
-    /// Internal nodes over kept[order[begin..end)], halving the range; returns their root.
-    std::int32_t link_range(std::span<const std::uint32_t> order,
-                            std::span<const std::int32_t> kept);
-    std::int32_t make_parent(std::int32_t a, std::int32_t b) {
-        const std::int32_t p = alloc_node();
-        Node& n = nodes_[std::size_t(p)];
-        n.parent = null;
-        n.child1 = a;
-        n.child2 = b;
-        n.enlarged = 0;
-        nodes_[std::size_t(a)].parent = nodes_[std::size_t(b)].parent = p;
-        linked::refit(nodes_.data(), p);
-        return p;
-    }
 
     std::vector<Node> nodes_;
     std::int32_t root_ = null;
@@ -474,45 +432,9 @@ class LinkedTree {
     std::vector<linked::SiblingCandidate<double>> heap_;
     std::vector<linked::SiblingCandidate<float>> float_heap_;
     std::vector<std::int32_t> rebuild_kept_, rebuild_stack_;
-    std::vector<std::uint32_t> rebuild_order_;
-    std::vector<Box> rebuild_boxes_;
     std::vector<linked::RebuildItem<T, N>> rebuild_items_;
     std::vector<std::uint8_t> rebuild_bins_;
 };
-
-template <class T, std::size_t N>
-std::int32_t LinkedTree<T, N>::link_layout(const Bvh<Box>& layout,
-                                           std::span<const std::int32_t> kept) {
-    std::vector<std::uint32_t>& all = rebuild_order_;
-    if (layout.primitive_indices.size() != kept.size() || layout.nodes.empty()) {
-        // A builder that left a subtree out (it should not): pair them all up in halves instead.
-        all.resize(kept.size());
-        for (std::size_t k = 0; k < kept.size(); ++k) all[k] = std::uint32_t(k);
-        return link_range(all, kept);
-    }
-    // Children come after their parents in a Bvh: linking from the last node back to the first
-    // finishes both children of a node before the node itself.
-    std::vector<std::int32_t>& linked_of = rebuild_stack_;
-    linked_of.assign(layout.nodes.size(), null);
-    for (std::size_t i = layout.nodes.size(); i-- > 0;) {
-        const auto& b = layout.nodes[i];
-        linked_of[i] =
-            b.is_leaf()
-                ? link_range(std::span(layout.primitive_indices).subspan(b.first, b.count), kept)
-                : make_parent(linked_of[b.left()], linked_of[b.right()]);
-    }
-    const std::int32_t root = linked_of[0];
-    nodes_[std::size_t(root)].parent = null;
-    return root;
-}
-
-template <class T, std::size_t N>
-std::int32_t LinkedTree<T, N>::link_range(std::span<const std::uint32_t> order,
-                                          std::span<const std::int32_t> kept) {
-    if (order.size() == 1) return kept[order[0]];
-    const std::size_t half = order.size() / 2;  // depth log2(size): the recursion stays shallow
-    return make_parent(link_range(order.first(half), kept), link_range(order.subspan(half), kept));
-}
 
 template <class T, std::size_t N>
 template <class LeafCheck>
