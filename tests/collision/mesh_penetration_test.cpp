@@ -316,6 +316,60 @@ TEST(MeshPenetration, FloatModels) {
     EXPECT_TRUE(r.verified);
 }
 
+/// Two meshes as one (b's vertices after a's).
+Mesh joined(const Mesh& a, const Mesh& b) {
+    Mesh m = a;
+    const auto n = std::uint32_t(a.vertices.size());
+    m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
+    for (const auto& t : b.triangles) m.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+    return m;
+}
+
+TEST(MeshPenetration, EveryPieceOfASolidIsAskedWhetherItIsInside) {
+    // b is two unit cubes: [0,1]^3 far from a, and [25,26]^3 wholly inside a = [20,30]^3. No
+    // faces meet; the inner piece alone overlaps, and leaving a takes at least 5 (along +x, +y
+    // or +z).
+    const Solid a(box({20, 20, 20}, {30, 30, 30}));
+    const Solid b(joined(box({0, 0, 0}, {1, 1, 1}), box({25, 25, 25}, {26, 26, 26})));
+    const auto r = signed_distance_between(a, b, shift({0, 0, 0}));
+    EXPECT_TRUE(r.contained);
+    EXPECT_LE(r.signed_distance, -5 * (1 - 1e-6));
+    EXPECT_GE(r.signed_distance, -6 * (1 + 1e-6));
+    EXPECT_TRUE(r.verified);
+    // The same two pieces as a, b a box around the inner one: a's piece inside b.
+    const Solid big(box({24, 24, 24}, {27.5, 27.5, 27.5}));
+    const auto q = signed_distance_between(b, big, shift({0, 0, 0}));
+    EXPECT_TRUE(q.contained);
+    EXPECT_LT(q.signed_distance, 0.0);
+}
+
+TEST(MeshPenetration, ApartNormalsAreUnitAtEveryScale) {
+    for (const double s : {1e-170, 1e-30, 1.0, 1e30, 1e150}) {
+        const Solid a(box({0, 0, 0}, {s, s, s})), b(box({0, 0, 0}, {s, s, s}));
+        const auto r = signed_distance_between(a, b, shift({3 * s, 0, 0}));
+        EXPECT_NEAR(r.signed_distance / s, 2.0, 1e-12) << s;
+        EXPECT_NEAR(r.normal[0], 1.0, 1e-12) << s;
+        EXPECT_NEAR(length(r.normal), 1.0, 1e-12) << s;
+    }
+}
+
+TEST(MeshPenetration, ConvexDepthIsExactOnlyWhereEpaCanBeTrusted) {
+    // Float cubes [0,s]^3, b moved by (s/2, s/4, 0): depth s/2 along +x at every scale; beyond
+    // the range where EPA's products of four coordinates stay finite and normal the result is
+    // the search's (a local optimum), still s/2 here.
+    using SolidF = SolidModel<Obb<float>>;
+    for (const float s : {1e-12f, 1e-3f, 1.0f, 1e3f, 1e10f, 1e20f}) {
+        std::vector<std::array<double, 2>> sq = {{0, 0}, {s, 0}, {s, s}, {0, s}};
+        const SolidF a(prism(sq, 0, s, 0)), b(prism(sq, 0, s, 0));
+        const Transform<float> p{Mat3<float>::identity(), Vec<float, 3>{s / 2, s / 4, 0}};
+        const auto r = signed_distance_between(a, b, p);
+        EXPECT_NEAR(-r.signed_distance / s, 0.5, 1e-3) << s;
+        EXPECT_NEAR(r.normal[0], 1.0f, 1e-3f) << s;
+        if (s >= 1e-3f && s <= 1e3f) EXPECT_EQ(r.quality, DepthQuality::Exact) << s;
+        if (s >= 1e10f || s <= 1e-12f) EXPECT_EQ(r.quality, DepthQuality::LocalOptimum) << s;
+    }
+}
+
 TEST(MeshPenetration, ContinuityThroughContact) {
     // A ball moved across a box's face in steps: depth continuous and the normal never flips
     // while it overlaps (convex: exact each step).

@@ -98,8 +98,10 @@ class DepthSearch {
         ++tests_;
         const Transform<T> p{pose_.rotation, pose_.translation + v};
         if (collides(a_.collision(), b_.collision(), p)) return true;
-        const bool c =
-            a_.contains(p.apply(b_.probe())) || b_.contains(p.inverse().apply(a_.probe()));
+        bool c = false;
+        for (const Vec3& q : b_.probes()) c = c || a_.contains(p.apply(q));
+        const Transform<T> back = p.inverse();
+        for (const Vec3& q : a_.probes()) c = c || b_.contains(back.apply(q));
         if (contained) *contained = c;
         return c;
     }
@@ -287,9 +289,26 @@ Vec<typename V::Scalar, 3> seed_direction(const SolidModel<V>& a, const SolidMod
     using T = typename V::Scalar;
     const Transform<T> identity{Mat3<T>::identity(), Vec<T, 3>(T(0))};
     const ConvexSignedDistance<T> h = convex_signed_distance(a.hull(), identity, b.hull(), pose);
-    if (epa_converged) *epa_converged = h.converged;
+    // GJK and EPA form products of up to four coordinates (volumes, squared normals): beyond a
+    // scale whose fourth power leaves T's normal range their answer is rounding, so it is only a
+    // seed there, not an exact depth.
+    const T extent = a.collision().scale() + b.collision().scale() +
+                     max_component(bvhkit::max(pose.translation, -pose.translation));
+    const T lo = T(16) * std::sqrt(std::sqrt(std::numeric_limits<T>::min()));
+    const T hi = std::sqrt(std::sqrt(std::numeric_limits<T>::max())) / T(16);
+    if (epa_converged) *epa_converged = h.converged && extent >= lo && extent <= hi;
     if (length_squared(h.normal) > T(0.5)) return h.normal;
     return Vec<T, 3>{T(0), T(0), T(1)};
+}
+
+/// v at unit length, computed after scaling by its largest component so that neither a huge nor
+/// a tiny v over- or underflows; zero for a zero or non-finite v.
+template <class T>
+Vec<T, 3> unit_direction(const Vec<T, 3>& v) {
+    const T m = max_component(bvhkit::max(v, -v));
+    if (!(m > T(0)) || !std::isfinite(m)) return Vec<T, 3>(T(0));
+    const Vec<T, 3> w = v / m;
+    return w / std::sqrt(dot(w, w));
 }
 
 }  // namespace penetration_detail
@@ -305,22 +324,20 @@ MeshSignedDistance<typename V::Scalar> signed_distance_between(
     check_rigid_pose(pose_of_b_in_a, "signed_distance_between", "pose_of_b_in_a");
     MeshSignedDistance<T> r;
     penetration_detail::DepthSearch<V> s(a, b, pose_of_b_in_a, options);
-    // Apart: the surfaces' distance, unless one interior holds the other.
-    const DistanceResult<T> apart = distance(a.collision(), b.collision(), pose_of_b_in_a);
-    if (apart.distance > T(0)) {
-        bool contained = false;
-        s.overlaps_at(Vec<T, 3>(T(0)), &contained);
-        if (!contained) {
-            r.signed_distance = apart.distance;
-            r.point_a = apart.point_a;
-            r.point_b = apart.point_b;
-            r.normal = normalize(apart.point_b - apart.point_a);
-            r.quality = DepthQuality::Exact;
-            r.overlap_tests = s.tests();
-            return r;
-        }
-        r.contained = true;
+    // Apart, by the exact decision (no face meets, no piece inside the other solid): the
+    // surfaces' distance, which rounding may make 0 but never negative.
+    bool contained = false;
+    if (!s.overlaps_at(Vec<T, 3>(T(0)), &contained)) {
+        const DistanceResult<T> apart = distance(a.collision(), b.collision(), pose_of_b_in_a);
+        r.signed_distance = apart.distance;
+        r.point_a = apart.point_a;
+        r.point_b = apart.point_b;
+        r.normal = penetration_detail::unit_direction(apart.point_b - apart.point_a);
+        r.quality = DepthQuality::Exact;
+        r.overlap_tests = s.tests();
+        return r;
     }
+    r.contained = contained;
     bool epa_converged = false;
     const Vec<T, 3> seed = penetration_detail::seed_direction(a, b, pose_of_b_in_a, &epa_converged);
     if (a.convex() && b.convex() && epa_converged) {

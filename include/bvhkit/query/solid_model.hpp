@@ -94,6 +94,38 @@ bool closed_mesh_is_convex(const M& mesh, const std::vector<std::uint32_t>& weld
     return pieces == 1 && euler == 2;
 }
 
+/// One corner of a triangle of each connected piece (triangles joined through welded corners),
+/// in the order the pieces first appear: once the surfaces do not meet, a piece is inside the
+/// other solid exactly when its corner is, and each piece must be asked on its own.
+template <IndexedTriangleMesh M>
+std::vector<Vec<typename M::Scalar, 3>> piece_probes(const M& mesh,
+                                                     const std::vector<std::uint32_t>& weld) {
+    std::uint32_t ids = 0;
+    for (const std::uint32_t w : weld) ids = std::max(ids, w + 1);
+    std::vector<std::uint32_t> parent(ids);
+    std::iota(parent.begin(), parent.end(), 0u);
+    const auto root = [&](std::uint32_t x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    const std::size_t nt = mesh.triangle_count();
+    for (std::size_t i = 0; i < nt; ++i) {
+        const auto& t = mesh.triangle(i);
+        parent[root(weld[t[0]])] = root(weld[t[1]]);
+        parent[root(weld[t[1]])] = root(weld[t[2]]);
+    }
+    std::vector<char> seen(ids, 0);
+    std::vector<Vec<typename M::Scalar, 3>> probes;
+    for (std::size_t i = 0; i < nt; ++i) {
+        const auto& t = mesh.triangle(i);
+        const std::uint32_t r = root(weld[t[0]]);
+        if (seen[r]) continue;
+        seen[r] = 1;
+        probes.push_back(mesh.vertex(t[0]));
+    }
+    return probes;
+}
+
 }  // namespace solid_detail
 
 template <BoundingVolume V>
@@ -116,16 +148,17 @@ class SolidModel {
                 "SolidModel: the mesh is not closed (an edge, after welding equal corners, is not "
                 "used as often in one direction as in the other); its interior is undefined");
         convex_ = solid_detail::closed_mesh_is_convex(mesh, weld);
-        probe_ = collision_.slot_triangles()[0].p0;
+        for (const auto& p : solid_detail::piece_probes(mesh, weld))
+            probes_.push_back(Vec<T, 3>(p));
     }
 
     const CollisionModel<V>& collision() const { return collision_; }
     const ConvexShape<T>& hull() const { return hull_; }
     /// Whether the mesh is convex (then it is its own hull).
     bool convex() const { return convex_; }
-    /// A vertex of the mesh: inside the other solid exactly when this one's surface is, once the
-    /// surfaces do not meet.
-    const Vec<T, 3>& probe() const { return probe_; }
+    /// A vertex of each connected piece of the mesh: once the surfaces do not meet, a piece is
+    /// inside the other solid exactly when its vertex is.
+    std::span<const Vec<T, 3>> probes() const { return probes_; }
 
     /// Whether q (not on the surface) is inside: the winding number, which is an integer for a
     /// closed mesh. The fast expansion is trusted where it is near an integer; otherwise (q very
@@ -149,7 +182,7 @@ class SolidModel {
     WindingNumberMesh<T> winding_;
     ConvexShape<T> hull_;
     bool convex_ = false;
-    Vec<T, 3> probe_{};
+    std::vector<Vec<T, 3>> probes_;
 };
 
 }  // namespace bvhkit
