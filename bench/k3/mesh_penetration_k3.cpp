@@ -1,7 +1,7 @@
 // K3 of issue 41: signed_distance_between (query/mesh_penetration.hpp) on the C1 poses of the
 // shared closed meshes against a copy of themselves, beside C2's distance() on the same models
 // (the poses where the copies are apart), one thread, medians of interleaved repetitions.
-// Not part of the CMake build (docs/benchmarks.md gives the one-line build).
+// Built with the benchmarks: build/release/bench/bvhkit_bench_k3.
 // --dense N: also the least depth over N directions spread on the sphere (a Fibonacci lattice,
 // each bisected on the exact test), against which the local optimum is compared.
 //   usage: mesh_penetration_k3 [--poses N] [--reps N] [--dense N] MESH...
