@@ -126,5 +126,54 @@ TEST(ConstQueriesFromThreads, DynamicTreeQueries) {
     });
 }
 
+/// Twelve instances of mesh() in a row, turned, some overlapping their neighbours.
+Scene<float> row_of_instances() {
+    Scene<float> scene;
+    const GeometryId g = scene.add_mesh(mesh());
+    for (int i = 0; i < 12; ++i) {
+        Transform<float> pose;
+        pose.rotation = rotation_about(normalize(Vec3f(0.3f, 1, 0.2f)), 0.4f * float(i));
+        pose.translation = Vec3f(1.9f * float(i), 0.1f * float(i % 3), 0);
+        scene.add_instance(g, pose, {.margin = i % 4 == 0 ? 0.05f : 0.0f});
+    }
+    return scene;
+}
+
+TEST(ConstQueriesFromThreads, SceneQueriesOnAFreshScene) {
+    // The readers start on a scene whose per-mesh trees are not built yet: the lazy builds (under
+    // std::call_once) race with the queries, which TSan watches.
+    const Scene<float> reference = row_of_instances();
+    const Aabb3f box = reference.bounds();
+    const auto origins = random_points(box, 400, 7);
+    const auto targets = random_points(box, 400, 8);
+    const auto answers = [&](const Scene<float>& scene, std::size_t i) {
+        const Ray3f ray(origins[i], targets[i] - origins[i]);
+        const SceneHit<float> hit = closest_hit(scene, ray);
+        const ScenePoint<float> near = closest_point(scene, origins[i]);
+        std::array<double, 6> a{
+            hit.t, double(hit.face), double(any_hit(scene, ray)), near.distance, 0, 0};
+        if (i % 100 == 0) {  // the pair queries walk every instance: a few of them
+            std::vector<InstancePair> pairs;
+            colliding_pairs(scene, pairs);
+            a[4] = double(pairs.size()) + closest_pair(scene).distance;
+            std::vector<SceneDistance<float>> within;
+            pairs_within(scene, 0.5f, within);
+            a[5] = double(within.size());
+        }
+        return a;
+    };
+    std::vector<std::array<double, 6>> serial(origins.size()), parallel(origins.size());
+    for (std::size_t i = 0; i < origins.size(); ++i) serial[i] = answers(reference, i);
+    const Scene<float> fresh = row_of_instances();
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t)
+        threads.emplace_back([&, t] {
+            for (std::size_t i = std::size_t(t); i < origins.size(); i += kThreads)
+                parallel[i] = answers(fresh, i);
+        });
+    for (auto& th : threads) th.join();
+    for (std::size_t i = 0; i < origins.size(); ++i) ASSERT_EQ(serial[i], parallel[i]) << i;
+}
+
 }  // namespace
 }  // namespace bvhkit
