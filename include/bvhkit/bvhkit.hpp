@@ -27,6 +27,7 @@
 #include "bvhkit/mesh/procedural.hpp"
 #include "bvhkit/primitives/segment.hpp"
 #include "bvhkit/query/closest_point_mesh.hpp"
+#include "bvhkit/query/contact_manifold.hpp"
 #include "bvhkit/query/crossings.hpp"
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/query/mesh_penetration.hpp"

@@ -513,6 +513,14 @@ class Scene:
         the same distance, the lowest slots win."""
         return SceneDistances(*self._impl.closest_pair(self._ignore(ignore)))
 
+    def closest_pair_with(self, other: "Scene", ignore: Optional[npt.ArrayLike] = None
+                          ) -> SceneDistances:
+        """The closest pair (a of this scene, b of ``other``) that may collide, as
+        :meth:`closest_pair` gives within one scene: one entry or none. ``ignore``: (q, 2) rows
+        (id of this scene, id of other)."""
+        o = self._other(other)
+        return SceneDistances(*self._impl.closest_pair_with(o, self._ignore(ignore)))
+
     def pairs_within(self, threshold: float, ignore: Optional[npt.ArrayLike] = None
                      ) -> SceneDistances:
         """Every pair that may collide whose distance (less both margins) is at most

@@ -56,6 +56,8 @@ void bind_instanced_type(nb::module_& m, const char* name) {
         .def("to_bytes", &S::to_bytes)
         .def("load_bytes", &S::load_bytes, nb::arg("data"))
         .def("closest_pair", &instance_pairs::closest_pair<T>, nb::arg("ignore"))
+        .def("closest_pair_with", &instance_pairs::closest_pair_with<T>, nb::arg("other"),
+             nb::arg("ignore"))
         .def("pairs_within", &instance_pairs::pairs_within<T>, nb::arg("threshold"),
              nb::arg("ignore"))
         .def("closest_instance", &instance_pairs::closest_instance<T>, nb::arg("geometry"),

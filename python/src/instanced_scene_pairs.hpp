@@ -194,6 +194,21 @@ nb::tuple closest_pair(const Scene<T>& s, const IdPairs& ignore) {
     return pack(found);
 }
 
+/// The closest pair (a of s, b of other): pack() of none or one.
+template <class T>
+nb::tuple closest_pair_with(const Scene<T>& s, const Scene<T>& other, const IdPairs& ignore) {
+    std::vector<SceneDistance<T>> found;
+    {
+        const std::vector<InstancePair> skip = pairs_of(ignore);
+        nb::gil_scoped_release release;
+        const BothLocks<T> lock(s, other);
+        check_pairs(s, other, ignore);
+        if (const SceneDistance<T> d = bvhkit::closest_pair(s.scene(), other.scene(), skip))
+            found.push_back(d);
+    }
+    return pack(found);
+}
+
 template <class T>
 nb::tuple pairs_within(const Scene<T>& s, T threshold, const IdPairs& ignore) {
     std::vector<SceneDistance<T>> found;

@@ -99,6 +99,13 @@ def test_two_scenes_collide_pair_by_pair():
     assert not s1.any_collision_with(s2, ignore=[[a, c], [b, d]])
     assert [tuple(p) for p in s2.colliding_pairs_with(s1)] == [(c, a), (d, b)]
     assert e not in {int(x) for x in s1.colliding_pairs_with(s2).ravel()}
+    # The closest pair across: (b, d) 0.5 apart less d's margin 0.6 beats (a, c) overlapping.
+    near = s1.closest_pair_with(s2)
+    assert [tuple(p) for p in near.pairs] == [(b, d)]
+    assert near.distance[0] == pytest.approx(-0.1, abs=1e-9)
+    near = s1.closest_pair_with(s2, ignore=[[b, d]])
+    assert [tuple(p) for p in near.pairs] == [(a, c)] and near.distance[0] == 0
+    assert len(s1.closest_pair_with(bvhkit.Scene(np.float64)).distance) == 0
     with pytest.raises(TypeError, match="other"):
         s1.colliding_pairs_with(bvhkit.Scene(np.float32))
     with pytest.raises(TypeError, match="other"):

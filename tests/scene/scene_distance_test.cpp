@@ -375,6 +375,10 @@ void check_two_scenes(double scale, double offset, std::uint64_t seed) {
     for (int k = 0; k < 10; ++k)
         ignore.push_back({ids1[rng.next() % ids1.size()], ids2[rng.next() % ids2.size()]});
     std::vector<InstancePair> expected;
+    // The closest pair by every pair's one-pair distance less the margins, the lower (a's slot,
+    // b's slot) on a tie.
+    T closest = std::numeric_limits<T>::infinity();
+    InstancePair closest_ids;
     for (const InstanceId a : ids1)
         for (const InstanceId b : ids2) {
             const auto& oa = s1.options(a);
@@ -387,9 +391,18 @@ void check_two_scenes(double scale, double offset, std::uint64_t seed) {
             const auto& ma = s1.geometry(s1.geometry_of(a)).collision_model();
             const auto& mb = s2.geometry(s2.geometry_of(b)).collision_model();
             const T m = oa.margin + ob.margin;
-            if (m == T(0) ? collides(ma, mb, rel) : distance(ma, mb, rel).distance <= m)
-                expected.push_back({a, b});
+            const T d = distance(ma, mb, rel).distance;
+            const T less =
+                m == T(0) ? d
+                          : scene_detail::narrow<T>(AccurateScalar<T>(d) - AccurateScalar<T>(m));
+            if (less < closest) closest = less, closest_ids = {a, b};
+            if (m == T(0) ? collides(ma, mb, rel) : d <= m) expected.push_back({a, b});
         }
+    const SceneDistance<T> nearest = closest_pair(s1, s2, ignore);
+    EXPECT_EQ(nearest.distance, closest);
+    EXPECT_EQ(nearest.a, closest_ids.a);
+    EXPECT_EQ(nearest.b, closest_ids.b);
+    EXPECT_FALSE(closest_pair(s1, Scene<T>(), ignore));
     std::sort(expected.begin(), expected.end());
     std::vector<InstancePair> found;
     colliding_pairs(s1, s2, found, ignore);

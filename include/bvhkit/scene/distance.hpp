@@ -182,6 +182,48 @@ SceneDistance<T> closest_pair(const Scene<T>& scene, std::span<const InstancePai
     return best;
 }
 
+/// The closest pair (a of `first`, b of `second`) that the filters let collide and that is not in
+/// `ignore` (given in the same (first, second) order), with its distance (less the margins) and
+/// world witnesses; ties go to the lower (a's slot, b's slot). Nothing (both null, +inf) when no
+/// such pair has finite triangles on both sides. Each instance of `first` walks `second`'s top
+/// level nearest first, pruned by the running best. The scenes share no ids; one scene passed as
+/// both measures every instance against every other and against itself (distance 0).
+template <class T>
+SceneDistance<T> closest_pair(const Scene<T>& first, const Scene<T>& second,
+                              std::span<const InstancePair> ignore = {}) {
+    using W = NearestWalkScalar<T>;
+    SceneDistance<T> best;
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> skip;
+    for (const InstancePair& p : ignore) skip.emplace_back(p.a.bits(), p.b.bits());
+    std::sort(skip.begin(), skip.end());
+    const T largest = scene_detail::largest_margin(second);
+    first.for_each_instance([&](InstanceId a) {
+        const SceneInstance<T>& ra = first.instance_at(a.proxy());
+        const SceneGeometry<T>& ga = first.geometry_at(ra.geometry);
+        if (!ga.has_extent()) return;
+        const scene_detail::BoxReach<T> reach = scene_detail::box_reach(ra.box);
+        const AccurateScalar<T> margins = AccurateScalar<T>(ra.options.margin) + largest;
+        second.top_level().query_nearest(reach.centre, [&](ProxyId proxy, W) -> W {
+            const InstanceId b(proxy);
+            const SceneInstance<T>& rb = second.instance_at(proxy);
+            const T m = ra.options.margin + rb.options.margin;
+            SceneDistance<T> d;
+            if (may_collide(ra.options, rb.options) &&
+                !std::binary_search(skip.begin(), skip.end(), std::pair(a.bits(), b.bits())) &&
+                scene_detail::may_beat(scene_detail::box_gap(ra.box, rb.box), m, best.distance) &&
+                scene_detail::measure(ga, ra.pose, second.geometry_at(rb.geometry), rb.pose, m,
+                                      d) &&
+                (d.distance < best.distance || (d.distance == best.distance &&
+                                                scene_detail::pair_before(a, b, best.a, best.b)))) {
+                d.a = a, d.b = b;
+                best = d;
+            }
+            return scene_detail::walk_bound(best.distance, reach.radius, margins);
+        });
+    });
+    return best;
+}
+
 /// Every pair of instances that the filters let collide and whose distance (less the margins) is
 /// at most `threshold`, sorted by (a's slot, b's slot), each with its witnesses: `out` is cleared,
 /// then filled. Error on a NaN threshold (+inf gives every pair with finite triangles).
