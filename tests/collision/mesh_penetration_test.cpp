@@ -365,8 +365,12 @@ TEST(MeshPenetration, ConvexDepthIsExactOnlyWhereEpaCanBeTrusted) {
         const auto r = signed_distance_between(a, b, p);
         EXPECT_NEAR(-r.signed_distance / s, 0.5, 1e-3) << s;
         EXPECT_NEAR(r.normal[0], 1.0f, 1e-3f) << s;
-        if (s >= 1e-3f && s <= 1e3f) EXPECT_EQ(r.quality, DepthQuality::Exact) << s;
-        if (s >= 1e10f || s <= 1e-12f) EXPECT_EQ(r.quality, DepthQuality::LocalOptimum) << s;
+        if (s >= 1e-3f && s <= 1e3f) {
+            EXPECT_EQ(r.quality, DepthQuality::Exact) << s;
+        }
+        if (s >= 1e10f || s <= 1e-12f) {
+            EXPECT_EQ(r.quality, DepthQuality::LocalOptimum) << s;
+        }
     }
 }
 
