@@ -21,7 +21,8 @@
 #include "exact_int.hpp"
 #include "test_support.hpp"
 
-namespace bvhkit::test {
+// A namespace of its own: the unity build puts this file beside hull_references.hpp's helpers.
+namespace bvhkit::test::climb_cases {
 namespace {
 
 using Vec3d = Vec<double, 3>;
@@ -268,4 +269,4 @@ TEST(HullSupport, PolytopeSupportIsExact) {
 }
 
 }  // namespace
-}  // namespace bvhkit::test
+}  // namespace bvhkit::test::climb_cases

@@ -17,7 +17,8 @@
 #include "bvhkit/scene/scene.hpp"
 #include "scene_support.hpp"
 
-namespace bvhkit {
+// A namespace of its own: the unity build joins this file with the other scene tests.
+namespace bvhkit::hull_box_cases {
 namespace {
 
 using scene_test::LD;
@@ -109,4 +110,4 @@ TEST(SceneHullBoxes, SupportQueriesHoldEveryVertex) {
 }
 
 }  // namespace
-}  // namespace bvhkit
+}  // namespace bvhkit::hull_box_cases
