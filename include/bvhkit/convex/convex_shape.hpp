@@ -39,6 +39,28 @@ class ConvexShape {
     Vec<T, 3> core_support(const Vec<T, 3>& d) const {
         return std::visit([&](const auto& s) { return s.core_support(d); }, shape_);
     }
+    /// The same, starting a hull's climb from vertex `hint` and leaving the answer's vertex there
+    /// (volumes/hull_support.hpp); the other shapes ignore it.
+    Vec<T, 3> support(const Vec<T, 3>& d, std::uint32_t& hint) const {
+        return std::visit(
+            [&](const auto& s) {
+                if constexpr (requires { s.support(d, hint); })
+                    return s.support(d, hint);
+                else
+                    return s.support(d);
+            },
+            shape_);
+    }
+    Vec<T, 3> core_support(const Vec<T, 3>& d, std::uint32_t& hint) const {
+        return std::visit(
+            [&](const auto& s) {
+                if constexpr (requires { s.core_support(d, hint); })
+                    return s.core_support(d, hint);
+                else
+                    return s.core_support(d);
+            },
+            shape_);
+    }
     /// The radius of the ball swept over the core: sphere and capsule radius, 0 for the others.
     T margin() const {
         return std::visit([](const auto& s) { return s.margin(); }, shape_);

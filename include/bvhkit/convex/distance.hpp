@@ -15,6 +15,7 @@
 // w is already in the simplex, when |v| stops shrinking (rounding), or after gjk_max_iterations.
 // Each of these leaves an answer: nothing loops for ever on degenerate input.
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <utility>
 
@@ -55,10 +56,15 @@ struct PosedSupport {
     Mat3<T> rotation;
     Vec<T, 3> offset;
     bool core;
+    // The last support vertex of a hull, where the next query's climb starts: GJK's and EPA's
+    // successive directions are close, so their support vertices are near each other. One query
+    // owns its pair, so the hint is never shared between threads.
+    mutable std::uint32_t hint = HullSupport<T>::none;
 
     Vec<T, 3> operator()(const Vec<T, 3>& d) const {
         const Vec<T, 3> local = rotation.transpose_times(d);
-        return rotation * (core ? shape->core_support(local) : shape->support(local)) + offset;
+        return rotation * (core ? shape->core_support(local, hint) : shape->support(local, hint)) +
+               offset;
     }
 };
 
@@ -84,8 +90,9 @@ ShapePair<T> make_shape_pair(const ConvexShape<T>& a, const Transform<T>& pose_a
     check_rigid_pose(pose_b, where, "pose_b");
     const Vec<T, 3> offset = pose_b.translation - pose_a.translation;
     const T scale = std::max({a.bounding_radius(), b.bounding_radius(), length(offset)});
-    return {{&a, pose_a.rotation, Vec<T, 3>{}, core},
-            {&b, pose_b.rotation, offset, core},
+    constexpr std::uint32_t none = HullSupport<T>::none;
+    return {{&a, pose_a.rotation, Vec<T, 3>{}, core, none},
+            {&b, pose_b.rotation, offset, core, none},
             pose_a.translation,
             T(64) * std::numeric_limits<T>::epsilon() * scale};
 }

@@ -6,15 +6,20 @@
 // collision. The lazy builds are guarded by std::call_once, so const queries on many threads may
 // trigger them at once; prepare() builds all three up front.
 //
-// World boxes: an instance's box is the box of its hull vertices under its pose, x' = R x + t
-// taken in the wider type W (double for float, long double for double) and rounded outward, then
-// padded by pose_pad() for the rounding of the queries' transforms. The hull's extent along each
-// axis is the geometry's (a linear map's extreme over a convex set is at a vertex), so a rotated
-// instance gets the tightest box there is, not the box of its rotated local box.
+// World boxes: an instance's box is the box of its hull vertices under its pose, x' = R x + t,
+// rounded outward, then padded by pose_pad() for the rounding of the queries' transforms. The
+// hull's extent along each axis is the geometry's (a linear map's extreme over a convex set is at
+// a vertex), so a rotated instance gets the tightest box there is, not the box of its rotated
+// local box. The extremes come from six support queries on the hull (rows of R, and their
+// negations), each climbing over the hull's neighbours (volumes/hull_support.hpp) instead of a
+// pass over every vertex: a pose change costs a few neighbourhoods per axis.
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <vector>
 
 #include "bvhkit/math/transform.hpp"
@@ -25,6 +30,7 @@
 #include "bvhkit/triangle_bvh.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/convex_hull.hpp"
+#include "bvhkit/volumes/hull_support.hpp"
 
 namespace bvhkit {
 
@@ -195,9 +201,8 @@ class SceneGeometry {
             for (const std::uint32_t k : tri) used.push_back(v[k]);
         }
         used = hull_detail::sorted_unique(std::move(used));
-        if (!used.empty())
-            for (const std::uint32_t k : quickhull_vertices<T>(used)) hull_.push_back(used[k]);
-        for (const Vec<T, 3>& v : hull_)
+        if (!used.empty()) hull_ = HullSupport<T>(std::span<const Vec<T, 3>>(used));
+        for (const Vec<T, 3>& v : hull_.vertices())
             for (std::size_t a = 0; a < 3; ++a) extent_ = std::max(extent_, W(std::fabs(W(v[a]))));
     }
     SceneGeometry(const SceneGeometry&) = delete;
@@ -206,7 +211,9 @@ class SceneGeometry {
     const BasicTriangleMesh<T>& mesh() const { return mesh_; }
     std::size_t triangle_count() const { return mesh_.triangles.size(); }
     /// The hull's vertices (empty when no triangle has finite corners).
-    const std::vector<Vec<T, 3>>& hull_vertices() const { return hull_; }
+    std::span<const Vec<T, 3>> hull_vertices() const { return hull_.vertices(); }
+    /// The hull's vertices with their neighbours, for support queries.
+    const HullSupport<T>& hull() const { return hull_; }
     bool has_extent() const { return !hull_.empty(); }
 
     /// The box of the geometry under `pose`, `pad` added on every side: rounded outward, never
@@ -214,14 +221,19 @@ class SceneGeometry {
     /// triangles gets the point box at t.
     Aabb<T, 3> world_box(const Transform<T>& pose, W pad) const {
         if (hull_.empty()) return Aabb<T, 3>(pose.translation, pose.translation);
+        // The vertices that reach farthest along -/+ each world axis: the exact maximisers of
+        // -/+ R_a . x (R_a the rotation's row a, negated exactly), so the extremes of R x + t over
+        // the whole hull are these vertices' values, each off only by its own rounding.
+        std::array<std::uint32_t, 6> extreme;
+        for (std::size_t a = 0; a < 3; ++a) {
+            extreme[2 * a] = hull_.support_index(-pose.rotation[a]);
+            extreme[2 * a + 1] = hull_.support_index(pose.rotation[a]);
+        }
         Vec<W, 3> lo, hi;
-        if (!extremes_in_double(pose, lo, hi)) {  // beyond double's range: the slow exact way
-            lo = Vec<W, 3>(std::numeric_limits<W>::infinity());
-            hi = Vec<W, 3>(-std::numeric_limits<W>::infinity());
-            for (const Vec<T, 3>& v : hull_) {
-                const Vec<W, 3> w = scene_detail::apply_wide<W>(pose, v);
-                for (std::size_t a = 0; a < 3; ++a)
-                    lo[a] = std::min(lo[a], w[a]), hi[a] = std::max(hi[a], w[a]);
+        if (!extremes_in_double(pose, extreme, lo, hi)) {  // beyond double's range: in W
+            for (std::size_t a = 0; a < 3; ++a) {
+                lo[a] = scene_detail::apply_wide<W>(pose, hull_.vertices()[extreme[2 * a]])[a];
+                hi[a] = scene_detail::apply_wide<W>(pose, hull_.vertices()[extreme[2 * a + 1]])[a];
             }
         }
         Aabb<T, 3> box;
@@ -232,33 +244,29 @@ class SceneGeometry {
         return box;
     }
 
-    /// The extremes of R x + t over the hull, each widened by a bound on its rounding, computed
-    /// in double: a pose change pays one pass over the hull, and long double (W for a double
-    /// mesh) costs several times double's arithmetic there. For a float mesh every product is
-    /// exact in double and the two sums and t round by at most 2 eps_d of 3.01 e + |t| (e the
-    /// hull's largest |coordinate|, |R_ab| <= 1 + 1e-4); for a double mesh the three products
-    /// add one rounding each: 4 eps_d of the same. False (nothing written) where a value leaves
-    /// double's range.
-    bool extremes_in_double(const Transform<T>& pose, Vec<W, 3>& lo_out, Vec<W, 3>& hi_out) const {
-        const Mat3<double> r(pose.rotation);
-        Vec<double, 3> lo(std::numeric_limits<double>::infinity()), hi(-lo[0]);
-        for (const Vec<T, 3>& v : hull_) {
-            const Vec<double, 3> x(v);
-            for (std::size_t a = 0; a < 3; ++a) {
-                const double w =
-                    r[a][0] * x[0] + r[a][1] * x[1] + r[a][2] * x[2] + double(pose.translation[a]);
-                lo[a] = std::min(lo[a], w);
-                hi[a] = std::max(hi[a], w);
-            }
-        }
+    /// The extremes of R x + t over the hull (coordinate a from the vertices extreme[2a], the
+    /// lowest, and extreme[2a + 1], the highest), each widened by a bound on its rounding,
+    /// computed in double: long double (W for a double mesh) costs several times double's
+    /// arithmetic. For a float mesh every product is exact in double and the two sums and t
+    /// round by at most 2 eps_d of 3.01 e + |t| (e the hull's largest |coordinate|, |R_ab| <= 1 +
+    /// 1e-4); for a double mesh the three products add one rounding each: 4 eps_d of the same.
+    /// The bound holds for each vertex's own value, and these vertices' exact values are the
+    /// exact extremes, so the widened values hold the exact extremes. False (nothing written)
+    /// where a value leaves double's range.
+    bool extremes_in_double(const Transform<T>& pose, const std::array<std::uint32_t, 6>& extreme,
+                            Vec<W, 3>& lo_out, Vec<W, 3>& hi_out) const {
         const double eps = std::numeric_limits<double>::epsilon();
         for (std::size_t a = 0; a < 3; ++a) {
-            const double slack =
-                4 * eps * (3.01 * double(extent_) + std::fabs(double(pose.translation[a])));
-            if (!(std::isfinite(lo[a]) && std::isfinite(hi[a]) && std::isfinite(slack)))
-                return false;
-            lo_out[a] = W(lo[a]) - W(slack);
-            hi_out[a] = W(hi[a]) + W(slack);
+            const Vec<double, 3> r(pose.rotation[a]);
+            const double t = double(pose.translation[a]);
+            const Vec<double, 3> x_lo(hull_.vertices()[extreme[2 * a]]),
+                x_hi(hull_.vertices()[extreme[2 * a + 1]]);
+            const double lo = r[0] * x_lo[0] + r[1] * x_lo[1] + r[2] * x_lo[2] + t;
+            const double hi = r[0] * x_hi[0] + r[1] * x_hi[1] + r[2] * x_hi[2] + t;
+            const double slack = 4 * eps * (3.01 * double(extent_) + std::fabs(t));
+            if (!(std::isfinite(lo) && std::isfinite(hi) && std::isfinite(slack))) return false;
+            lo_out[a] = W(lo) - W(slack);
+            hi_out[a] = W(hi) + W(slack);
         }
         return true;
     }
@@ -272,10 +280,11 @@ class SceneGeometry {
     ///
     ///   pad = 16 eps_T E + 8 eps_W (tau + 2 E) + 6 d E.
     ///
-    /// Why it suffices. (a) The box: extremes_in_double adds its own bound on its rounding; beyond
-    /// double's range each coordinate of R x + t is two products and three sums in W of terms at
-    /// most sqrt(3) E and tau, off by at most 3 eps_W (sqrt(3) E + tau) from the exact value,
-    /// which the second term covers; rounding outward to T only grows the box. (b) The
+    /// Why it suffices. (a) The box: its extremes are the values of the exact extreme vertices
+    /// (world_box), so only their own rounding counts: extremes_in_double adds its bound on it;
+    /// beyond double's range each coordinate of R x + t is two products and three sums in W of
+    /// terms at most sqrt(3) E and tau, off by at most 3 eps_W (sqrt(3) E + tau) from the exact
+    /// value, which the second term covers; rounding outward to T only grows the box. (b) The
     /// queries: a world point p goes to p' = R^T (p - t), the difference and the products taken
     /// in W (off by at most 3 eps_W |p - t|: relative to the local distance, not to |t|, because
     /// t is subtracted first) and rounded to T once (eps_T / 2 of each coordinate). A point
@@ -325,7 +334,7 @@ class SceneGeometry {
 
   private:
     BasicTriangleMesh<T> mesh_;
-    std::vector<Vec<T, 3>> hull_;
+    HullSupport<T> hull_;
     W extent_ = 0;  // the hull's largest |coordinate|
     mutable std::once_flag rays_once_, points_once_, collision_once_;
     mutable std::unique_ptr<TriangleBvh<T>> rays_;

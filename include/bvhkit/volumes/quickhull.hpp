@@ -26,6 +26,19 @@
 
 namespace bvhkit {
 
+/// The hull's surface as Quickhull leaves it, indices into the input points. `dimension` 3: the
+/// vertices and the triangles of a closed surface, each triangle counterclockwise seen from
+/// outside, every input point on or inside every triangle's plane (decided exactly), so the
+/// surface is convex, though neighbouring triangles may be coplanar and a vertex may lie inside a
+/// flat facet. 2: the vertices of a convex polygon in order round it, each a strict corner, no
+/// triangles. 0: the vertices only (three points or fewer, collinear points, or the fallback that
+/// keeps every point).
+struct HullSurface {
+    int dimension = 0;
+    std::vector<std::uint32_t> vertices;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
 namespace hull_detail {
 
 template <class T>
@@ -33,13 +46,24 @@ class Quickhull {
   public:
     explicit Quickhull(std::span<const Vec<T, 3>> points) : p_(points) {}
 
-    std::vector<std::uint32_t> vertices() {
+    HullSurface surface() {
+        HullSurface out;
         const std::size_t n = p_.size();
-        if (n <= 3) return all();
+        if (n <= 3) {
+            out.vertices = all();
+            return out;
+        }
         std::array<std::uint32_t, 4> s{};
         const int dimension = initial_simplex(s);
-        if (dimension == 1) return {s[0], s[1]};
-        if (dimension == 2) return planar_hull(s);
+        if (dimension == 1) {
+            out.vertices = {s[0], s[1]};
+            return out;
+        }
+        if (dimension == 2) {
+            out.dimension = 2;
+            out.vertices = planar_hull(s);
+            return out;
+        }
         build_tetrahedron(s);
         std::vector<std::uint32_t> rest;
         rest.reserve(n);
@@ -47,16 +71,21 @@ class Quickhull {
             if (i != s[0] && i != s[1] && i != s[2] && i != s[3]) rest.push_back(i);
         distribute(rest, 0);
         expand();
-        if (broken_) return all();  // cannot happen with exact tests; all points stay correct
+        if (broken_) {  // cannot happen with exact tests; all points stay correct
+            out.vertices = all();
+            return out;
+        }
+        out.dimension = 3;
         std::vector<char> used(n, 0);
-        std::vector<std::uint32_t> out;
         for (const Face& f : faces_)
-            if (f.alive)
+            if (f.alive) {
+                out.triangles.push_back(f.v);
                 for (std::uint32_t v : f.v)
                     if (!used[v]) {
                         used[v] = 1;
-                        out.push_back(v);
+                        out.vertices.push_back(v);
                     }
+            }
         return out;
     }
 
@@ -300,15 +329,15 @@ class Quickhull {
 
 }  // namespace hull_detail
 
-/// Indices of the hull's vertices among `sorted_unique` (sorted lexicographically, no
-/// duplicates): every input point lies in their convex hull, exactly.
+/// The hull's surface over `sorted_unique` (sorted lexicographically, no duplicates): every input
+/// point lies in the convex hull of its vertices, exactly.
 ///
 /// The orientation tests are exact only for coordinate differences within 2^±300 (predicates.hpp):
 /// a double model beyond about 1e77 or below 1e-77 is divided by a power of two first (an exact,
 /// order-keeping scaling), unless that would merge points (coordinates far below the rest sinking
 /// into denormals), where the points are taken as they are.
 template <class T>
-std::vector<std::uint32_t> quickhull_vertices(std::span<const Vec<T, 3>> sorted_unique) {
+HullSurface quickhull_surface(std::span<const Vec<T, 3>> sorted_unique) {
     if constexpr (sizeof(T) > sizeof(float)) {
         double m = 0;
         for (const Vec<T, 3>& p : sorted_unique)
@@ -322,10 +351,16 @@ std::vector<std::uint32_t> quickhull_vertices(std::span<const Vec<T, 3>> sorted_
                 if (i > 0 && scaled[i] == scaled[i - 1]) distinct = false;
             }
             if (distinct)
-                return hull_detail::Quickhull<T>(std::span<const Vec<T, 3>>(scaled)).vertices();
+                return hull_detail::Quickhull<T>(std::span<const Vec<T, 3>>(scaled)).surface();
         }
     }
-    return hull_detail::Quickhull<T>(sorted_unique).vertices();
+    return hull_detail::Quickhull<T>(sorted_unique).surface();
+}
+
+/// Indices of the hull's vertices among `sorted_unique` (quickhull_surface's vertices).
+template <class T>
+std::vector<std::uint32_t> quickhull_vertices(std::span<const Vec<T, 3>> sorted_unique) {
+    return quickhull_surface<T>(sorted_unique).vertices;
 }
 
 /// Lexicographic order, the order quickhull_vertices expects.
