@@ -143,85 +143,68 @@ inline bool pair_before(InstanceId a, InstanceId b, InstanceId c, InstanceId d) 
 
 }  // namespace scene_detail
 
-/// The closest pair of instances that the filters let collide (group/mask, not in `ignore`),
-/// a.index() < b.index(), with its distance (less the margins) and world witness points; nothing
-/// (both ids null, distance +inf) when no such pair has finite triangles on both sides.
-template <class T>
-SceneDistance<T> closest_pair(const Scene<T>& scene, std::span<const InstancePair> ignore = {}) {
-    using W = NearestWalkScalar<T>;
-    SceneDistance<T> best;
-    const auto skip = scene_detail::ignore_set(ignore);
-    const T largest = scene_detail::largest_margin(scene);
-    scene.for_each_instance([&](InstanceId a) {
-        const SceneInstance<T>& ra = scene.instance_at(a.proxy());
-        const SceneGeometry<T>& ga = scene.geometry_at(ra.geometry);
-        if (!ga.has_extent()) return;
-        const scene_detail::BoxReach<T> reach = scene_detail::box_reach(ra.box);
-        const AccurateScalar<T> margins = AccurateScalar<T>(ra.options.margin) + largest;
-        scene.top_level().query_nearest(reach.centre, [&](ProxyId proxy, W) -> W {
-            const InstanceId b(proxy);
-            if (b.index() > a.index()) {
-                const SceneInstance<T>& rb = scene.instance_at(proxy);
-                const T m = ra.options.margin + rb.options.margin;
-                SceneDistance<T> d;
-                if (may_collide(ra.options, rb.options) && !scene_detail::ignored(skip, a, b) &&
-                    scene_detail::may_beat(scene_detail::box_gap(ra.box, rb.box), m,
-                                           best.distance) &&
-                    scene_detail::measure(ga, ra.pose, scene.geometry_at(rb.geometry), rb.pose, m,
-                                          d) &&
-                    (d.distance < best.distance ||
-                     (d.distance == best.distance &&
-                      scene_detail::pair_before(a, b, best.a, best.b)))) {
-                    d.a = a, d.b = b;
-                    best = d;
-                }
-            }
-            return scene_detail::walk_bound(best.distance, reach.radius, margins);
-        });
-    });
-    return best;
-}
+namespace scene_detail {
 
-/// The closest pair (a of `first`, b of `second`) that the filters let collide and that is not in
-/// `ignore` (given in the same (first, second) order), with its distance (less the margins) and
-/// world witnesses; ties go to the lower (a's slot, b's slot). Nothing (both null, +inf) when no
-/// such pair has finite triangles on both sides. Each instance of `first` walks `second`'s top
-/// level nearest first, pruned by the running best. The scenes share no ids; one scene passed as
-/// both measures every instance against every other and against itself (distance 0).
-template <class T>
-SceneDistance<T> closest_pair(const Scene<T>& first, const Scene<T>& second,
-                              std::span<const InstancePair> ignore = {}) {
+/// The closest pair (a of `first`, b of `second`) with wanted(a, b) and may_collide: each
+/// instance of `first` walks `second`'s top level nearest first, pruned by the running best; ties
+/// go to the lower (a's slot, b's slot).
+template <class T, class Wanted>
+SceneDistance<T> closest_of(const Scene<T>& first, const Scene<T>& second, Wanted&& wanted) {
     using W = NearestWalkScalar<T>;
     SceneDistance<T> best;
-    std::vector<std::pair<std::uint64_t, std::uint64_t>> skip;
-    for (const InstancePair& p : ignore) skip.emplace_back(p.a.bits(), p.b.bits());
-    std::sort(skip.begin(), skip.end());
-    const T largest = scene_detail::largest_margin(second);
+    const T largest = largest_margin(second);
     first.for_each_instance([&](InstanceId a) {
         const SceneInstance<T>& ra = first.instance_at(a.proxy());
         const SceneGeometry<T>& ga = first.geometry_at(ra.geometry);
         if (!ga.has_extent()) return;
-        const scene_detail::BoxReach<T> reach = scene_detail::box_reach(ra.box);
+        const BoxReach<T> reach = box_reach(ra.box);
         const AccurateScalar<T> margins = AccurateScalar<T>(ra.options.margin) + largest;
         second.top_level().query_nearest(reach.centre, [&](ProxyId proxy, W) -> W {
             const InstanceId b(proxy);
             const SceneInstance<T>& rb = second.instance_at(proxy);
             const T m = ra.options.margin + rb.options.margin;
             SceneDistance<T> d;
-            if (may_collide(ra.options, rb.options) &&
-                !std::binary_search(skip.begin(), skip.end(), std::pair(a.bits(), b.bits())) &&
-                scene_detail::may_beat(scene_detail::box_gap(ra.box, rb.box), m, best.distance) &&
-                scene_detail::measure(ga, ra.pose, second.geometry_at(rb.geometry), rb.pose, m,
-                                      d) &&
-                (d.distance < best.distance || (d.distance == best.distance &&
-                                                scene_detail::pair_before(a, b, best.a, best.b)))) {
+            if (wanted(a, b) && may_collide(ra.options, rb.options) &&
+                may_beat(box_gap(ra.box, rb.box), m, best.distance) &&
+                measure(ga, ra.pose, second.geometry_at(rb.geometry), rb.pose, m, d) &&
+                (d.distance < best.distance ||
+                 (d.distance == best.distance && pair_before(a, b, best.a, best.b)))) {
                 d.a = a, d.b = b;
                 best = d;
             }
-            return scene_detail::walk_bound(best.distance, reach.radius, margins);
+            return walk_bound(best.distance, reach.radius, margins);
         });
     });
     return best;
+}
+
+}  // namespace scene_detail
+
+/// The closest pair of instances that the filters let collide (group/mask, not in `ignore`),
+/// a.index() < b.index(), with its distance (less the margins) and world witness points; nothing
+/// (both ids null, distance +inf) when no such pair has finite triangles on both sides.
+template <class T>
+SceneDistance<T> closest_pair(const Scene<T>& scene, std::span<const InstancePair> ignore = {}) {
+    const auto skip = scene_detail::ignore_set(ignore);
+    return scene_detail::closest_of(scene, scene, [&](InstanceId a, InstanceId b) {
+        return b.index() > a.index() && !scene_detail::ignored(skip, a, b);
+    });
+}
+
+/// The closest pair (a of `first`, b of `second`) that the filters let collide and that is not in
+/// `ignore` (given in the same (first, second) order), with its distance (less the margins) and
+/// world witnesses; ties go to the lower (a's slot, b's slot). Nothing (both null, +inf) when no
+/// such pair has finite triangles on both sides. The scenes share no ids; one scene passed as both
+/// measures every instance against every other and against itself (distance 0).
+template <class T>
+SceneDistance<T> closest_pair(const Scene<T>& first, const Scene<T>& second,
+                              std::span<const InstancePair> ignore = {}) {
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> skip;
+    for (const InstancePair& p : ignore) skip.emplace_back(p.a.bits(), p.b.bits());
+    std::sort(skip.begin(), skip.end());
+    return scene_detail::closest_of(first, second, [&](InstanceId a, InstanceId b) {
+        return !std::binary_search(skip.begin(), skip.end(), std::pair(a.bits(), b.bits()));
+    });
 }
 
 /// Every pair of instances that the filters let collide and whose distance (less the margins) is
