@@ -19,16 +19,7 @@ namespace bvhkit {
 namespace {
 
 using scene_test::LD;
-
-template <class T>
-BasicTriangleMesh<T> sphere_mesh(std::uint32_t subdivisions, double scale) {
-    const TriangleMesh m = make_sphere(subdivisions);
-    BasicTriangleMesh<T> out;
-    for (const auto& v : m.vertices)
-        out.vertices.push_back(Vec<T, 3>(T(v[0] * scale), T(v[1] * scale), T(v[2] * scale)));
-    out.triangles = m.triangles;
-    return out;
-}
+using scene_test::sphere_mesh;
 
 /// The radii of the balls a convex polyhedron around the origin lies between: the least distance
 /// of a face's plane, the largest of a vertex (long double).

@@ -18,6 +18,7 @@ namespace bvhkit::distance_test {
 namespace {
 
 using scene_test::LD;
+using scene_test::sphere_mesh;
 
 template <class T>
 BasicTriangleMesh<T> cube_mesh(T h) {
@@ -27,16 +28,6 @@ BasicTriangleMesh<T> cube_mesh(T h) {
     m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                    {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
     return m;
-}
-
-template <class T>
-BasicTriangleMesh<T> sphere_mesh(std::uint32_t subdivisions, double scale) {
-    const TriangleMesh m = make_sphere(subdivisions);
-    BasicTriangleMesh<T> out;
-    for (const auto& v : m.vertices)
-        out.vertices.push_back(Vec<T, 3>(T(v[0] * scale), T(v[1] * scale), T(v[2] * scale)));
-    out.triangles = m.triangles;
-    return out;
 }
 
 template <class T>

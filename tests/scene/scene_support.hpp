@@ -10,12 +10,24 @@
 #include <vector>
 
 #include "bvhkit/math/random.hpp"
+#include "bvhkit/mesh/procedural.hpp"
 #include "bvhkit/scene/scene.hpp"
 
 namespace bvhkit::scene_test {
 
 using LD = long double;
 using V3 = Vec<LD, 3>;
+
+/// The icosphere of `subdivisions` at radius `scale`, in T.
+template <class T>
+BasicTriangleMesh<T> sphere_mesh(std::uint32_t subdivisions, double scale) {
+    const TriangleMesh m = make_sphere(subdivisions);
+    BasicTriangleMesh<T> out;
+    for (const auto& v : m.vertices)
+        out.vertices.push_back(Vec<T, 3>(T(v[0] * scale), T(v[1] * scale), T(v[2] * scale)));
+    out.triangles = m.triangles;
+    return out;
+}
 
 template <class T>
 V3 wide(const Vec<T, 3>& v) {
