@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -372,6 +373,25 @@ TEST(MeshPenetration, ConvexDepthIsExactOnlyWhereEpaCanBeTrusted) {
             EXPECT_EQ(r.quality, DepthQuality::LocalOptimum) << s;
         }
     }
+}
+
+TEST(MeshPenetration, OptionsOutOfRangeAreErrors) {
+    const Solid a(box({0, 0, 0}, {2, 2, 2})), b(box({0, 0, 0}, {1, 1, 1}));
+    const auto with = [](auto change) {
+        MeshPenetrationOptions o;
+        change(o);
+        return o;
+    };
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (const MeshPenetrationOptions& o : {with([](auto& o) { o.max_overlap_tests = 0; }),
+                                            with([](auto& o) { o.smallest_angle = 0; }),
+                                            with([&](auto& o) { o.smallest_angle = nan; }),
+                                            with([](auto& o) { o.search_precision = 1; }),
+                                            with([&](auto& o) { o.final_precision = nan; }),
+                                            with([](auto& o) { o.final_precision = -1e-6; })})
+        EXPECT_THROW(signed_distance_between(a, b, shift({1.7, 0.5, 0.5}), o), Error);
+    EXPECT_NO_THROW(
+        signed_distance_between(a, b, shift({1.7, 0.5, 0.5}), MeshPenetrationOptions{}));
 }
 
 TEST(MeshPenetration, ContinuityThroughContact) {

@@ -76,6 +76,22 @@ struct MeshPenetrationOptions {
 
 namespace penetration_detail {
 
+/// Error naming the first option out of its range: a budget below one test, a step or a bracket
+/// that is not finite and positive (a zero step would search until the budget runs out).
+inline void check_options(const MeshPenetrationOptions& o) {
+    const auto fail = [](const char* name, double value, const char* range) {
+        throw Error(std::string("signed_distance_between: options.") + name + " = " +
+                    std::to_string(value) + " must be " + range);
+    };
+    if (o.max_overlap_tests < 1) fail("max_overlap_tests", o.max_overlap_tests, ">= 1");
+    if (!(o.smallest_angle > 0 && o.smallest_angle <= 3.2))
+        fail("smallest_angle", o.smallest_angle, "in (0, pi] radians");
+    if (!(o.search_precision > 0 && o.search_precision < 1))
+        fail("search_precision", o.search_precision, "in (0, 1)");
+    if (!(o.final_precision > 0 && o.final_precision < 1))
+        fail("final_precision", o.final_precision, "in (0, 1)");
+}
+
 template <BoundingVolume V>
 class DepthSearch {
   public:
@@ -322,6 +338,7 @@ MeshSignedDistance<typename V::Scalar> signed_distance_between(
     const MeshPenetrationOptions& options = {}) {
     using T = typename V::Scalar;
     check_rigid_pose(pose_of_b_in_a, "signed_distance_between", "pose_of_b_in_a");
+    penetration_detail::check_options(options);
     MeshSignedDistance<T> r;
     penetration_detail::DepthSearch<V> s(a, b, pose_of_b_in_a, options);
     // Apart, by the exact decision (no face meets, no piece inside the other solid): the
