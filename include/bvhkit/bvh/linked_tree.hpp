@@ -423,7 +423,6 @@ class LinkedTree {
         }
     }
 
-
     std::vector<Node> nodes_;
     std::int32_t root_ = null;
     std::int32_t free_ = null;
