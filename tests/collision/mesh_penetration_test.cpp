@@ -181,20 +181,22 @@ TEST(MeshPenetration, OpenMeshAndBadPoseAreErrors) {
     EXPECT_THROW(signed_distance_between(a, a, bad), Error);
 }
 
+/// Two meshes as one (b's vertices after a's).
+Mesh joined(const Mesh& a, const Mesh& b) {
+    Mesh m = a;
+    const auto n = std::uint32_t(a.vertices.size());
+    m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
+    for (const auto& t : b.triangles) m.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+    return m;
+}
+
 TEST(MeshPenetration, Convexity) {
     EXPECT_TRUE(Solid(box({0, 0, 0}, {1, 2, 3})).convex());
     EXPECT_TRUE(Solid(sphere({0, 0, 0}, 1, 2)).convex());
     EXPECT_FALSE(Solid(l_solid()).convex());
     EXPECT_FALSE(Solid(torus(2, 0.5, 24, 12)).convex());
     // Two disjoint boxes: every edge convex, but two pieces.
-    Mesh two = box({0, 0, 0}, {1, 1, 1});
-    const Mesh other = box({3, 0, 0}, {4, 1, 1});
-    for (auto t : other.triangles) {
-        for (auto& i : t) i += 8;
-        two.triangles.push_back(t);
-    }
-    two.vertices.insert(two.vertices.end(), other.vertices.begin(), other.vertices.end());
-    EXPECT_FALSE(Solid(two).convex());
+    EXPECT_FALSE(Solid(joined(box({0, 0, 0}, {1, 1, 1}), box({3, 0, 0}, {4, 1, 1}))).convex());
 }
 
 TEST(MeshPenetration, BoxesApartAndInto) {
@@ -315,15 +317,6 @@ TEST(MeshPenetration, FloatModels) {
     r = signed_distance_between(l, b, q);
     EXPECT_NEAR(r.signed_distance, -0.2f, 1e-4f);
     EXPECT_TRUE(r.verified);
-}
-
-/// Two meshes as one (b's vertices after a's).
-Mesh joined(const Mesh& a, const Mesh& b) {
-    Mesh m = a;
-    const auto n = std::uint32_t(a.vertices.size());
-    m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
-    for (const auto& t : b.triangles) m.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
-    return m;
 }
 
 TEST(MeshPenetration, EveryPieceOfASolidIsAskedWhetherItIsInside) {

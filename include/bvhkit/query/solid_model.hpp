@@ -32,10 +32,13 @@ namespace bvhkit {
 
 namespace solid_detail {
 
-/// Whether a closed mesh (welded ids `weld`) is convex: one connected piece, Euler characteristic
-/// 2, every edge shared by exactly two triangles and convex (see the header comment).
+/// Whether a closed mesh (welded ids `weld`, `pieces` connected pieces: piece_probes) is convex:
+/// one piece, Euler characteristic 2, every edge shared by exactly two triangles and convex (see
+/// the header comment).
 template <IndexedTriangleMesh M>
-bool closed_mesh_is_convex(const M& mesh, const std::vector<std::uint32_t>& weld) {
+bool closed_mesh_is_convex(const M& mesh, const std::vector<std::uint32_t>& weld,
+                           std::size_t pieces) {
+    if (pieces != 1) return false;
     using D = Vec<double, 3>;
     const std::size_t nt = mesh.triangle_count();
     // Directed edges (from, to) -> triangle, sorted for the twin's look-up.
@@ -56,19 +59,11 @@ bool closed_mesh_is_convex(const M& mesh, const std::vector<std::uint32_t>& weld
     std::sort(edges.begin(), edges.end());
     for (std::size_t k = 1; k < edges.size(); ++k)
         if (edges[k].first == edges[k - 1].first) return false;  // an edge used twice one way
-    // Union-find over the welded ids for the connected pieces.
-    std::vector<std::uint32_t> parent(ids);
-    std::iota(parent.begin(), parent.end(), 0u);
-    const auto root = [&](std::uint32_t x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    };
     std::vector<char> used(ids, 0);
     const double diagonal = length(box.max - box.min);
     for (const auto& [key, tri] : edges) {
         const std::uint32_t a = std::uint32_t(key >> 32), b = std::uint32_t(key);
         used[a] = used[b] = 1;
-        parent[root(a)] = root(b);
         const std::uint64_t twin_key = (std::uint64_t(b) << 32) | a;
         const auto twin = std::lower_bound(edges.begin(), edges.end(),
                                            std::pair<std::uint64_t, std::uint32_t>(twin_key, 0));
@@ -83,15 +78,8 @@ bool closed_mesh_is_convex(const M& mesh, const std::vector<std::uint32_t>& weld
             if (dot(n, D(mesh.vertex(u[k])) - p0) > 1e-9 * diagonal * length(n)) return false;
         }
     }
-    std::uint32_t vertices = 0, pieces = 0;
-    for (std::uint32_t x = 0; x < ids; ++x) {
-        if (!used[x]) continue;
-        ++vertices;
-        if (root(x) == x) ++pieces;
-    }
-    const std::int64_t euler =
-        std::int64_t(vertices) - std::int64_t(edges.size() / 2) + std::int64_t(nt);
-    return pieces == 1 && euler == 2;
+    const auto vertices = std::int64_t(std::count(used.begin(), used.end(), char(1)));
+    return vertices - std::int64_t(edges.size() / 2) + std::int64_t(nt) == 2;
 }
 
 /// One corner of a triangle of each connected piece (triangles joined through welded corners),
@@ -147,9 +135,9 @@ class SolidModel {
             throw Error(
                 "SolidModel: the mesh is not closed (an edge, after welding equal corners, is not "
                 "used as often in one direction as in the other); its interior is undefined");
-        convex_ = solid_detail::closed_mesh_is_convex(mesh, weld);
         for (const auto& p : solid_detail::piece_probes(mesh, weld))
             probes_.push_back(Vec<T, 3>(p));
+        convex_ = solid_detail::closed_mesh_is_convex(mesh, weld, probes_.size());
     }
 
     const CollisionModel<V>& collision() const { return collision_; }
