@@ -476,5 +476,42 @@ TEST(SceneQueries, ManyThreadsBuildTheTreesOnceAndAgree) {
     }
 }
 
+// The batch calls on every thread give each ray the one-by-one answer (a scene whose trees the
+// batch itself builds), and lengths that differ are Errors.
+TEST(SceneQueries, BatchesOnAllThreadsEqualOneByOne) {
+    RandomScene<float> rs(1, 0, 16, 37);
+    std::vector<Ray<float, 3>> rays;
+    SplitMix64 rng(5);
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3f o(float(rng.uniform(-6, 6)), float(rng.uniform(-6, 6)),
+                      float(rng.uniform(-6, 6)));
+        const Vec3d d = rng.unit_vector();
+        rays.push_back(Ray<float, 3>(o, Vec3f(float(d[0]), float(d[1]), float(d[2]))));
+    }
+    const std::span<const Ray<float, 3>> all(rays);
+    std::vector<SceneHit<float>> hits(rays.size()), serial(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size(), 7), occluded_serial(rays.size(), 7);
+    closest_hits(rs.scene, all, std::span(hits));  // every core
+    any_hits(rs.scene, all, std::span(occluded), 0u);
+    closest_hits(rs.scene, all, std::span(serial), 1u);
+    any_hits(rs.scene, all, std::span(occluded_serial), 1u);
+    int hit = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const SceneHit<float> one = closest_hit(rs.scene, rays[i]);
+        EXPECT_EQ(hits[i].t, one.t);
+        EXPECT_EQ(hits[i].face, one.face);
+        EXPECT_EQ(hits[i].instance, one.instance);
+        EXPECT_EQ(serial[i].t, one.t);
+        EXPECT_EQ(occluded[i], std::uint8_t(any_hit(rs.scene, rays[i])));
+        EXPECT_EQ(occluded_serial[i], occluded[i]);
+        EXPECT_EQ(bool(occluded[i]), bool(one));  // any hit exactly when a closest hit
+        hit += bool(one);
+    }
+    EXPECT_GT(hit, 150);  // the rays meet the scene: the comparison is not of misses only
+    EXPECT_GT(int(rays.size()) - hit, 150);
+    EXPECT_THROW(closest_hits(rs.scene, all, std::span(hits).first(5)), Error);
+    EXPECT_THROW(any_hits(rs.scene, all, std::span(occluded).first(5)), Error);
+}
+
 }  // namespace
 }  // namespace bvhkit

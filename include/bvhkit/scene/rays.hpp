@@ -18,10 +18,13 @@
 // leaves T's finite range in an instance's frame (a direction of 3e38 rotated 45 degrees, an
 // origin 3e38 from an instance at -3e38) misses that instance.
 #include <algorithm>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "bvhkit/exec/executor.hpp"
+#include "bvhkit/query/triangle_rays.hpp"
 #include "bvhkit/scene/scene.hpp"
 
 namespace bvhkit {
@@ -38,6 +41,12 @@ struct SceneHit {
 };
 
 namespace scene_detail {
+
+inline void check_batch(std::size_t rays, std::size_t out, const char* what) {
+    if (rays != out)
+        throw Error(std::string(what) + " holds " + std::to_string(out) + " entries for " +
+                    std::to_string(rays) + " rays");
+}
 
 template <class T>
 bool check_scene_ray(const Ray<T, 3>& ray, const char* where) {
@@ -141,16 +150,38 @@ void all_hits(const Scene<T>& scene, const Ray<T, 3>& ray, std::vector<SceneHit<
     });
 }
 
-/// hits[i] = closest_hit(scene, rays[i]) for every ray, on the calling thread (serial: call it
-/// from several threads on parts of a batch to use more cores). Error when the spans' lengths
-/// differ.
+/// hits[i] = closest_hit(scene, rays[i]) for every ray, on `threads` threads (0 = every core, 1 =
+/// the calling thread; several only when bvhkit has oneTBB) or on an Executor. Rays go in fixed
+/// chunks and each answer is its ray's alone, so the answers equal the one-by-one calls for any
+/// thread count. The first rays to reach a geometry build its ray tree (once, under call_once).
+/// Error when the spans' lengths differ.
 template <class T>
 void closest_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
-                  std::span<SceneHit<T>> hits) {
-    if (rays.size() != hits.size())
-        throw Error("closest_hits(Scene): " + std::to_string(rays.size()) + " rays but " +
-                    std::to_string(hits.size()) + " hits");
-    for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(scene, rays[i]);
+                  std::span<SceneHit<T>> hits, const Executor& exec) {
+    scene_detail::check_batch(rays.size(), hits.size(), "closest_hits(Scene): hits");
+    exec.parallel_for(rays.size(), ray_batch_grain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) hits[i] = closest_hit(scene, rays[i]);
+    });
+}
+template <class T>
+void closest_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
+                  std::span<SceneHit<T>> hits, unsigned threads = 0) {
+    closest_hits(scene, rays, hits, Executor(threads));
+}
+
+/// occluded[i] = any_hit(scene, rays[i]) (1 or 0) for every ray, threads as closest_hits.
+template <class T>
+void any_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
+              std::span<std::uint8_t> occluded, const Executor& exec) {
+    scene_detail::check_batch(rays.size(), occluded.size(), "any_hits(Scene): occluded");
+    exec.parallel_for(rays.size(), ray_batch_grain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) occluded[i] = std::uint8_t(any_hit(scene, rays[i]));
+    });
+}
+template <class T>
+void any_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
+              std::span<std::uint8_t> occluded, unsigned threads = 0) {
+    any_hits(scene, rays, occluded, Executor(threads));
 }
 
 }  // namespace bvhkit
