@@ -366,6 +366,7 @@ void check_two_scenes(double scale, double offset, std::uint64_t seed) {
     for (int k = 0; k < 10; ++k)
         ignore.push_back({ids1[rng.next() % ids1.size()], ids2[rng.next() % ids2.size()]});
     std::vector<InstancePair> expected;
+    std::vector<std::pair<InstancePair, T>> measured;  // every wanted pair, distance less margins
     // The closest pair by every pair's one-pair distance less the margins, the lower (a's slot,
     // b's slot) on a tie.
     T closest = std::numeric_limits<T>::infinity();
@@ -387,6 +388,7 @@ void check_two_scenes(double scale, double offset, std::uint64_t seed) {
                 m == T(0) ? d
                           : scene_detail::narrow<T>(AccurateScalar<T>(d) - AccurateScalar<T>(m));
             if (less < closest) closest = less, closest_ids = {a, b};
+            measured.push_back({{a, b}, less});
             if (m == T(0) ? collides(ma, mb, rel) : d <= m) expected.push_back({a, b});
         }
     const SceneDistance<T> nearest = closest_pair(s1, s2, ignore);
@@ -394,6 +396,26 @@ void check_two_scenes(double scale, double offset, std::uint64_t seed) {
     EXPECT_EQ(nearest.a, closest_ids.a);
     EXPECT_EQ(nearest.b, closest_ids.b);
     EXPECT_FALSE(closest_pair(s1, Scene<T>(), ignore));
+    // Pairs within thresholds that keep none, some and all of them.
+    std::sort(measured.begin(), measured.end());
+    for (const double t : {-1.0, 0.0, 0.5, 2.0, 1e30}) {
+        const T threshold = T(t * scale);
+        std::vector<SceneDistance<T>> within;
+        pairs_within(s1, s2, threshold, within, ignore);
+        std::vector<std::pair<InstancePair, T>> want;
+        for (const auto& m : measured)
+            if (m.second <= threshold) want.push_back(m);
+        ASSERT_EQ(within.size(), want.size()) << "threshold " << t;
+        for (std::size_t i = 0; i < want.size(); ++i) {
+            EXPECT_EQ((InstancePair{within[i].a, within[i].b}), want[i].first);
+            EXPECT_EQ(within[i].distance, want[i].second);
+        }
+        if (t == 2.0) {
+            EXPECT_GT(want.size(), 3u);
+        }
+    }
+    std::vector<SceneDistance<T>> none;
+    EXPECT_THROW(pairs_within(s1, s2, std::numeric_limits<T>::quiet_NaN(), none), Error);
     std::sort(expected.begin(), expected.end());
     std::vector<InstancePair> found;
     colliding_pairs(s1, s2, found, ignore);

@@ -207,45 +207,81 @@ SceneDistance<T> closest_pair(const Scene<T>& first, const Scene<T>& second,
     });
 }
 
-/// Every pair of instances that the filters let collide and whose distance (less the margins) is
-/// at most `threshold`, sorted by (a's slot, b's slot), each with its witnesses: `out` is cleared,
-/// then filled. Error on a NaN threshold (+inf gives every pair with finite triangles).
-template <class T>
-void pairs_within(const Scene<T>& scene, T threshold, std::vector<SceneDistance<T>>& out,
-                  std::span<const InstancePair> ignore = {}) {
+namespace scene_detail {
+
+/// Every pair (a of `first`, b of `second`) with wanted(a, b), may_collide and distance (less the
+/// margins) at most `threshold`, appended to `out` in (a's slot, b's slot) order: each instance
+/// of `first` walks `second`'s top level nearest first, out to the threshold's bound.
+template <class T, class Wanted>
+void within_of(const Scene<T>& first, const Scene<T>& second, T threshold, Wanted&& wanted,
+               std::vector<SceneDistance<T>>& out) {
     using W = NearestWalkScalar<T>;
-    if (std::isnan(threshold)) throw Error("pairs_within(Scene): threshold is NaN");
-    out.clear();
-    const auto skip = scene_detail::ignore_set(ignore);
-    const T largest = scene_detail::largest_margin(scene);
-    scene.for_each_instance([&](InstanceId a) {
-        const SceneInstance<T>& ra = scene.instance_at(a.proxy());
-        const SceneGeometry<T>& ga = scene.geometry_at(ra.geometry);
+    const T largest = largest_margin(second);
+    first.for_each_instance([&](InstanceId a) {
+        const SceneInstance<T>& ra = first.instance_at(a.proxy());
+        const SceneGeometry<T>& ga = first.geometry_at(ra.geometry);
         if (!ga.has_extent()) return;
-        const std::size_t first = out.size();
-        const scene_detail::BoxReach<T> reach = scene_detail::box_reach(ra.box);
-        const W bound = scene_detail::walk_bound(threshold, reach.radius,
-                                                 AccurateScalar<T>(ra.options.margin) + largest);
-        scene.top_level().query_nearest(reach.centre, [&](ProxyId proxy, W) -> W {
+        const std::size_t begin = out.size();
+        const BoxReach<T> reach = box_reach(ra.box);
+        const W bound =
+            walk_bound(threshold, reach.radius, AccurateScalar<T>(ra.options.margin) + largest);
+        second.top_level().query_nearest(reach.centre, [&](ProxyId proxy, W) -> W {
             const InstanceId b(proxy);
-            if (b.index() <= a.index()) return bound;
-            const SceneInstance<T>& rb = scene.instance_at(proxy);
+            const SceneInstance<T>& rb = second.instance_at(proxy);
             const T m = ra.options.margin + rb.options.margin;
             SceneDistance<T> d;
-            if (may_collide(ra.options, rb.options) && !scene_detail::ignored(skip, a, b) &&
-                scene_detail::may_beat(scene_detail::box_gap(ra.box, rb.box), m, threshold) &&
-                scene_detail::measure(ga, ra.pose, scene.geometry_at(rb.geometry), rb.pose, m, d) &&
+            if (wanted(a, b) && may_collide(ra.options, rb.options) &&
+                may_beat(box_gap(ra.box, rb.box), m, threshold) &&
+                measure(ga, ra.pose, second.geometry_at(rb.geometry), rb.pose, m, d) &&
                 d.distance <= threshold) {
                 d.a = a, d.b = b;
                 out.push_back(d);
             }
             return bound;
         });
-        std::sort(out.begin() + std::ptrdiff_t(first), out.end(),
+        std::sort(out.begin() + std::ptrdiff_t(begin), out.end(),
                   [](const SceneDistance<T>& x, const SceneDistance<T>& y) {
                       return x.b.index() < y.b.index();
                   });
     });
+}
+
+}  // namespace scene_detail
+
+/// Every pair of instances that the filters let collide and whose distance (less the margins) is
+/// at most `threshold`, sorted by (a's slot, b's slot), each with its witnesses: `out` is cleared,
+/// then filled. Error on a NaN threshold (+inf gives every pair with finite triangles).
+template <class T>
+void pairs_within(const Scene<T>& scene, T threshold, std::vector<SceneDistance<T>>& out,
+                  std::span<const InstancePair> ignore = {}) {
+    if (std::isnan(threshold)) throw Error("pairs_within(Scene): threshold is NaN");
+    out.clear();
+    const auto skip = scene_detail::ignore_set(ignore);
+    scene_detail::within_of(
+        scene, scene, threshold,
+        [&](InstanceId a, InstanceId b) {
+            return b.index() > a.index() && !scene_detail::ignored(skip, a, b);
+        },
+        out);
+}
+
+/// Every pair (a of `first`, b of `second`) that the filters let collide, not in `ignore` (given in
+/// the same (first, second) order), whose distance (less the margins) is at most `threshold`,
+/// sorted by (a's slot, b's slot): `out` is cleared, then filled. Error on a NaN threshold.
+template <class T>
+void pairs_within(const Scene<T>& first, const Scene<T>& second, T threshold,
+                  std::vector<SceneDistance<T>>& out, std::span<const InstancePair> ignore = {}) {
+    if (std::isnan(threshold)) throw Error("pairs_within(Scene, Scene): threshold is NaN");
+    out.clear();
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> skip;
+    for (const InstancePair& p : ignore) skip.emplace_back(p.a.bits(), p.b.bits());
+    std::sort(skip.begin(), skip.end());
+    scene_detail::within_of(
+        first, second, threshold,
+        [&](InstanceId a, InstanceId b) {
+            return !std::binary_search(skip.begin(), skip.end(), std::pair(a.bits(), b.bits()));
+        },
+        out);
 }
 
 /// The instance nearest to the scene's geometry `geometry` placed at `pose` with `options` (its
