@@ -40,6 +40,7 @@
 #include "bvhkit/scene/closest_point.hpp"
 #include "bvhkit/scene/collision.hpp"
 #include "bvhkit/scene/distance.hpp"
+#include "bvhkit/scene/face_contacts.hpp"
 #include "bvhkit/scene/rays.hpp"
 #include "bvhkit/scene/scene_file.hpp"
 #include "bvhkit/triangle_bvh.hpp"

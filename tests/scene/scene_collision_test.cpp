@@ -6,6 +6,7 @@
 // single-pair reference runs on every pair whose centres are not surely too far apart.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <set>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "bvhkit/mesh/procedural.hpp"
 #include "bvhkit/primitives/triangle_triangle.hpp"
 #include "bvhkit/scene/collision.hpp"
+#include "bvhkit/scene/face_contacts.hpp"
 #include "scene_support.hpp"
 
 namespace bvhkit {
@@ -219,12 +221,15 @@ TEST(SceneCollision, PairsAgreeWithATriangleLoop) {
     }
     const scene_test::WorldMesh<double> world(scene);
     std::set<std::pair<std::int32_t, std::int32_t>> expected;
+    std::set<std::array<std::int64_t, 4>> expected_faces;
     for (const auto& x : world.triangles)
         for (const auto& y : world.triangles)
             if (x.instance.index() < y.instance.index() &&
                 triangles_intersect(Triangle<double>{x.p[0], x.p[1], x.p[2]},
-                                    Triangle<double>{y.p[0], y.p[1], y.p[2]}))
+                                    Triangle<double>{y.p[0], y.p[1], y.p[2]})) {
                 expected.insert({x.instance.index(), y.instance.index()});
+                expected_faces.insert({x.instance.index(), y.instance.index(), x.face, y.face});
+            }
     std::vector<InstancePair> pairs;
     colliding_pairs(scene, pairs);
     std::set<std::pair<std::int32_t, std::int32_t>> found;
@@ -232,6 +237,24 @@ TEST(SceneCollision, PairsAgreeWithATriangleLoop) {
     EXPECT_EQ(found, expected);
     EXPECT_GT(expected.size(), 5u);
     EXPECT_EQ(any_collision(scene), !expected.empty());
+    // The face contacts: the same triangle pairs as the loop, each segment on both triangles.
+    std::vector<SceneFaceContact<double>> contacts;
+    colliding_faces(scene, contacts);
+    std::set<std::array<std::int64_t, 4>> found_faces;
+    for (const auto& c : contacts) {
+        EXPECT_FALSE(c.separated);
+        found_faces.insert({c.a.index(), c.b.index(), c.face_a, c.face_b});
+        for (const auto& end : {c.p, c.q}) {
+            EXPECT_LT(scene_test::point_triangle_distance(scene_test::wide(end),
+                                                          *world.find(c.a, c.face_a)),
+                      1e-8);
+            EXPECT_LT(scene_test::point_triangle_distance(scene_test::wide(end),
+                                                          *world.find(c.b, c.face_b)),
+                      1e-8);
+        }
+    }
+    EXPECT_EQ(found_faces, expected_faces);
+    EXPECT_EQ(found_faces.size(), contacts.size());  // each triangle pair once
 }
 
 // Touching counts as colliding; a gap does not, unless the margins cover it.
@@ -260,6 +283,18 @@ TEST(SceneCollision, TouchingGapsAndMargins) {
         EXPECT_FALSE(any_collision(scene));
         scene.set_options(a, {.margin = 6.5e-4});
         EXPECT_TRUE(any_collision(scene));
+        // Colliding through the margins only: one separated entry, the closest points 1e-3 apart.
+        std::vector<SceneFaceContact<double>> contacts;
+        colliding_faces(scene, contacts);
+        ASSERT_EQ(contacts.size(), 1u);
+        EXPECT_TRUE(contacts[0].separated);
+        EXPECT_NEAR(double(scene_test::norm3(scene_test::wide(contacts[0].p) -
+                                             scene_test::wide(contacts[0].q))),
+                    1e-3, 1e-9);
+        // The left tetrahedron's point on its face x = far, the right one's at far - 1e-3.
+        const bool left_first = contacts[0].a == a;
+        EXPECT_NEAR((left_first ? contacts[0].p : contacts[0].q)[0], far, 1e-9);
+        EXPECT_NEAR((left_first ? contacts[0].q : contacts[0].p)[0], far - 1e-3, 1e-9);
         // Groups that exclude each other never collide.
         scene.set_options(a, {.group = 1, .mask = 1, .margin = 1});
         scene.set_options(b, {.group = 2, .mask = 3, .margin = 1});
