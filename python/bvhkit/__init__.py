@@ -67,6 +67,7 @@ __all__ = [
     "SceneIntersections",
     "SceneClosest",
     "SceneDistances",
+    "SceneFaceContacts",
     "pinhole_rays",
     "MissingFileError",
 ]
@@ -473,6 +474,7 @@ from ._instances import (  # noqa: E402
     Scene,
     SceneClosest,
     SceneDistances,
+    SceneFaceContacts,
     SceneHits,
     SceneIntersections,
 )

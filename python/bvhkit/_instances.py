@@ -22,6 +22,7 @@ from ._scene_args import (
     _U64,
     SceneClosest,
     SceneDistances,
+    SceneFaceContacts,
     SceneHits,
     SceneIntersections,
     _ids,
@@ -504,6 +505,25 @@ class Scene:
         o = self._other(other)
         return bool(self._impl.any_collision_with(o, self._ignore(ignore)))
 
+    def colliding_faces(self, ignore: Optional[npt.ArrayLike] = None) -> SceneFaceContacts:
+        """Where the colliding pairs of :meth:`colliding_pairs` touch: for each pair, every
+        pair of its triangles that cross, with the world-space segment where they do
+        (:class:`SceneFaceContacts`); a pair that collides only through its margins gives one
+        entry, its closest triangles and points, marked ``separated``."""
+        return self._faces(self._impl.colliding_faces(self._ignore(ignore)))
+
+    def colliding_faces_with(self, other: "Scene", ignore: Optional[npt.ArrayLike] = None
+                             ) -> SceneFaceContacts:
+        """:meth:`colliding_faces` for the pairs of :meth:`colliding_pairs_with`."""
+        o = self._other(other)
+        return self._faces(self._impl.colliding_faces_with(o, self._ignore(ignore)))
+
+    @staticmethod
+    def _faces(raw: tuple) -> SceneFaceContacts:
+        pairs, faces, p, q, coplanar, separated = raw
+        return SceneFaceContacts(pairs, faces, p, q, coplanar.view(np.bool_),
+                                 separated.view(np.bool_))
+
     # ------------------------------------------------------------------ distance
 
     def closest_pair(self, ignore: Optional[npt.ArrayLike] = None) -> SceneDistances:
@@ -529,6 +549,17 @@ class Scene:
         if math.isnan(t):
             raise ValueError("threshold: must not be NaN")
         return SceneDistances(*self._impl.pairs_within(t, self._ignore(ignore)))
+
+    def pairs_within_with(self, other: "Scene", threshold: float,
+                          ignore: Optional[npt.ArrayLike] = None) -> SceneDistances:
+        """Every pair (a of this scene, b of ``other``) that may collide whose distance (less
+        both margins) is at most ``threshold``, sorted by a's slot then b's. ``ignore``: (q, 2)
+        rows (id of this scene, id of other)."""
+        o = self._other(other)
+        t = _a.number("threshold", threshold)
+        if math.isnan(t):
+            raise ValueError("threshold: must not be NaN")
+        return SceneDistances(*self._impl.pairs_within_with(o, t, self._ignore(ignore)))
 
     def closest_instance(
         self,

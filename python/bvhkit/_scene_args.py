@@ -86,6 +86,26 @@ class SceneDistances(NamedTuple):
     """(p, 2) int64 the faces the two points lie on."""
 
 
+class SceneFaceContacts(NamedTuple):
+    """What :meth:`Scene.colliding_faces` returns: one entry per crossing triangle pair of each
+    colliding pair of instances (or, for a pair that collides only through its margins, one
+    entry with its closest triangles, ``separated``)."""
+
+    pairs: np.ndarray
+    """(c, 2) int64 instance ids, as :meth:`Scene.colliding_pairs` gives them."""
+    faces: np.ndarray
+    """(c, 2) int64 the triangles of the first's and of the second's mesh."""
+    p: np.ndarray
+    """(c, 3) world space: one end of the segment where the triangles cross (``separated``: the
+    closest point on the first's mesh)."""
+    q: np.ndarray
+    """(c, 3) the segment's other end (``separated``: the closest point on the second's mesh)."""
+    coplanar: np.ndarray
+    """(c,) bool: the triangles are coplanar and overlap."""
+    separated: np.ndarray
+    """(c,) bool: the pair is within its margins, its triangles apart."""
+
+
 def _index(name: str, value: Any, top: int) -> int:
     """An id or index argument: an int (numpy integers too, not bool) in [0, top]."""
     if type(value) is not int:

@@ -53,6 +53,9 @@ void bind_instanced_type(nb::module_& m, const char* name) {
              nb::arg("ignore"))
         .def("any_collision_with", &instance_pairs::any_collision_with<T>, nb::arg("other"),
              nb::arg("ignore"))
+        .def("colliding_faces", &instance_pairs::colliding_faces<T>, nb::arg("ignore"))
+        .def("colliding_faces_with", &instance_pairs::colliding_faces_with<T>, nb::arg("other"),
+             nb::arg("ignore"))
         .def("to_bytes", &S::to_bytes)
         .def("load_bytes", &S::load_bytes, nb::arg("data"))
         .def("closest_pair", &instance_pairs::closest_pair<T>, nb::arg("ignore"))
@@ -60,6 +63,8 @@ void bind_instanced_type(nb::module_& m, const char* name) {
              nb::arg("ignore"))
         .def("pairs_within", &instance_pairs::pairs_within<T>, nb::arg("threshold"),
              nb::arg("ignore"))
+        .def("pairs_within_with", &instance_pairs::pairs_within_with<T>, nb::arg("other"),
+             nb::arg("threshold"), nb::arg("ignore"))
         .def("closest_instance", &instance_pairs::closest_instance<T>, nb::arg("geometry"),
              nb::arg("rotation"), nb::arg("translation"), nb::arg("group"), nb::arg("mask"),
              nb::arg("margin"));

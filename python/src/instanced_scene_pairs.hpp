@@ -1,5 +1,6 @@
 #pragma once
-// InstancedScene<T>'s collision and distance calls (scene/collision.hpp, scene/distance.hpp):
+// InstancedScene<T>'s collision, face contact and distance calls (scene/collision.hpp,
+// scene/face_contacts.hpp, scene/distance.hpp):
 // within one scene, between two scenes, and against one more posed mesh. Each reads the ignore
 // list and the pose before it releases the GIL, then checks the ids under the scene's shared lock.
 #include <string>
@@ -7,6 +8,7 @@
 
 #include "bvhkit/scene/collision.hpp"
 #include "bvhkit/scene/distance.hpp"
+#include "bvhkit/scene/face_contacts.hpp"
 #include "instanced_scene.hpp"
 
 namespace bvhkit::python::instance_pairs {
@@ -178,6 +180,55 @@ bool any_collision_with(const Scene<T>& s, const Scene<T>& other, const IdPairs&
     return bvhkit::any_collision(s.scene(), other.scene(), skip);
 }
 
+/// (pairs (c, 2), faces (c, 2), p (c, 3), q (c, 3), coplanar (c,), separated (c,)); the flags as
+/// 0/1 bytes (the Python side views them as bool).
+template <class T>
+nb::tuple pack_faces(const std::vector<SceneFaceContact<T>>& v) {
+    const std::size_t n = v.size();
+    std::vector<std::int64_t> ids(2 * n), faces(2 * n);
+    std::vector<T> p(3 * n), q(3 * n);
+    std::vector<std::uint8_t> coplanar(n), separated(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        ids[2 * i] = std::int64_t(v[i].a.bits());
+        ids[2 * i + 1] = std::int64_t(v[i].b.bits());
+        faces[2 * i] = std::int64_t(v[i].face_a);
+        faces[2 * i + 1] = std::int64_t(v[i].face_b);
+        for (std::size_t a = 0; a < 3; ++a) p[3 * i + a] = v[i].p[a], q[3 * i + a] = v[i].q[a];
+        coplanar[i] = std::uint8_t(v[i].coplanar);
+        separated[i] = std::uint8_t(v[i].separated);
+    }
+    return nb::make_tuple(owned_array(std::move(ids), n, 2), owned_array(std::move(faces), n, 2),
+                          owned_array(std::move(p), n, 3), owned_array(std::move(q), n, 3),
+                          owned_array(std::move(coplanar), n, 0),
+                          owned_array(std::move(separated), n, 0));
+}
+
+template <class T>
+nb::tuple colliding_faces(const Scene<T>& s, const IdPairs& ignore) {
+    std::vector<SceneFaceContact<T>> out;
+    {
+        const std::vector<InstancePair> skip = pairs_of(ignore);
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(s.mutex());
+        check_pairs(s, s, ignore);
+        bvhkit::colliding_faces(s.scene(), out, skip);
+    }
+    return pack_faces(out);
+}
+
+template <class T>
+nb::tuple colliding_faces_with(const Scene<T>& s, const Scene<T>& other, const IdPairs& ignore) {
+    std::vector<SceneFaceContact<T>> out;
+    {
+        const std::vector<InstancePair> skip = pairs_of(ignore);
+        nb::gil_scoped_release release;
+        const BothLocks<T> lock(s, other);
+        check_pairs(s, other, ignore);
+        bvhkit::colliding_faces(s.scene(), other.scene(), out, skip);
+    }
+    return pack_faces(out);
+}
+
 // ---------------------------------------------------------------- distance
 
 /// The closest pair: pack() of none or one.
@@ -218,6 +269,20 @@ nb::tuple pairs_within(const Scene<T>& s, T threshold, const IdPairs& ignore) {
         const std::shared_lock<std::shared_mutex> lock(s.mutex());
         check_pairs(s, s, ignore);
         bvhkit::pairs_within(s.scene(), threshold, found, skip);
+    }
+    return pack(found);
+}
+
+template <class T>
+nb::tuple pairs_within_with(const Scene<T>& s, const Scene<T>& other, T threshold,
+                            const IdPairs& ignore) {
+    std::vector<SceneDistance<T>> found;
+    {
+        const std::vector<InstancePair> skip = pairs_of(ignore);
+        nb::gil_scoped_release release;
+        const BothLocks<T> lock(s, other);
+        check_pairs(s, other, ignore);
+        bvhkit::pairs_within(s.scene(), other.scene(), threshold, found, skip);
     }
     return pack(found);
 }

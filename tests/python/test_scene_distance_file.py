@@ -1,5 +1,5 @@
 """bvhkit.Scene's distance queries (closest pair, pairs within a threshold, the instance nearest a
-posed mesh), collision between two scenes, and saving, loading and pickling a scene. References:
+posed mesh), collision and face contacts between two scenes, and saving, loading and pickling a scene. References:
 bvhkit.distance / bvhkit.collide on every pair (no top-level tree), and boxes at known gaps."""
 
 import pickle
@@ -106,6 +106,35 @@ def test_two_scenes_collide_pair_by_pair():
     near = s1.closest_pair_with(s2, ignore=[[b, d]])
     assert [tuple(p) for p in near.pairs] == [(a, c)] and near.distance[0] == 0
     assert len(s1.closest_pair_with(bvhkit.Scene(np.float64)).distance) == 0
+    # Pairs within 0.2 across: (a, c) overlapping (0) and (b, d) at -0.1; e is filtered out.
+    w = s1.pairs_within_with(s2, 0.2)
+    assert [tuple(p) for p in w.pairs] == [(a, c), (b, d)]
+    assert w.distance == pytest.approx([0.0, -0.1], abs=1e-9)
+    assert len(s1.pairs_within_with(s2, -0.2).distance) == 0
+    assert [tuple(p) for p in s1.pairs_within_with(s2, 0.2, ignore=[[a, c]]).pairs] == [(b, d)]
+    with pytest.raises(ValueError, match="threshold"):
+        s1.pairs_within_with(s2, float("nan"))
+    # Face contacts across: (a, c) cross along segments on both unit boxes' surfaces (the
+    # largest |coordinate - centre| is 1/2 on a box's surface); (b, d) within the margin only.
+    fc = s1.colliding_faces_with(s2)
+    crossing = ~fc.separated
+    assert {tuple(p) for p in fc.pairs[crossing]} == {(a, c)}
+    assert {tuple(p) for p in fc.pairs[fc.separated]} == {(b, d)}
+    for end in (fc.p[crossing], fc.q[crossing]):
+        assert np.abs(end - 0.5).max(axis=1) == pytest.approx(0.5, abs=1e-12)
+        assert np.abs(end - 1.0).max(axis=1) == pytest.approx(0.5, abs=1e-12)
+    sep = np.flatnonzero(fc.separated)[0]
+    assert fc.p[sep][0] == pytest.approx(6.0, abs=1e-12)  # b's face x = 6
+    assert fc.q[sep][0] == pytest.approx(6.5, abs=1e-12)  # d's face x = 6.5
+    assert fc.coplanar.dtype == np.bool_ and fc.faces.shape == (len(fc.pairs), 2)
+    assert len(s1.colliding_faces_with(s2, ignore=[[a, c], [b, d]]).pairs) == 0
+    # Within one scene: a and c of one scene cross as they do across.
+    s3 = bvhkit.Scene(np.float64)
+    g3 = s3.add_mesh(v, f)
+    x, y = s3.add_instance(g3, None, [0, 0, 0]), s3.add_instance(g3, None, [0.5, 0.5, 0.5])
+    within = s3.colliding_faces()
+    assert {tuple(p) for p in within.pairs} == {(x, y)} and not within.separated.any()
+    assert sorted(map(tuple, within.faces)) == sorted(map(tuple, fc.faces[crossing]))
     with pytest.raises(TypeError, match="other"):
         s1.colliding_pairs_with(bvhkit.Scene(np.float32))
     with pytest.raises(TypeError, match="other"):
