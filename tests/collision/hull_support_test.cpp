@@ -137,6 +137,51 @@ std::vector<Vec3d> sphere(SplitMix64& rng, std::size_t n, double radius, Vec3d c
     return p;
 }
 
+// The sign of d . (u - v) against exact integers, on inputs where the double filter cannot decide:
+// exact ties (axis and lattice directions on lattice points, where the rounded values are exact),
+// near ties that round to ties, products that underflow, and mixed huge and tiny terms.
+TEST(HullSupport, DotDifferenceSignIsExact) {
+    SplitMix64 rng(77);
+    int ties = 0, cases = 0;
+    const auto check = [&](const Vec3d& d, const Vec3d& u, const Vec3d& v) {
+        const ExactDots dots(std::vector<Vec3d>{u, v});
+        const int want = (dots.dot(d, u) - dots.dot(d, v)).sign();
+        ASSERT_EQ(support_detail::dot_difference_sign(d, u, v), want)
+            << "d " << d[0] << " " << d[1] << " " << d[2] << " u " << u[0] << " " << u[1] << " "
+            << u[2] << " v " << v[0] << " " << v[1] << " " << v[2];
+        ties += want == 0;
+        ++cases;
+    };
+    const auto lattice = [&](double step) {
+        return Vec3d{step * double(rng.next() % 5), step * double(rng.next() % 5),
+                     step * double(rng.next() % 5)};
+    };
+    for (int i = 0; i < 20000; ++i) {
+        const double step = std::ldexp(1.0, int(rng.next() % 200) - 100);
+        Vec3d d{double(int(rng.next() % 5) - 2), double(int(rng.next() % 5) - 2),
+                double(int(rng.next() % 5) - 2)};
+        const Vec3d u = lattice(step), v = lattice(step);
+        check(d, u, v);
+        // Near ties: one coordinate moved by one unit in the last place.
+        Vec3d w = v;
+        w[i % 3] = std::nextafter(u[i % 3], 1e300);
+        check(d, u, w);
+        // Far from the origin: both points shifted by a large offset, the difference exact or not.
+        const Vec3d far{1e15, -3e14, 7e13};
+        check(d, u + far, v + far);
+        // Random directions: exact ties only when the differences cancel term by term.
+        const Vec3d r = rng.unit_vector();
+        check(r, u, v);
+        // Products in the subnormal range: ties that only the exact path may call.
+        check(d * 1e-300, u * 1e-10, v * 1e-10);
+        check(r * 1e-300, u * 1e-20, w * 1e-20);
+        // Mixed: a huge term beside tiny ones.
+        check(Vec3d{1e200, 1e-200, 1.0}, Vec3d{0.0, u[1], u[2]}, Vec3d{0.0, v[1], v[2]});
+    }
+    EXPECT_GT(ties, 10000);  // the tie paths ran
+    EXPECT_GT(cases - ties, 10000);
+}
+
 TEST(HullSupport, SpheresAtEveryScale) {
     SplitMix64 rng(11);
     const std::vector<Vec3d> dirs = directions(rng, scaled(200, 10));

@@ -42,6 +42,29 @@ namespace bvhkit {
 
 namespace support_detail {
 
+/// Whether e_i = u_i - v_i, p_i = d_i e_i and dot = p0 + p1 + p2, as rounded, are all exact:
+/// each operation's rounding error is recovered exactly (Knuth's TwoSum, the FMA residual of a
+/// product) and must be zero. Ties of axis-aligned directions on boxes and grids (the common
+/// case in CAD scenes) end here instead of in expansion arithmetic. A product in the subnormal
+/// range could lose a residual below the smallest subnormal, so it must be exactly zero from a
+/// zero factor, or normal.
+inline bool rounded_exactly(const Vec<double, 3>& d, const Vec<double, 3>& u,
+                            const Vec<double, 3>& v, double e0, double e1, double e2, double p0,
+                            double p1, double p2, double dot) {
+    const auto sum_error = [](double a, double b, double s) {
+        const double bb = s - a;
+        return (a - (s - bb)) + (b - bb);
+    };
+    const double e[3] = {e0, e1, e2}, p[3] = {p0, p1, p2};
+    for (std::size_t i = 0; i < 3; ++i) {
+        if (sum_error(u[i], -v[i], e[i]) != 0) return false;
+        if (p[i] == 0 ? (d[i] != 0 && e[i] != 0) : std::fabs(p[i]) < 0x1p-1000) return false;
+        if (std::fma(d[i], e[i], -p[i]) != 0) return false;
+    }
+    const double p01 = p0 + p1;
+    return sum_error(p0, p1, p01) == 0 && sum_error(p01, p2, dot) == 0;
+}
+
 /// The sign of d . (u - v), exact for every finite double input.
 inline int dot_difference_sign(const Vec<double, 3>& d, const Vec<double, 3>& u,
                                const Vec<double, 3>& v) {
@@ -56,6 +79,7 @@ inline int dot_difference_sign(const Vec<double, 3>& d, const Vec<double, 3>& u,
     const double bound = 5 * 0x1p-53 * (std::fabs(p0) + std::fabs(p1) + std::fabs(p2)) + 0x1p-1073;
     if (dot > bound) return 1;
     if (-dot > bound) return -1;
+    if (rounded_exactly(d, u, v, e0, e1, e2, p0, p1, p2, dot)) return (dot > 0) - (dot < 0);
     // The sign does not change when d or (u, v) is scaled by a power of two: each is brought into
     // the range where products of two terms are exact expansions (that of orient2d).
     exact::BitSpan span_d, span_x;
