@@ -111,9 +111,20 @@ TEST(ScenePoses, StoredRotationIsTheNearest) {
         Transform<double> q;
         q.rotation = exact;
         scene.set_pose(id, q);
+        // Orthonormal to a few units of double's rounding already: stored as given, bit for bit.
+        if (rigid_deviation(exact) <= 8 * std::numeric_limits<double>::epsilon()) {
+            for (std::size_t r = 0; r < 3; ++r)
+                EXPECT_EQ(scene.pose(id).rotation.row[r], exact.row[r]);
+        }
         for (std::size_t r = 0; r < 3; ++r)
             for (std::size_t c = 0; c < 3; ++c)
                 EXPECT_NEAR(scene.pose(id).rotation[r][c], exact[r][c], 4e-16);
+        // Just beyond that: the nearest rotation replaces it, closer to orthonormal than given.
+        Transform<double> off = q;
+        for (std::size_t c = 0; c < 3; ++c) off.rotation[0][c] *= 1 + 1e-13;
+        scene.set_pose(id, off);
+        EXPECT_NE(scene.pose(id).rotation.row[0], off.rotation.row[0]);
+        EXPECT_LE(rigid_deviation(scene.pose(id).rotation), 1e-15);
     }
     scene.validate();
 }

@@ -109,8 +109,15 @@ Mat3<T> nearest_rotation(const Mat3<T>& rotation) {
 
 /// The pose as a Scene stores it: the translation as given, the rotation replaced by the nearest
 /// rotation (so R^T is R's inverse to T's rounding, and a relative pose R_a^T R_b is as rigid).
+/// A rotation already orthonormal to a few units of T's rounding (what a rotation computed in T
+/// from angles or quaternions is) is kept as given: its polar factor, rounded to T, would differ
+/// from it by about as much, and the Newton steps in the wider type cost more than the rest of a
+/// pose change. The pad of the world box (pose_pad) measures the stored rotation's deviation
+/// either way.
 template <class T>
 Transform<T> rigid_pose(const Transform<T>& pose) {
+    if (rigid_deviation(pose.rotation) <= 8 * double(std::numeric_limits<T>::epsilon()))
+        return pose;
     return {nearest_rotation<AccurateScalar<T>>(pose.rotation), pose.translation};
 }
 
