@@ -150,7 +150,8 @@ class Scene:
         ``translations`` (k, 3) (None: zeros), in one call. Every id and pose is checked before
         any instance moves: an error (a stale id, a non-rigid rotation, a NaN) leaves the scene
         as it was. An id given twice ends at its last pose."""
-        self._set_poses(_ids("ids", ids), rotations, translations, "rotations", "translations")
+        self._set_poses(_ids("ids", ids, live_checked=True), rotations, translations, "rotations",
+                        "translations")
 
     def _set_poses(self, i: np.ndarray, rotations: Any, translations: Any, rn: str, tn: str
                    ) -> None:

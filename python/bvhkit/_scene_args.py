@@ -117,8 +117,10 @@ def _index(name: str, value: Any, top: int) -> int:
     return value
 
 
-def _ids(name: str, value: Any) -> np.ndarray:
-    """Instance ids: an int or an integer array, as a C-contiguous (k,) int64 array."""
+def _ids(name: str, value: Any, live_checked: bool = False) -> np.ndarray:
+    """Instance ids: an int or an integer array, as a C-contiguous (k,) int64 array.
+    ``live_checked``: the C++ call names every id that is not a live instance (a negative one
+    included), so an int64 array skips the range pass (a planner's set_poses pays it per call)."""
     if isinstance(value, (bool, np.bool_)):
         raise TypeError(f"{name}: must be an int or an array of ints, not bool")
     a = value if isinstance(value, np.ndarray) else np.asarray(value)
@@ -128,6 +130,8 @@ def _ids(name: str, value: Any) -> np.ndarray:
         raise TypeError(f"{name}: dtype must be an integer type, not {a.dtype}")
     if a.ndim != 1:
         raise ValueError(f"{name}: shape must be (k,), not {a.shape}")
+    if live_checked and a.dtype == np.int64 and a.flags.c_contiguous:
+        return a
     if a.size and (int(a.min()) < 0 or int(a.max()) > _I64):
         raise ValueError(f"{name}: every id must be one add_instance returned (0 <= id < 2^63)")
     return np.ascontiguousarray(a, dtype=np.int64)

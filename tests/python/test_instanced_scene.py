@@ -425,6 +425,9 @@ def test_bad_arguments_are_named():
         (lambda: s.set_poses([i, i], None, [[0, 0, 0]]), ValueError, "translations"),
         (lambda: s.set_poses([1.5], None, [[0, 0, 0]]), TypeError, "ids"),
         (lambda: s.set_poses([i + 7], None, [[0, 0, 0]]), ValueError, r"ids\[0\]"),
+        (lambda: s.set_poses(np.array([i, -1]), None, np.zeros((2, 3))), ValueError, r"ids\[1\]"),
+        (lambda: s.set_poses(np.array([2**64 - 1], np.uint64), None, [[0, 0, 0]]), ValueError,
+         "ids"),
         (lambda: s.set_pose(-3), ValueError, "id"),
         (lambda: s.remove([i, i]), ValueError, "more than once"),
         (lambda: s.set_options([i + 7], group=3), ValueError, r"ids\[0\]"),
@@ -452,6 +455,10 @@ def test_bad_arguments_are_named():
     # Nothing above changed the scene.
     assert len(s) == 1 and s.pose(i)[1].tolist() == [0, 0, 0]
     s.validate()
+    # A strided int64 id array (not contiguous) is taken as any other.
+    s.set_poses(np.array([i, i])[::2], None, [[0.0, 0.0, 1.0]])
+    assert s.pose(i)[1][2] == 1
+    s.set_pose(i)
     # NaN rays miss, NaN points find nothing: bad data in a batch is not an error.
     h = s.intersect([[np.nan, 0, 0], [0.5, 0.5, -1]], [[0, 0, 1], [0, 0, 1]])
     assert h.instance[0] == -1 and h.instance[1] == i
