@@ -159,6 +159,10 @@ TEST(ConstQueriesFromThreads, SceneQueriesOnAFreshScene) {
             std::vector<SceneDistance<float>> within;
             pairs_within(scene, 0.5f, within);
             a[5] = double(within.size());
+            pairs_within(scene, scene, 0.5f, within);
+            std::vector<SceneFaceContact<float>> faces;
+            colliding_faces(scene, faces);
+            a[5] += 1000 * double(within.size()) + 1e6 * double(faces.size());
         }
         return a;
     };
@@ -173,6 +177,28 @@ TEST(ConstQueriesFromThreads, SceneQueriesOnAFreshScene) {
         });
     for (auto& th : threads) th.join();
     for (std::size_t i = 0; i < origins.size(); ++i) ASSERT_EQ(serial[i], parallel[i]) << i;
+}
+
+// The ray batch on the library's own threads, on a scene whose ray trees the batch builds.
+TEST(ConstQueriesFromThreads, SceneRayBatchOnAFreshScene) {
+    const Scene<float> reference = row_of_instances();
+    const Aabb3f box = reference.bounds();
+    const auto origins = random_points(box, 2000, 9);
+    const auto targets = random_points(box, 2000, 10);
+    std::vector<Ray3f> rays;
+    for (std::size_t i = 0; i < origins.size(); ++i)
+        rays.push_back(Ray3f(origins[i], targets[i] - origins[i]));
+    const Scene<float> fresh = row_of_instances();
+    std::vector<SceneHit<float>> hits(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size());
+    closest_hits(fresh, std::span<const Ray3f>(rays), std::span(hits), 0u);
+    any_hits(fresh, std::span<const Ray3f>(rays), std::span(occluded), 0u);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const SceneHit<float> one = closest_hit(reference, rays[i]);
+        ASSERT_EQ(hits[i].t, one.t) << i;
+        ASSERT_EQ(hits[i].face, one.face) << i;
+        ASSERT_EQ(bool(occluded[i]), any_hit(reference, rays[i])) << i;
+    }
 }
 
 }  // namespace
