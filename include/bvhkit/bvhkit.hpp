@@ -39,6 +39,7 @@
 #include "bvhkit/query/winding_number.hpp"
 #include "bvhkit/scene/closest_point.hpp"
 #include "bvhkit/scene/collision.hpp"
+#include "bvhkit/scene/configurations.hpp"
 #include "bvhkit/scene/distance.hpp"
 #include "bvhkit/scene/face_contacts.hpp"
 #include "bvhkit/scene/rays.hpp"
