@@ -83,7 +83,8 @@ def p7(meshes, n: int, reps: int, mods, workload) -> List[str]:
             w.peer("open3d RaycastingScene", setup_o3d)
         rows += w.measure(reps, _agreement)
     rows.append(f"P7        {len(which)} objects, {sum(len(unit[g][1]) for g in which)} "
-                f"triangles posed ({len(unit)} meshes held once by bvhkit), {n} points")
+                f"triangles posed ({len(unit)} meshes held once by bvhkit), {n} points, "
+                f"{int(scene.contains(p).sum())} inside")
     return rows
 
 

@@ -571,7 +571,8 @@ def main(argv=None) -> None:
     if "P7" in only:
         from ._bench_proximity import p7
 
-        meshes = [_mesh(m)[:2] for m in ("spot.obj", "fandisk.obj", "dragon-lowres.ply", "torus")]
+        meshes = [_mesh(m)[:2] for m in ("spot.obj", "fandisk.obj", "dragon-lowres.ply",
+                                         "torus:u=96,v=48")]
         print(f"P7: 100 objects of {', '.join(str(len(f)) for _, f in meshes)} triangles")
         show(p7(meshes, max(1000, int(200_000 * s)), args.reps, mods, Workload))
 
