@@ -44,6 +44,7 @@
 #include "bvhkit/scene/face_contacts.hpp"
 #include "bvhkit/scene/rays.hpp"
 #include "bvhkit/scene/scene_file.hpp"
+#include "bvhkit/scene/signed_distance.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "bvhkit/version.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"

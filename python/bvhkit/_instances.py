@@ -355,6 +355,43 @@ class Scene:
         self._impl.closest_point(p, dist, point, inst, geom, face, bary, n)
         return SceneClosest(dist, point, inst, geom, face, bary)
 
+    def signed_distance(
+        self, points: npt.ArrayLike, sign: _a.Sign = "pseudonormal", threads: int = 0
+    ) -> SceneClosest:
+        """The distance from each point to the nearest surface of any instance, negative where
+        the point is inside any instance (overlapping instances: inside their union), as on the
+        scene made one world-space mesh: :class:`SceneClosest` ``(distance, point, instance,
+        geometry, face, barycentric)``, as :meth:`closest_point` gives, the distance signed.
+
+        Inside an instance, as :meth:`TriangleMesh.signed_distance` decides it on that one
+        mesh: ``sign="pseudonormal"`` by the angle-weighted pseudonormal at the instance's
+        closest point (exact for closed, consistently oriented meshes);
+        ``sign="winding_number"`` by :meth:`contains`'s rule (meshes with holes). Only the
+        instances whose world box holds the point are asked. A point on one instance's surface
+        and inside another gets -0.0 (``np.signbit``). Points with a NaN or infinite
+        coordinate, and every point of a scene without faces: distance = inf, instance = -1.
+        """
+        _a.option("sign", sign, _a.SIGNS)
+        p = _a.rows("points", points, 3, self.dtype)
+        n = _a.threads(threads)
+        k, dt = len(p), self.dtype
+        dist, point, bary = np.empty(k, dt), np.empty((k, 3), dt), np.empty((k, 3), dt)
+        inst, geom, face = np.empty(k, np.int64), np.empty(k, np.int64), np.empty(k, np.int64)
+        self._impl.signed_distance(p, sign, dist, point, inst, geom, face, bary, n)
+        return SceneClosest(dist, point, inst, geom, face, bary)
+
+    def contains(self, points: npt.ArrayLike, threads: int = 0) -> np.ndarray:
+        """Whether each point is inside any instance: (k,) bool. Inside one instance as
+        :meth:`TriangleMesh.contains` decides it (winding number above 1/2: exactly by one
+        ray's crossings on a closed mesh, by the fast winding number otherwise). Points with a
+        NaN or infinite coordinate are outside. (``id in scene`` asks whether an instance id is
+        live.)"""
+        p = _a.rows("points", points, 3, self.dtype)
+        n = _a.threads(threads)
+        out = np.empty(len(p), np.bool_)
+        self._impl.contains_points(p, out, n)
+        return out
+
     # ------------------------------------------------------------------ collision
 
     @staticmethod

@@ -53,10 +53,12 @@ class SceneIntersections(NamedTuple):
 
 
 class SceneClosest(NamedTuple):
-    """What :meth:`Scene.closest_point` returns, one entry per point."""
+    """What :meth:`Scene.closest_point` and :meth:`Scene.signed_distance` return, one entry
+    per point."""
 
     distance: np.ndarray
-    """(k,) distance to the nearest instance; inf for an empty scene or a non-finite point."""
+    """(k,) distance to the nearest instance (signed by :meth:`Scene.signed_distance`: negative
+    inside); inf for an empty scene or a non-finite point."""
     point: np.ndarray
     """(k, 3) the nearest point, world space; NaN where there is none."""
     instance: np.ndarray

@@ -14,6 +14,9 @@ Workloads (sizes times --scale):
   P6  a collision manager per robot configuration: a six-link arm among three scanned meshes,
       1,000 configurations one call each, against python-fcl's DynamicAABBTreeCollisionManager
       (bvhkit/_bench_scene.py)
+  P7  scene proximity: closest point and signed distance for 200,000 points over 100 posed
+      closed objects, against Open3D's RaycastingScene holding one geometry per object
+      (bvhkit/_bench_proximity.py)
 
 A peer runs when it imports and sets up; a peer that fails is listed with the reason and the rest
 go on. Peers: Open3D (RaycastingScene), Embree 4 through embreex (its scene's `run`, one
@@ -506,7 +509,7 @@ def main(argv=None) -> None:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scale", type=float, default=1.0, help="workload size factor (1 = full)")
     ap.add_argument("--reps", type=int, default=3, help="repetitions (median reported)")
-    ap.add_argument("--only", default="P1,P2,P3,P4,P5,P6", help="comma-separated workloads")
+    ap.add_argument("--only", default="P1,P2,P3,P4,P5,P6,P7", help="comma-separated workloads")
     ap.add_argument("--mesh", default="igea.ply", help="mesh file or spec for P1 and P2")
     ap.add_argument("--big-mesh", default="sphere:subdiv=8,displacement=0.2",
                     help="the large mesh of P1 (1.3M triangles by default); 'none' skips it")
@@ -565,6 +568,13 @@ def main(argv=None) -> None:
         print(f"P6: arm of 6 capsules among {', '.join(str(len(f)) for _, f in meshes)} "
               "triangles")
         show(p6(meshes, max(10, int(1000 * s)), args.reps, mods.get("fcl")))
+    if "P7" in only:
+        from ._bench_proximity import p7
+
+        meshes = [_mesh(m)[:2] for m in ("spot.obj", "fandisk.obj", "dragon-lowres.ply",
+                                         "torus:u=96,v=48")]
+        print(f"P7: 100 objects of {', '.join(str(len(f)) for _, f in meshes)} triangles")
+        show(p7(meshes, max(1000, int(200_000 * s)), args.reps, mods, Workload))
 
 
 if __name__ == "__main__":

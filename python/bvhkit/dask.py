@@ -12,8 +12,8 @@ single key of the graph, which the local threaded scheduler uses in place. A Tri
 in its file format, trees included, so no worker rebuilds them (docs/scale-out.md; a ray tree
 with spatial splits alone is rebuilt by each worker that loads the scene); a Scene in the scene
 file format, its top-level tree included, its per-mesh trees built by each worker at its first
-query. A Scene answers closest_point (SceneClosest), intersect (SceneHits) and occluded; the
-other functions are TriangleMesh's alone.
+query. A Scene answers closest_point and signed_distance (SceneClosest), contains, intersect
+(SceneHits) and occluded; the other functions are TriangleMesh's alone.
 To reuse one shipment for several calls, pass ``share(scene)`` instead of the scene.
 
 ``threads`` is per partition and defaults to 1: dask already runs partitions in parallel.
@@ -183,11 +183,20 @@ def closest_point(
 def signed_distance(
     scene: _Scene, points: npt.ArrayLike, sign: _a.Sign = "pseudonormal", threads: int = 1
 ) -> da.Array:
-    """:meth:`TriangleMesh.signed_distance` on each partition."""
-    _mesh_only(scene, "signed_distance")
+    """:meth:`TriangleMesh.signed_distance` on each partition; for a :class:`bvhkit.Scene`,
+    :meth:`Scene.signed_distance`'s SceneClosest of dask arrays."""
     t = _a.threads(threads)
     _a.option("sign", sign, _a.SIGNS)
     p = _rows("points", points)
+    if _is_scene(scene):
+        dt = _dtype(scene)
+
+        def scene_block(s: Scene, b: np.ndarray) -> tuple:
+            return tuple(s.signed_distance(b, sign=sign, threads=t))
+
+        i64 = np.int64
+        souts = [((), dt), ((3,), dt), ((), i64), ((), i64), ((), i64), ((3,), dt)]
+        return SceneClosest(*_map(scene, [p], scene_block, souts))  # type: ignore[return-value]
 
     def block(s: TriangleMesh, b: np.ndarray) -> tuple:
         return (s.signed_distance(b, sign=sign, threads=t),)
@@ -212,7 +221,17 @@ def winding_number(
 
 
 def contains(scene: _Scene, points: npt.ArrayLike, threads: int = 1) -> da.Array:
-    """:meth:`TriangleMesh.contains` on each partition: (n,) bool."""
+    """:meth:`TriangleMesh.contains` on each partition: (n,) bool; for a :class:`bvhkit.Scene`,
+    :meth:`Scene.contains`."""
+    if _is_scene(scene):
+        t = _a.threads(threads)
+        p = _rows("points", points)
+        _dtype(scene)
+
+        def scene_block(s: Scene, b: np.ndarray) -> tuple:
+            return (s.contains(b, threads=t),)
+
+        return _map(scene, [p], scene_block, [((), np.bool_)])[0]
     return winding_number(scene, points, threads=threads) > 0.5
 
 

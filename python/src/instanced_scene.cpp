@@ -44,6 +44,11 @@ void bind_instanced_type(nb::module_& m, const char* name) {
         .def("closest_point", &S::closest_point, nb::arg("points"), nb::arg("distance"),
              nb::arg("point"), nb::arg("instance"), nb::arg("geometry"), nb::arg("face"),
              nb::arg("barycentric"), nb::arg("threads"))
+        .def("signed_distance", &S::signed_distance, nb::arg("points"), nb::arg("sign"),
+             nb::arg("distance"), nb::arg("point"), nb::arg("instance"), nb::arg("geometry"),
+             nb::arg("face"), nb::arg("barycentric"), nb::arg("threads"))
+        .def("contains_points", &S::contains_points, nb::arg("points"), nb::arg("out"),
+             nb::arg("threads"))
         .def("colliding_pairs", &instance_pairs::colliding_pairs<T>, nb::arg("ignore"))
         .def("any_collision", &instance_pairs::any_collision<T>, nb::arg("ignore"))
         .def("colliding_instances", &instance_pairs::colliding_instances<T>, nb::arg("geometry"),

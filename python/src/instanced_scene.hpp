@@ -25,6 +25,7 @@
 #include "bvhkit/scene/rays.hpp"
 #include "bvhkit/scene/scene.hpp"
 #include "bvhkit/scene/scene_file.hpp"
+#include "bvhkit/scene/signed_distance.hpp"
 #include "common.hpp"
 
 namespace bvhkit::python {
@@ -414,6 +415,59 @@ class InstancedScene {
                 bp[3 * i + 1] = c.u;
                 bp[3 * i + 2] = c.v;
             }
+        });
+    }
+
+    /// closest_point's answers with the distance signed (scene/signed_distance.hpp): negative
+    /// inside any instance, by `sign` ("pseudonormal" or "winding_number").
+    void signed_distance(const Rows<T, 3>& points, const std::string& sign, OutColumn<T> distance,
+                         OutRows<T, 3> point, OutColumn<std::int64_t> instance,
+                         OutColumn<std::int64_t> geometry, OutColumn<std::int64_t> face,
+                         OutRows<T, 3> barycentric, unsigned threads) const {
+        SceneSign rule;
+        if (sign == "pseudonormal")
+            rule = SceneSign::pseudonormal;
+        else if (sign == "winding_number")
+            rule = SceneSign::winding_number;
+        else
+            throw Error("sign: '" + sign + "' is not one of 'pseudonormal', 'winding_number'");
+        const std::size_t k = points.shape(0);
+        expect_rows(distance, k, "distance");
+        expect_rows(point, k, "point");
+        for (const auto* c : {&instance, &geometry, &face}) expect_rows(*c, k, "out");
+        expect_rows(barycentric, k, "barycentric");
+        const T* p = points.data();
+        T *dp = distance.data(), *cp = point.data(), *bp = barycentric.data();
+        std::int64_t *ip = instance.data(), *gp = geometry.data(), *fp = face.data();
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        run_batch(k, 64, threads, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) {
+                const SceneSignedDistance<T> s = bvhkit::signed_distance(scene_, at(p, i), rule);
+                const ScenePoint<T>& c = s.closest;
+                const T nan = std::numeric_limits<T>::quiet_NaN();
+                dp[i] = s.distance;
+                for (std::size_t a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;
+                ip[i] = c ? bits_of(c.instance) : -1;
+                gp[i] = c ? std::int64_t(c.geometry.index()) : -1;
+                fp[i] = c ? std::int64_t(c.face) : -1;
+                bp[3 * i] = c ? T(1) - c.u - c.v : T(0);
+                bp[3 * i + 1] = c.u;
+                bp[3 * i + 2] = c.v;
+            }
+        });
+    }
+
+    /// Whether each point is inside any instance (scene/signed_distance.hpp's contains()).
+    void contains_points(const Rows<T, 3>& points, OutColumn<bool> out, unsigned threads) const {
+        const std::size_t k = points.shape(0);
+        expect_rows(out, k, "out");
+        const T* p = points.data();
+        bool* op = out.data();
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        run_batch(k, 64, threads, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) op[i] = bvhkit::contains(scene_, at(p, i));
         });
     }
 

@@ -203,7 +203,13 @@ def test_dask_ships_a_scene():
         occ = bd.occluded(target, da.from_array(o, chunks=(128, 3)),
                           da.from_array(d, chunks=(128, 3)), tmax=1.0)
         assert np.array_equal(occ.compute(), s.occluded(o, d, tmax=1.0))
+        for sign in ("pseudonormal", "winding_number"):
+            got = bd.signed_distance(target, da.from_array(p, chunks=(100, 3)), sign=sign)
+            for x, y in zip(got, s.signed_distance(p, sign=sign)):
+                assert np.array_equal(x.compute(), y)
+        inside = bd.contains(target, da.from_array(p, chunks=(100, 3)))
+        assert np.array_equal(inside.compute(), s.contains(p))
     with pytest.raises(TypeError, match="TriangleMesh query"):
-        bd.signed_distance(s, da.from_array(p, chunks=(100, 3)))
+        bd.winding_number(s, da.from_array(p, chunks=(100, 3)))
     with pytest.raises(ValueError, match="max_distance"):
         bd.closest_point(s, da.from_array(p, chunks=(100, 3)), max_distance=1.0)

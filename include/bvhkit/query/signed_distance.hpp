@@ -104,8 +104,14 @@ class SignedDistanceMesh {
     /// (see ClosestPointMesh::closest_point).
     SignedDistance<T> signed_distance(const Vec<T, 3>& p, const MeshPoint<T>& near,
                                       NearestScratch<T>& scratch) const {
+        return signed_distance_at(p, closest_.closest_point(p, near, scratch));
+    }
+    /// The signed distance of p given `closest`, p's closest point on closest_point_mesh() (found
+    /// by the caller's own walk, as a scene's nearest walk over many meshes finds it): its
+    /// distance, negative where p lies behind the pseudonormal there. inf for none.
+    SignedDistance<T> signed_distance_at(const Vec<T, 3>& p, const MeshPoint<T>& closest) const {
         SignedDistance<T> r;
-        r.closest = closest_.closest_point(p, near, scratch);
+        r.closest = closest;
         if (!r.closest) return {std::numeric_limits<T>::infinity(), r.closest};
         const T d = r.closest.distance;
         // In W: p - point and the products would overflow T for a point near T's maximum.

@@ -26,28 +26,39 @@ struct ScenePoint {
     explicit operator bool() const { return face != invalid_index; }
 };
 
-/// The point of the scene nearest to p (none for an empty scene or a point with a NaN or
-/// infinite coordinate). Of points at the same distance, the first instance the walk reaches
-/// wins. An instance from which p is beyond T's range in the instance's frame is skipped.
+namespace scene_detail {
+
+/// What the nearest walk found: the answer in the world, and the winner's proxy and answer in
+/// its own frame (for a caller that signs it: scene/signed_distance.hpp).
 template <class T>
-ScenePoint<T> closest_point(const Scene<T>& scene, const Vec<T, 3>& p) {
+struct NearestFound {
+    ScenePoint<T> point;
+    ProxyId proxy;
+    MeshPoint<T> local;
+};
+
+/// closest_point()'s walk over the closest point trees that tree_of(const SceneGeometry<T>&)
+/// gives: each geometry's own, or the one inside its SignedDistanceMesh.
+template <class T, class TreeOf>
+NearestFound<T> nearest_over(const Scene<T>& scene, const Vec<T, 3>& p, TreeOf&& tree_of) {
     using W = AccurateScalar<T>;
-    ScenePoint<T> best;
-    if (!is_finite(p)) return best;
+    NearestFound<T> found;
+    if (!is_finite(p)) return found;
     thread_local NearestScratch<T> scratch;
-    MeshPoint<T> best_local;
-    ProxyId best_proxy;
+    MeshPoint<T>& best_local = found.local;
+    ProxyId& best_proxy = found.proxy;
     W best_distance = std::numeric_limits<W>::infinity();
     scene.top_level().query_nearest(p, [&](ProxyId proxy, W) -> W {
         const SceneInstance<T>& r = scene.instance_at(proxy);
         const SceneGeometry<T>& g = scene.geometry_at(r.geometry);
         if (!g.has_extent()) return std::numeric_limits<W>::infinity();
-        const Vec<T, 3> local = scene_detail::to_local_point<W>(r.pose, p);
+        const Vec<T, 3> local = to_local_point<W>(r.pose, p);
         // Beyond T's range in the instance's frame (p 3e38 from an instance at -3e38): the
         // instance is farther than any distance T holds, so it is skipped, not measured.
         if (!is_finite(local)) return best_distance * best_distance;
-        const MeshPoint<T> m = g.closest_point_tree().closest_point_within(local, best_distance,
-                                                                           MeshPoint<T>{}, scratch);
+        const ClosestPointMesh<T>& tree = tree_of(g);
+        const MeshPoint<T> m =
+            tree.closest_point_within(local, best_distance, MeshPoint<T>{}, scratch);
         if (m && W(m.distance) < best_distance) {
             best_local = m;
             best_proxy = proxy;
@@ -55,9 +66,10 @@ ScenePoint<T> closest_point(const Scene<T>& scene, const Vec<T, 3>& p) {
         }
         return best_distance * best_distance;
     });
-    if (!best_local) return best;
+    if (!best_local) return found;
     const SceneInstance<T>& r = scene.instance_at(best_proxy);
-    const Vec<W, 3> q = scene_detail::apply_wide<W>(r.pose, best_local.point);
+    const Vec<W, 3> q = apply_wide<W>(r.pose, best_local.point);
+    ScenePoint<T>& best = found.point;
     best.instance = InstanceId(best_proxy);
     best.geometry = r.geometry;
     best.face = best_local.triangle;
@@ -65,7 +77,21 @@ ScenePoint<T> closest_point(const Scene<T>& scene, const Vec<T, 3>& p) {
     best.distance = best_local.distance;
     best.u = best_local.u;
     best.v = best_local.v;
-    return best;
+    return found;
+}
+
+}  // namespace scene_detail
+
+/// The point of the scene nearest to p (none for an empty scene or a point with a NaN or
+/// infinite coordinate). Of points at the same distance, the first instance the walk reaches
+/// wins. An instance from which p is beyond T's range in the instance's frame is skipped.
+template <class T>
+ScenePoint<T> closest_point(const Scene<T>& scene, const Vec<T, 3>& p) {
+    return scene_detail::nearest_over(scene, p,
+                                      [](const SceneGeometry<T>& g) -> const ClosestPointMesh<T>& {
+                                          return g.closest_point_tree();
+                                      })
+        .point;
 }
 
 }  // namespace bvhkit

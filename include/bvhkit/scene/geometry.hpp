@@ -27,6 +27,7 @@
 #include "bvhkit/primitives/triangle_mesh.hpp"
 #include "bvhkit/query/closest_point_mesh.hpp"
 #include "bvhkit/query/collision_model.hpp"
+#include "bvhkit/scene/geometry_solid.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/convex_hull.hpp"
@@ -332,6 +333,15 @@ class SceneGeometry {
                        [&] { collision_ = std::make_unique<CollisionModel<Aabb<T, 3>>>(mesh_); });
         return *collision_;
     }
+    /// The signed distance and inside/outside structures (scene/geometry_solid.hpp), built at
+    /// their first use, not by prepare().
+    const SignedDistanceMesh<T>& signed_distance_mesh() const {
+        return solid_.signed_distance_mesh(mesh_);
+    }
+    const WindingNumberMesh<T>& winding_number_mesh() const {
+        return solid_.winding_number_mesh(mesh_);
+    }
+    bool is_closed() const { return solid_.closed(mesh_); }
     /// Builds the three trees now rather than at the first query of each family.
     void prepare() const {
         (void)ray_tree();
@@ -347,6 +357,7 @@ class SceneGeometry {
     mutable std::unique_ptr<TriangleBvh<T>> rays_;
     mutable std::unique_ptr<ClosestPointMesh<T>> points_;
     mutable std::unique_ptr<CollisionModel<Aabb<T, 3>>> collision_;
+    scene_detail::GeometrySolid<T> solid_;
 };
 
 }  // namespace bvhkit
