@@ -470,8 +470,8 @@ from ._convex import (  # noqa: E402
 )
 from ._dynamic import DynamicTree2D, DynamicTree3D  # noqa: E402
 from ._solid import MeshSignedDistances, Solid, signed_distance_between  # noqa: E402
-from ._instances import (  # noqa: E402
-    Scene,
+from ._instances import Scene  # noqa: E402
+from ._scene_args import (  # noqa: E402
     SceneClosest,
     SceneDistances,
     SceneFaceContacts,

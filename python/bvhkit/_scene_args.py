@@ -128,6 +128,8 @@ def _ids(name: str, value: Any, live_checked: bool = False) -> np.ndarray:
     a = value if isinstance(value, np.ndarray) else np.asarray(value)
     if a.ndim == 0:
         a = a.reshape(1)
+    if a.shape == (0,) and not isinstance(value, np.ndarray):
+        return np.empty(0, np.int64)  # [] reads as float64: no id, of any type
     if a.dtype.kind not in "iu":
         raise TypeError(f"{name}: dtype must be an integer type, not {a.dtype}")
     if a.ndim != 1:

@@ -1,5 +1,6 @@
 // The binding of InstancedScene<T> (instanced_scene.hpp, instanced_scene_pairs.hpp) as
-// bvhkit._bvhkit.InstancedScene32/64, wrapped by bvhkit.Scene (python/bvhkit/_instances.py).
+// bvhkit._bvhkit.InstancedScene32/64, wrapped by bvhkit.Scene (python/bvhkit/_instances.py,
+// _scene_pairs.py).
 #include "instanced_scene.hpp"
 #include "instanced_scene_pairs.hpp"
 
@@ -61,6 +62,10 @@ void bind_instanced_type(nb::module_& m, const char* name) {
         .def("colliding_faces", &instance_pairs::colliding_faces<T>, nb::arg("ignore"))
         .def("colliding_faces_with", &instance_pairs::colliding_faces_with<T>, nb::arg("other"),
              nb::arg("ignore"))
+        .def("colliding_pairs_at", &instance_pairs::colliding_pairs_at<T>, nb::arg("ids"),
+             nb::arg("rotations"), nb::arg("translations"), nb::arg("ignore"))
+        .def("any_collisions_at", &instance_pairs::any_collisions_at<T>, nb::arg("ids"),
+             nb::arg("rotations"), nb::arg("translations"), nb::arg("ignore"), nb::arg("threads"))
         .def("to_bytes", &S::to_bytes)
         .def("load_bytes", &S::load_bytes, nb::arg("data"))
         .def("closest_pair", &instance_pairs::closest_pair<T>, nb::arg("ignore"))

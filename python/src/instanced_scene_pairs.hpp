@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bvhkit/scene/collision.hpp"
+#include "bvhkit/scene/configurations.hpp"
 #include "bvhkit/scene/distance.hpp"
 #include "bvhkit/scene/face_contacts.hpp"
 #include "instanced_scene.hpp"
@@ -227,6 +228,61 @@ nb::tuple colliding_faces_with(const Scene<T>& s, const Scene<T>& other, const I
         bvhkit::colliding_faces(s.scene(), other.scene(), out, skip);
     }
     return pack_faces(out);
+}
+
+// ---------------------------------------------------------------- configurations
+
+/// The instances `ids` and their poses at every configuration: rows k * ids.size() + i.
+template <class T>
+struct Configurations {
+    std::vector<InstanceId> ids;
+    std::vector<Transform<T>> poses;
+    Configurations(const Ids& which, const Mats<T>& rotations, const Rows<T, 3>& translations) {
+        for (std::size_t i = 0; i < which.shape(0); ++i)
+            ids.push_back(Scene<T>::id_of(which.data()[i]));
+        expect_rows(translations, rotations.shape(0), "translations");
+        poses.resize(rotations.shape(0));
+        for (std::size_t r = 0; r < poses.size(); ++r)
+            poses[r] = Scene<T>::pose_at(rotations, translations, r);
+    }
+};
+
+/// The colliding pairs with a moved instance at one configuration, (p, 2) ids sorted.
+template <class T>
+nb::ndarray<nb::numpy, std::int64_t> colliding_pairs_at(const Scene<T>& s, const Ids& which,
+                                                        const Mats<T>& rotations,
+                                                        const Rows<T, 3>& translations,
+                                                        const IdPairs& ignore) {
+    const Configurations<T> c(which, rotations, translations);
+    std::vector<InstancePair> out;
+    {
+        const std::vector<InstancePair> skip = pairs_of(ignore);
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(s.mutex());
+        check_pairs(s, s, ignore);
+        bvhkit::colliding_pairs_at(s.scene(), c.ids, c.poses, out, skip);
+    }
+    return id_pairs(out);
+}
+
+/// Whether each configuration collides: (K,) 0/1 bytes, over the extension's pool.
+template <class T>
+nb::ndarray<nb::numpy, std::uint8_t> any_collisions_at(const Scene<T>& s, const Ids& which,
+                                                       const Mats<T>& rotations,
+                                                       const Rows<T, 3>& translations,
+                                                       const IdPairs& ignore, unsigned threads) {
+    const Configurations<T> c(which, rotations, translations);
+    const std::size_t n = c.ids.size();
+    const std::size_t k = n == 0 ? 0 : c.poses.size() / n;
+    std::vector<std::uint8_t> out(k);
+    {
+        const std::vector<InstancePair> skip = pairs_of(ignore);
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(s.mutex());
+        check_pairs(s, s, ignore);
+        bvhkit::any_collisions_at(s.scene(), c.ids, c.poses, out, skip, BatchExecutor{threads});
+    }
+    return owned_array(std::move(out), k, 0);
 }
 
 // ---------------------------------------------------------------- distance

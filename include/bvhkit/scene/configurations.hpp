@@ -154,15 +154,17 @@ bool any_collision_at(const Scene<T>& scene, std::span<const InstanceId> ids,
 
 /// Many configurations of the same instances: configuration k puts ids[i] at
 /// poses[k * ids.size() + i]; collides[k] = any_collision_at for it (1 or 0). On `threads`
-/// threads (0 = every core, 1 = the calling thread) or an Executor; each answer is its
+/// threads (0 = every core, 1 = the calling thread) or an Executor (or anything with its
+/// parallel_for(count, grain, body)); each answer is its
 /// configuration's alone, the same for any thread count. Every configuration is checked before
 /// any is tested: an Error (lengths, ids, a bad pose, naming the configuration) leaves `collides`
 /// unwritten.
-template <class T>
+template <class T, class Exec>
+    requires(!std::is_arithmetic_v<Exec>)
 void any_collisions_at(const Scene<T>& scene, std::span<const InstanceId> ids,
                        std::type_identity_t<std::span<const Transform<T>>> poses,
                        std::span<std::uint8_t> collides, std::span<const InstancePair> ignore,
-                       const Executor& exec) {
+                       const Exec& exec) {
     const std::size_t n = ids.size();
     if (poses.size() != n * collides.size())
         throw Error("any_collisions_at(Scene): " + std::to_string(poses.size()) + " poses for " +
