@@ -12,7 +12,9 @@ Workloads (sizes times --scale):
       intersect, in microseconds per Python call; and collide on batches of 1, 10, 100 and 1,000
       poses with threads=0 against threads=1 (the ratio: at most about 1 for small batches)
   P6  a collision manager per robot configuration: a six-link arm among three scanned meshes,
-      1,000 configurations one call each, against python-fcl's DynamicAABBTreeCollisionManager
+      1,000 configurations one call each (set_poses then any_collision, or any_collision_at),
+      and all in one any_collision_at call (1 thread, all threads), against python-fcl's
+      DynamicAABBTreeCollisionManager; the ratio is python-fcl's time over the row's
       (bvhkit/_bench_scene.py)
   P7  scene proximity: closest point and signed distance for 200,000 points over 100 posed
       closed objects, against Open3D's RaycastingScene holding one geometry per object
