@@ -466,8 +466,8 @@ def test_bad_arguments_are_named():
 
 
 def test_docs_examples_run_as_written():
-    """docs/scenes.md's Python examples, read from the file; the robot's printed pairs are the
-    ones its comments show."""
+    """docs/scenes.md's Python examples, read from the file; the robot's printed pairs and its
+    count of colliding configurations are the ones its comments show."""
     import contextlib
     import io
     import pathlib
@@ -479,7 +479,8 @@ def test_docs_examples_run_as_written():
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         exec(compile(robot, str(doc), "exec"), {})
-    shown = [line[2:] for line in robot.splitlines() if line.startswith("# [")]
+    shown = [line[2:] for line in robot.splitlines()
+             if line.startswith("# [") or re.match(r"# \d+ of ", line)]
     assert out.getvalue().splitlines() == shown
     namespace, out = {}, io.StringIO()
     with contextlib.redirect_stdout(out):
