@@ -481,6 +481,61 @@ TEST(ConvexShapes, FarFromTheOriginAndScales) {
     }
 }
 
+TEST(ConvexShapes, ExtremeScalesArePowersOfTwoOfTheUnitAnswer) {
+    // Every coordinate scaled by 2^k is exact, so the exact answers scale by 2^k too. GJK's and
+    // EPA's determinants multiply four coordinates: at 2^+-600 (1e+-180) they leave double's
+    // range unless the pair is brought to unit size first. Hulls, boxes, capsules and spheres,
+    // apart and overlapping.
+    const std::vector<Vec3d> hull_points{{-1, -0.5, -0.7}, {1.1, -0.6, -0.4}, {0.2, 1.2, -0.8},
+                                         {0.1, 0.1, 1.3},  {0.8, 0.7, 0.6},   {-0.9, 0.6, 0.5}};
+    const auto shapes = [&](double s) {
+        std::vector<Vec3d> scaled_points;
+        for (const Vec3d& p : hull_points) scaled_points.push_back(p * s);
+        return std::vector<ConvexShape<double>>{
+            ConvexShape<double>(BoxShape<double>(Vec3d{0.7, 0.4, 1.0} * s)),
+            ConvexShape<double>(CapsuleShape<double>(0.3 * s, 0.6 * s)),
+            ConvexShape<double>(bvhkit::SphereShape<double>(0.5 * s)),
+            ConvexShape<double>(
+                bvhkit::ConvexPolytope<double>{std::span<const Vec3d>(scaled_points)})};
+    };
+    const auto unit_shapes = shapes(1);
+    int overlapping = 0;
+    for (const int k : {-1000, -600, -300, 300, 600, 1000}) {
+        const double s = std::ldexp(1.0, k);
+        const auto scaled_shapes = shapes(s);
+        std::mt19937_64 same(37);
+        for (int i = 0; i < 120; ++i) {
+            const std::size_t x = std::size_t(i) % 4, y = std::size_t(i / 4) % 4;
+            Transformd pa = random_pose(same, 1.5), pb = random_pose(same, 1.5);
+            const auto unit =
+                bvhkit::convex_signed_distance(unit_shapes[x], pa, unit_shapes[y], pb);
+            const auto apart = bvhkit::convex_distance(unit_shapes[x], pa, unit_shapes[y], pb);
+            pa.translation *= s;
+            pb.translation *= s;
+            const auto scaled =
+                bvhkit::convex_signed_distance(scaled_shapes[x], pa, scaled_shapes[y], pb);
+            const auto scaled_apart =
+                bvhkit::convex_distance(scaled_shapes[x], pa, scaled_shapes[y], pb);
+            const double tol = unit.converged ? 1e-8 : 1e-3;
+            EXPECT_NEAR(scaled.signed_distance / s, unit.signed_distance, tol)
+                << "2^" << k << " pair " << i;
+            EXPECT_NEAR(scaled_apart.distance / s, apart.distance, 1e-8)
+                << "2^" << k << " pair " << i;
+            EXPECT_EQ(scaled_apart.overlap, apart.overlap) << "2^" << k << " pair " << i;
+            EXPECT_NEAR(bvhkit::length(scaled.normal - unit.normal), 0.0, 1e-6)
+                << "2^" << k << " pair " << i;
+            for (std::size_t a = 0; a < 3; ++a) {
+                EXPECT_NEAR(scaled.point_a[a] / s, unit.point_a[a], 1e-6) << "2^" << k << " " << i;
+                EXPECT_NEAR(scaled_apart.point_b[a] / s, apart.point_b[a], 1e-6)
+                    << "2^" << k << " " << i;
+            }
+            overlapping += unit.signed_distance < 0;
+        }
+    }
+    EXPECT_GT(overlapping, 60);
+    EXPECT_LT(overlapping, 6 * 120 - 60);
+}
+
 TEST(ConvexShapes, ContinuousThroughContact) {
     // B moves along a fixed direction through A in small steps: the signed distance changes by at
     // most the step (it is 1-Lipschitz in a translation), and the normal never flips.

@@ -7,7 +7,10 @@
 //
 // Frames: the poses place each shape in the world. The work is done in a frame with A's position at
 // the origin (world orientation), so two shapes far from the world origin (1e6) but near each other
-// lose nothing to the size of their coordinates; the points returned are in the world frame.
+// lose nothing to the size of their coordinates; the points returned are in the world frame. That
+// frame is also scaled by a power of two (exact) that brings the pair's size near 1: GJK's and
+// EPA's determinants multiply up to four coordinates, which at 1e-80 or 1e80 would underflow or
+// overflow a double (at 1e-10 or 1e10 a float), and the answers are scaled back at the end.
 //
 // Termination: with v the simplex's nearest point and w the new support point, |v| bounds the core
 // distance from above and v.w / |v| from below; GJK stops when the gap |v|^2 - v.w is within a
@@ -61,9 +64,12 @@ struct PosedSupport {
     // owns its pair, so the hint is never shared between threads.
     mutable std::uint32_t hint = HullSupport<T>::none;
 
+    T factor;  // the working frame's scale (a power of two); offset is already scaled
+
     Vec<T, 3> operator()(const Vec<T, 3>& d) const {
         const Vec<T, 3> local = rotation.transpose_times(d);
-        return rotation * (core ? shape->core_support(local, hint) : shape->support(local, hint)) +
+        return rotation * ((core ? shape->core_support(local, hint) : shape->support(local, hint)) *
+                           factor) +
                offset;
     }
 };
@@ -72,8 +78,12 @@ struct PosedSupport {
 template <class T>
 struct ShapePair {
     PosedSupport<T> a, b;
-    Vec<T, 3> origin;  // A's position in the world: working frame + origin = world
+    Vec<T, 3> origin;  // A's position in the world: working frame * unscale + origin = world
     T abs_tolerance;   // distances below this are rounding of the shapes' coordinates
+    T unscale;         // 1 / the working frame's factor
+
+    /// A point of the working frame in the world.
+    Vec<T, 3> world(const Vec<T, 3>& x) const { return x * unscale + origin; }
 
     /// The support point w = a - b of D along d, and the point a of A behind it.
     std::pair<Vec<T, 3>, Vec<T, 3>> support(const Vec<T, 3>& d) const {
@@ -82,6 +92,29 @@ struct ShapePair {
     }
 };
 
+/// The pair's size: the larger bounding radius, or the offset's largest coordinate. A radius
+/// computed from squares underflows for shapes below about the square root of T's smallest
+/// normal number and overflows above the root of its largest; there the shapes' own extents
+/// along the axes (six supports each) stand in.
+template <class T>
+T pair_scale(const ConvexShape<T>& a, const ConvexShape<T>& b, const Vec<T, 3>& offset) {
+    T scale = std::max({a.bounding_radius(), b.bounding_radius(), std::fabs(offset[0]),
+                        std::fabs(offset[1]), std::fabs(offset[2])});
+    const T low = std::sqrt(std::numeric_limits<T>::min()) * T(1024);
+    const T high = std::sqrt(std::numeric_limits<T>::max()) / T(1024);
+    if (scale >= low && scale <= high) return scale;
+    scale = std::max({std::fabs(offset[0]), std::fabs(offset[1]), std::fabs(offset[2])});
+    for (const ConvexShape<T>* s : {&a, &b})
+        for (std::size_t i = 0; i < 3; ++i)
+            for (const T sign : {T(1), T(-1)}) {
+                Vec<T, 3> d{};
+                d[i] = sign;
+                const Vec<T, 3> p = s->support(d);
+                scale = std::max({scale, std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
+            }
+    return scale;
+}
+
 template <class T>
 ShapePair<T> make_shape_pair(const ConvexShape<T>& a, const Transform<T>& pose_a,
                              const ConvexShape<T>& b, const Transform<T>& pose_b, bool core,
@@ -89,12 +122,16 @@ ShapePair<T> make_shape_pair(const ConvexShape<T>& a, const Transform<T>& pose_a
     check_rigid_pose(pose_a, where, "pose_a");
     check_rigid_pose(pose_b, where, "pose_b");
     const Vec<T, 3> offset = pose_b.translation - pose_a.translation;
-    const T scale = std::max({a.bounding_radius(), b.bounding_radius(), length(offset)});
+    const T scale = pair_scale(a, b, offset);
+    // A power of two that brings the scale into [1, 2) (none for a pair of points at one place).
+    const int e = scale > T(0) && std::isfinite(scale) ? std::ilogb(scale) : 0;
+    const T factor = std::ldexp(T(1), -e), unscale = std::ldexp(T(1), e);
     constexpr std::uint32_t none = HullSupport<T>::none;
-    return {{&a, pose_a.rotation, Vec<T, 3>{}, core, none},
-            {&b, pose_b.rotation, offset, core, none},
+    return {{&a, pose_a.rotation, Vec<T, 3>{}, core, none, factor},
+            {&b, pose_b.rotation, offset * factor, core, none, factor},
             pose_a.translation,
-            T(64) * std::numeric_limits<T>::epsilon() * scale};
+            T(64) * std::numeric_limits<T>::epsilon() * scale * factor,
+            unscale};
 }
 
 template <class T>
@@ -189,13 +226,16 @@ ConvexDistance<T> convex_distance(const ConvexShape<T>& a, const Transform<T>& p
     r.iterations = g.iterations;
     if (g.overlap) {
         r.overlap = true;
-        r.point_a = r.point_b = convex_detail::simplex_witness_a(g.simplex) + pair.origin;
+        r.point_a = r.point_b = pair.world(convex_detail::simplex_witness_a(g.simplex));
         return r;
     }
+    // Back in world units (the working frame's factor undone) before the margins enter.
     const T ma = a.margin(), mb = b.margin();
-    const T core_distance = length(g.v);
-    const Vec<T, 3> n = g.v * (T(-1) / core_distance);
-    const Vec<T, 3> core_a = g.simplex.witness_a(), core_b = core_a - g.v;
+    const T v_length = length(g.v);
+    const T core_distance = v_length * pair.unscale;
+    const Vec<T, 3> n = g.v * (T(-1) / v_length);
+    const Vec<T, 3> core_a = g.simplex.witness_a() * pair.unscale;
+    const Vec<T, 3> core_b = core_a + n * core_distance;
     const T distance = core_distance - ma - mb;
     if (distance > T(0)) {
         r.distance = distance;

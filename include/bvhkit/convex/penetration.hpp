@@ -424,6 +424,7 @@ ConvexSignedDistance<T> convex_signed_distance(const ConvexShape<T>& a, const Tr
     const T ma = a.margin(), mb = b.margin();
     Vec<T, 3> core_a, n;
     T core_signed;  // the cores' signed distance
+    // In the working frame (scaled by a power of two), then back in world units below.
     if (!g.overlap) {
         core_signed = length(g.v);
         n = g.v * (T(-1) / core_signed);
@@ -439,6 +440,8 @@ ConvexSignedDistance<T> convex_signed_distance(const ConvexShape<T>& a, const Tr
         n = e.normal;
         core_a = e.witness_a;
     }
+    core_signed *= pair.unscale;
+    core_a = core_a * pair.unscale;
     r.signed_distance = core_signed - ma - mb;
     r.normal = n;
     r.point_a = core_a + n * ma + pair.origin;
