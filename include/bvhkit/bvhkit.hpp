@@ -28,6 +28,7 @@
 #include "bvhkit/primitives/segment.hpp"
 #include "bvhkit/query/closest_point_mesh.hpp"
 #include "bvhkit/query/contact_manifold.hpp"
+#include "bvhkit/query/convex_mesh.hpp"
 #include "bvhkit/query/crossings.hpp"
 #include "bvhkit/query/distance.hpp"
 #include "bvhkit/query/mesh_penetration.hpp"

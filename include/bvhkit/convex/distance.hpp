@@ -85,11 +85,15 @@ struct ShapePair {
     /// A point of the working frame in the world.
     Vec<T, 3> world(const Vec<T, 3>& x) const { return x * unscale + origin; }
 
+    using Scalar = T;
+
     /// The support point w = a - b of D along d, and the point a of A behind it.
     std::pair<Vec<T, 3>, Vec<T, 3>> support(const Vec<T, 3>& d) const {
         const Vec<T, 3> pa = a(d);
         return {pa - b(-d), pa};
     }
+    /// GJK's first direction: from A's position to B's.
+    Vec<T, 3> initial_direction() const { return b.offset; }
 };
 
 /// The pair's size: the larger bounding radius, or the offset's largest coordinate. A radius
@@ -142,10 +146,13 @@ struct GjkRun {
     int iterations = 0;
 };
 
-template <class T>
-GjkRun<T> run_gjk(const ShapePair<T>& p) {
+/// GJK on a pair with support(d) -> {w, a} (w a point of D = A - B, a the point of A behind it),
+/// initial_direction() and abs_tolerance: ShapePair, or a shape against a triangle
+/// (query/convex_mesh.hpp).
+template <class Pair, class T = typename Pair::Scalar>
+GjkRun<T> run_gjk(const Pair& p) {
     GjkRun<T> r;
-    Vec<T, 3> dir = p.b.offset;
+    Vec<T, 3> dir = p.initial_direction();
     if (!(length_squared(dir) > T(0))) dir = {T(1), T(0), T(0)};
     const auto [w0, a0] = p.support(dir);
     r.simplex.add(w0, a0);

@@ -304,15 +304,10 @@ Vec<typename V::Scalar, 3> seed_direction(const SolidModel<V>& a, const SolidMod
                                           bool* epa_converged) {
     using T = typename V::Scalar;
     const Transform<T> identity{Mat3<T>::identity(), Vec<T, 3>(T(0))};
+    // GJK and EPA work on the pair brought to unit size (convex/distance.hpp), so the hulls'
+    // answer holds at every scale.
     const ConvexSignedDistance<T> h = convex_signed_distance(a.hull(), identity, b.hull(), pose);
-    // GJK and EPA form products of up to four coordinates (volumes, squared normals): beyond a
-    // scale whose fourth power leaves T's normal range their answer is rounding, so it is only a
-    // seed there, not an exact depth.
-    const T extent = a.collision().scale() + b.collision().scale() +
-                     max_component(bvhkit::max(pose.translation, -pose.translation));
-    const T lo = T(16) * std::sqrt(std::sqrt(std::numeric_limits<T>::min()));
-    const T hi = std::sqrt(std::sqrt(std::numeric_limits<T>::max())) / T(16);
-    if (epa_converged) *epa_converged = h.converged && extent >= lo && extent <= hi;
+    if (epa_converged) *epa_converged = h.converged;
     if (length_squared(h.normal) > T(0.5)) return h.normal;
     return Vec<T, 3>{T(0), T(0), T(1)};
 }
