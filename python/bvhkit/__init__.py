@@ -9,7 +9,8 @@
 - :class:`Solid` with :func:`signed_distance_between`: the distance, or the penetration depth,
   between two closed meshes over batches of rigid poses.
 - :class:`Sphere`, :class:`Box`, :class:`Capsule`, :class:`Cylinder`, :class:`Cone` and
-  :class:`ConvexHull` with :func:`convex_distance` (GJK) and :func:`convex_signed_distance` (EPA).
+  :class:`ConvexHull` with :func:`convex_distance` (GJK) and :func:`convex_signed_distance` (EPA),
+  and against a mesh with :func:`convex_mesh_distance` and :func:`convex_mesh_collides`.
 - :class:`DynamicTree2D` and :class:`DynamicTree3D`: a dynamic AABB tree for moving boxes.
 - :class:`Scene`: many posed instances of shared meshes, for rays, closest points and collision
   (with :func:`pinhole_rays` for a camera's rays).
@@ -60,6 +61,9 @@ __all__ = [
     "ConvexDistances",
     "convex_signed_distance",
     "ConvexSignedDistances",
+    "convex_mesh_distance",
+    "convex_mesh_collides",
+    "ConvexMeshDistances",
     "DynamicTree2D",
     "DynamicTree3D",
     "Scene",
@@ -461,11 +465,14 @@ from ._convex import (  # noqa: E402
     Cone,
     ConvexDistances,
     ConvexHull,
+    ConvexMeshDistances,
     ConvexShape,
     ConvexSignedDistances,
     Cylinder,
     Sphere,
     convex_distance,
+    convex_mesh_collides,
+    convex_mesh_distance,
     convex_signed_distance,
 )
 from ._dynamic import DynamicTree2D, DynamicTree3D  # noqa: E402

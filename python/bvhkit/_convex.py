@@ -269,3 +269,78 @@ def convex_signed_distance(
     converged = np.empty(k, np.bool_)
     _bvhkit.convex_signed_distance(a._impl, b._impl, r, t, d, pa, pb, normal, converged, n)
     return ConvexSignedDistances(d, pa, pb, normal, converged)
+
+
+class ConvexMeshDistances(NamedTuple):
+    """What :func:`convex_mesh_distance` returns, one entry per pose, in the mesh's frame."""
+
+    distance: np.ndarray
+    """(k,) the distance between the shape and the mesh's triangles; 0 where they meet; inf for
+    a mesh without triangles."""
+    overlap: np.ndarray
+    """(k,) bool: the shape meets the mesh (touching counts)."""
+    point_shape: np.ndarray
+    """(k, 3) the closest point on the shape; where they meet, a point of the contact (NaN for a
+    mesh without triangles)."""
+    point_mesh: np.ndarray
+    """(k, 3) the closest point on the mesh (``point_mesh - point_shape`` has length
+    ``distance``)."""
+    face: np.ndarray
+    """(k,) int64 the mesh's face that point_mesh lies on (-1 for a mesh without triangles)."""
+
+
+def _shape_and_mesh(shape: Any, mesh: Any) -> None:
+    from ._collision import CollisionModel
+
+    if not isinstance(shape, ConvexShape):
+        raise TypeError(
+            f"shape: must be a ConvexShape (Sphere, Box, ...), not {type(shape).__name__}")
+    if not isinstance(mesh, CollisionModel):
+        raise TypeError(f"mesh: must be a CollisionModel, not {type(mesh).__name__}")
+    if mesh.dtype != _F64:
+        raise TypeError(f"mesh: must be a float64 CollisionModel (the shapes are float64), not "
+                        f"{mesh.dtype}")
+
+
+def convex_mesh_distance(
+    shape: ConvexShape,
+    mesh: Any,
+    rotations: Optional[npt.ArrayLike],
+    translations: npt.ArrayLike,
+    threads: int = 0,
+) -> ConvexMeshDistances:
+    """The distance between ``shape`` placed at each pose and the triangles of ``mesh`` (a float64
+    :class:`CollisionModel` of any volume), with the closest points and the mesh's face: the
+    mesh's tree walked best first, GJK between the shape and each triangle reached (spheres and
+    capsules exact to rounding). A pose maps a point x of the shape to ``rotations[i] @ x +
+    translations[i]`` in the mesh's frame (as in :func:`collide`; one pose may be (3, 3) and
+    (3,)); poses are spread over ``threads`` threads (0 = every core)."""
+    _shape_and_mesh(shape, mesh)
+    r, t, k = _pose_arrays(rotations, translations, _F64)
+    n = _threads(threads)
+    d = np.empty(k, _F64)
+    overlap = np.empty(k, np.bool_)
+    ps = np.empty((k, 3), _F64)
+    pm = np.empty((k, 3), _F64)
+    face = np.empty(k, np.int64)
+    _bvhkit.convex_mesh(mesh._impl, shape._impl, r, t, d, overlap, ps, pm, face, False, n)
+    return ConvexMeshDistances(d, overlap, ps, pm, face)
+
+
+def convex_mesh_collides(
+    shape: ConvexShape,
+    mesh: Any,
+    rotations: Optional[npt.ArrayLike],
+    translations: npt.ArrayLike,
+    threads: int = 0,
+) -> np.ndarray:
+    """Whether ``shape`` placed at each pose meets the triangles of ``mesh`` (poses as in
+    :func:`convex_mesh_distance`): (k,) bool, each pose stopping at the first triangle met."""
+    _shape_and_mesh(shape, mesh)
+    r, t, k = _pose_arrays(rotations, translations, _F64)
+    n = _threads(threads)
+    overlap = np.empty(k, np.bool_)
+    empty = np.empty((0,), _F64)
+    _bvhkit.convex_mesh(mesh._impl, shape._impl, r, t, empty, overlap, empty.reshape(0, 3),
+                        empty.reshape(0, 3), np.empty(0, np.int64), True, n)
+    return overlap

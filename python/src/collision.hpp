@@ -241,6 +241,21 @@ class Model {
         run_poses(r, t, 1, threads, per_pose);
     }
 
+    /// Calls per_pose(i, pose, model) for every pose of one more object (a convex shape:
+    /// convex.cpp) in this model's frame, without the GIL, under this model's shared lock.
+    template <class PerPose>
+    void shape_poses(const std::optional<PoseArray>& rotations, const PoseArray& translations,
+                     unsigned threads, PerPose&& per_pose) const {
+        const PoseValues<T> t(translations, 1, "translations");
+        const PoseValues<T> r =
+            rotations ? PoseValues<T>(*rotations, 2, "rotations") : PoseValues<T>();
+        pose_count(r, t);
+        nb::gil_scoped_release release;
+        const std::shared_lock<std::shared_mutex> lock(mutex_);
+        run_poses(r, t, 1, threads,
+                  [&](std::size_t i, const Transform<T>& pose) { per_pose(i, pose, model_); });
+    }
+
     void collides(const Model& b, const std::optional<PoseArray>& rotations,
                   const PoseArray& translations, OutColumn<bool> out, unsigned threads) const {
         expect_rows(out, PoseValues<T>(translations, 1, "translations").count(), "out");

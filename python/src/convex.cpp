@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bvhkit/convex/penetration.hpp"
+#include "bvhkit/query/convex_mesh.hpp"
 #include "collision.hpp"
 
 #include <nanobind/stl/optional.h>
@@ -129,6 +130,52 @@ void signed_distance_batch(const Convex& a, const Convex& b,
     });
 }
 
+/// The shape at each pose in the mesh model's frame: distance, overlap, closest points (the
+/// model's frame) and the mesh's face; with `collides_only`, only overlap (stopping at the first
+/// triangle met) and the other outputs untouched.
+template <class V>
+void mesh_batch(const Model<V>& mesh, const Convex& shape,
+                const std::optional<PoseArray>& rotations, const PoseArray& translations,
+                OutColumn<double> dist, OutColumn<bool> overlap, OutRows<double, 3> point_shape,
+                OutRows<double, 3> point_mesh, OutColumn<std::int64_t> face, bool collides_only,
+                unsigned threads) {
+    const std::size_t k = PoseValues<double>(translations, 1, "translations").count();
+    expect_rows(overlap, k, "overlap");
+    if (!collides_only) {
+        expect_rows(dist, k, "distance");
+        expect_rows(point_shape, k, "point_shape");
+        expect_rows(point_mesh, k, "point_mesh");
+        expect_rows(face, k, "face");
+    }
+    const Transform<double> identity = Transform<double>::identity();
+    mesh.shape_poses(rotations, translations, threads,
+                     [&](std::size_t i, const Transform<double>& pose, const CollisionModel<V>& m) {
+                         if (collides_only) {
+                             overlap.data()[i] =
+                                 convex_mesh_collides(shape.shape(), pose, m, identity);
+                             return;
+                         }
+                         const ConvexMeshDistance<double> c =
+                             convex_mesh_distance(shape.shape(), pose, m, identity);
+                         const bool found = c.face != ConvexMeshDistance<double>{}.face;
+                         dist.data()[i] = c.distance;
+                         overlap.data()[i] = c.overlap;
+                         const double nan = std::numeric_limits<double>::quiet_NaN();
+                         put(point_shape.data(), i, found ? c.point_shape : Vec<double, 3>(nan));
+                         put(point_mesh.data(), i, found ? c.point_mesh : Vec<double, 3>(nan));
+                         face.data()[i] = found ? std::int64_t(c.face) : -1;
+                     });
+}
+
+template <class V>
+void bind_mesh_batch(nb::module_& m) {
+    m.def("convex_mesh", &mesh_batch<V>, nb::arg("mesh"), nb::arg("shape"),
+          nb::arg("rotations").none(), nb::arg("translations"), nb::arg("distance"),
+          nb::arg("overlap"), nb::arg("point_shape"), nb::arg("point_mesh"), nb::arg("face"),
+          nb::arg("collides_only"), nb::arg("threads"),
+          "The shape at each pose in the mesh's frame against the mesh: into the arrays.");
+}
+
 }  // namespace
 
 void bind_convex(nb::module_& m) {
@@ -154,6 +201,13 @@ void bind_convex(nb::module_& m) {
           nb::arg("point_a"), nb::arg("point_b"), nb::arg("normal"), nb::arg("converged"),
           nb::arg("threads"),
           "Signed distance (minus the EPA penetration depth when overlapping) of b at each pose.");
+    bind_mesh_batch<Aabb<double, 3>>(m);
+    bind_mesh_batch<Sphere<double>>(m);
+    bind_mesh_batch<Obb<double>>(m);
+    bind_mesh_batch<Rss<double>>(m);
+    bind_mesh_batch<ObbRss<double>>(m);
+    bind_mesh_batch<Kdop<double, 18>>(m);
+    bind_mesh_batch<ConvexHull<double>>(m);
 }
 
 }  // namespace bvhkit::python

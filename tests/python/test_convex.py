@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import bvhkit
-from reference import random_rotations
+from reference import box_mesh, random_rotations
 
 I3 = np.eye(3)
 CUBE = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
@@ -338,3 +338,66 @@ def test_bad_poses_and_arguments(f):
     # bad values reported in the documented order: the translation first
     with pytest.raises(ValueError, match="translations"):
         f(a, b, np.stack([I3 * 2, I3]), [[0, 0, 0], [np.inf, 0, 0]])
+
+
+def test_convex_against_a_mesh_matches_the_analytic_box_distance():
+    """A sphere and a capsule against a closed box mesh [-1, 1]^3 (OBB and AABB trees): the
+    distance is the analytic distance from the centre (from the segment, found by dense sampling
+    and checked within its spacing) to the box, less the radius, and 0 where they meet."""
+    v, f = box_mesh([-1, -1, -1], [1, 1, 1])
+    rng = np.random.default_rng(5)
+    k = 400
+    centres = rng.uniform(-1.8, 1.8, (k, 3))
+    rotations = random_rotations(rng, k)
+
+    def box_distance(p):
+        return np.linalg.norm(np.maximum(np.abs(p) - 1, 0), axis=-1)
+
+    for volume in ("obb", "aabb", "rss"):
+        mesh = bvhkit.CollisionModel(v, f, volume=volume, dtype=np.float64)
+        d = bvhkit.convex_mesh_distance(bvhkit.Sphere(0.5), mesh, rotations, centres)
+        # The surface distance: outside the box it is the box distance; inside, the distance to
+        # the nearest face (the mesh is a surface: a sphere inside the box meets it only if it
+        # reaches a face).
+        inside = np.all(np.abs(centres) < 1, axis=1)
+        surface = np.where(inside, 1 - np.abs(centres).max(axis=1), box_distance(centres))
+        np.testing.assert_allclose(d.distance, np.maximum(surface - 0.5, 0), atol=1e-9)
+        np.testing.assert_array_equal(d.overlap, surface <= 0.5)
+        gap = np.linalg.norm(d.point_mesh - d.point_shape, axis=1)
+        np.testing.assert_allclose(gap, d.distance, atol=1e-9)
+        assert np.all(np.abs(d.point_mesh).max(axis=1) > 1 - 1e-9)  # on the box's surface
+        assert ((0 <= d.face) & (d.face < len(f))).all()
+        clear = np.abs(surface - 0.5) > 1e-6
+        np.testing.assert_array_equal(
+            bvhkit.convex_mesh_collides(bvhkit.Sphere(0.5), mesh, rotations, centres)[clear],
+            d.overlap[clear])
+        assert 50 < d.overlap.sum() < k - 50
+        # A capsule: its segment's distance to the surface by sampling the segment densely.
+        cap = bvhkit.convex_mesh_distance(bvhkit.Capsule(0.2, 0.5), mesh, rotations, centres)
+        s = np.linspace(-0.5, 0.5, 2001)
+        axis = rotations[:, :, 2]
+        pts = centres[:, None, :] + s[None, :, None] * axis[:, None, :]
+        inside = np.all(np.abs(pts) < 1, axis=2)
+        surf = np.where(inside, 1 - np.abs(pts).max(axis=2), box_distance(pts))
+        crosses = inside.any(axis=1) & (~inside).any(axis=1)
+        sampled = np.where(crosses, 0, surf.min(axis=1))
+        np.testing.assert_allclose(cap.distance, np.maximum(sampled - 0.2, 0), atol=1e-3)
+        assert np.all(cap.distance <= np.maximum(sampled - 0.2, 0) + 1e-9)  # samples: upper bounds
+
+
+def test_convex_against_a_mesh_bad_arguments():
+    v, f = box_mesh([-1, -1, -1], [1, 1, 1])
+    mesh64 = bvhkit.CollisionModel(v, f, dtype=np.float64)
+    mesh32 = bvhkit.CollisionModel(v, f)
+    with pytest.raises(TypeError, match="mesh"):
+        bvhkit.convex_mesh_distance(bvhkit.Sphere(1), mesh32, None, [0, 0, 0])
+    with pytest.raises(TypeError, match="mesh"):
+        bvhkit.convex_mesh_collides(bvhkit.Sphere(1), "mesh", None, [0, 0, 0])
+    with pytest.raises(TypeError, match="shape"):
+        bvhkit.convex_mesh_distance(mesh64, mesh64, None, [0, 0, 0])
+    with pytest.raises(ValueError, match="translations"):
+        bvhkit.convex_mesh_distance(bvhkit.Sphere(1), mesh64, None, [0, np.nan, 0])
+    with pytest.raises(ValueError, match="rotations"):
+        bvhkit.convex_mesh_collides(bvhkit.Sphere(1), mesh64, np.eye(3) * 2, [0, 0, 0])
+    one = bvhkit.convex_mesh_distance(bvhkit.Box([0.5, 0.5, 0.5]), mesh64, None, [3, 0, 0])
+    assert one.distance.shape == (1,) and one.distance[0] == pytest.approx(1.5, abs=1e-12)

@@ -81,7 +81,10 @@ PlacedShape<V> place(const ConvexShape<typename V::Scalar>& shape,
     using W = AccurateScalar<T>;
     check_rigid_pose(shape_pose, where, "shape_pose");
     check_rigid_pose(mesh_pose, where, "mesh_pose");
-    PlacedShape<V> s{&shape, {}, {}, T(0), {}};
+    struct {
+        Transform<T> in_mesh;
+        T reach = 0;
+    } s;
     // inverse(mesh_pose) * shape_pose in the wider type, rounded once: R_m^T R_s and
     // R_m^T (t_s - t_m), so two poses far out and near each other lose nothing.
     for (std::size_t i = 0; i < 3; ++i) {
@@ -119,10 +122,10 @@ PlacedShape<V> place(const ConvexShape<typename V::Scalar>& shape,
         faces.push_back({q[0], q[1], q[3]});
         faces.push_back({q[0], q[3], q[2]});
     }
-    s.volume = VolumeTraits<V>::fit(std::span<const Triangle<T>>(faces));
-    s.prepared =
-        VolumeTraits<V>::prepare(s.in_mesh, pose_slack(mesh.scale(), T(2) * s.reach, s.in_mesh));
-    return s;
+    const V volume = VolumeTraits<V>::fit(std::span<const Triangle<T>>(faces));
+    return {
+        &shape, s.in_mesh, volume, s.reach,
+        VolumeTraits<V>::prepare(s.in_mesh, pose_slack(mesh.scale(), T(2) * s.reach, s.in_mesh))};
 }
 
 /// GJK between the placed shape and triangle `tri` (mesh frame): the distance (0 when they
