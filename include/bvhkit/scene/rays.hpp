@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "bvhkit/build/build.hpp"
+#include "bvhkit/query/ray.hpp"
 #include "bvhkit/scene/scene.hpp"
 
 namespace bvhkit {
@@ -141,16 +143,135 @@ void all_hits(const Scene<T>& scene, const Ray<T, 3>& ray, std::vector<SceneHit<
     });
 }
 
+/// The scene's top level flattened for rays: a static binned-SAH tree over the instances' world
+/// boxes, one instance per leaf, each leaf holding what its ray needs (the pose, the geometry's
+/// ray tree) beside it. The dynamic top level is made for change (its nodes linked, its cast
+/// general enough for boxes); a batch of rays through a scene that stands still walks this one
+/// instead: flat nodes, and the ray's octant chosen once per ray rather than once per box
+/// (query/ray.hpp's walk).
+///
+/// A snapshot: it answers for the scene as it was when made (its poses copied, its geometry's
+/// trees referenced, so it must not outlive the scene), and changing the scene afterwards leaves
+/// it stale; make a new one. Making it costs a build over the instances (O(n log n)), so it pays
+/// for itself over many rays: closest_hits and any_hits make one per call when the batch is large
+/// enough (ray_top_min_rays).
+template <class T>
+class SceneRayTop {
+  public:
+    explicit SceneRayTop(const Scene<T>& scene) {
+        std::vector<Aabb<T, 3>> boxes;
+        std::vector<Vec<T, 3>> centres;
+        scene.for_each_instance([&](InstanceId id) {
+            const SceneInstance<T>& r = scene.instance_at(id.proxy());
+            const SceneGeometry<T>& g = scene.geometry_at(r.geometry);
+            if (!g.has_extent()) return;
+            boxes.push_back(r.box);
+            centres.push_back(safe_centroid(r.box));
+            entries_.push_back({r.pose, &g.ray_tree(), id.proxy(), r.geometry});
+        });
+        BuildOptions options;
+        options.max_leaf_size = 1;  // an instance costs a whole tree walk: never two per leaf
+        options.threads = 1;
+        bvh_ = build_bvh<T, 3>(boxes, centres, options);
+    }
+
+    /// As closest_hit(scene, ray) for the scene when this was made (of hits at the same t, the
+    /// one this walk reaches first wins, which may be another instance than closest_hit's).
+    SceneHit<T> closest_hit(const Ray<T, 3>& ray) const {
+        SceneHit<T> best;
+        if (!scene_detail::check_scene_ray(ray, "SceneRayTop::closest_hit") || bvh_.nodes.empty())
+            return best;
+        Hit<T> best_local;
+        const Entry* best_entry = nullptr;
+        Ray<T, 3> walk = ray;
+        traverse_ray(bvh_, walk, [&](const BvhNode<Aabb<T, 3>>& leaf) {
+            const Entry& e = entries_[bvh_.primitive_indices[leaf.first]];
+            const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, walk.tmax);
+            if (!is_traceable(local)) return false;  // overflowed in the instance's frame
+            const Hit<T> h = e.tree->closest_hit(local);
+            if (!h || !(h.t < best_local.t)) return false;
+            best_local = h;
+            best_entry = &e;
+            walk.tmax = h.t;
+            return h.t == T(0);  // a hit at the origin: nothing can be nearer
+        });
+        if (best_entry) {
+            best.instance = InstanceId(best_entry->proxy);
+            best.geometry = best_entry->geometry;
+            best.face = best_local.primitive;
+            best.t = best_local.t;
+            best.u = best_local.u;
+            best.v = best_local.v;
+            best.normal = scene_detail::to_world_vector<AccurateScalar<T>>(best_entry->pose,
+                                                                           best_local.normal);
+        }
+        return best;
+    }
+
+    /// As any_hit(scene, ray) for the scene when this was made.
+    bool any_hit(const Ray<T, 3>& ray) const {
+        if (!scene_detail::check_scene_ray(ray, "SceneRayTop::any_hit") || bvh_.nodes.empty())
+            return false;
+        bool hit = false;
+        Ray<T, 3> walk = ray;
+        traverse_ray(bvh_, walk, [&](const BvhNode<Aabb<T, 3>>& leaf) {
+            const Entry& e = entries_[bvh_.primitive_indices[leaf.first]];
+            const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, ray.tmax);
+            hit = is_traceable(local) && e.tree->any_hit(local);
+            return hit;
+        });
+        return hit;
+    }
+
+  private:
+    struct Entry {
+        Transform<T> pose;
+        const TriangleBvh<T>* tree;
+        ProxyId proxy;
+        GeometryId geometry;
+    };
+    Bvh<Aabb<T, 3>> bvh_;
+    std::vector<Entry> entries_;  // by the tree's primitive index
+};
+
+/// The batch size from which closest_hits and any_hits trace through a SceneRayTop made for the
+/// call: below it, making one costs more than it saves.
+template <class T>
+std::size_t ray_top_min_rays(const Scene<T>& scene) {
+    return 64 + 4 * scene.instance_count();
+}
+
 /// hits[i] = closest_hit(scene, rays[i]) for every ray, on the calling thread (serial: call it
-/// from several threads on parts of a batch to use more cores). Error when the spans' lengths
-/// differ.
+/// from several threads on parts of a batch to use more cores); a large batch goes through a
+/// SceneRayTop made for the call (so a tie between instances at the same t may go to another of
+/// them than closest_hit's). Error when the spans' lengths differ.
 template <class T>
 void closest_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
                   std::span<SceneHit<T>> hits) {
     if (rays.size() != hits.size())
         throw Error("closest_hits(Scene): " + std::to_string(rays.size()) + " rays but " +
                     std::to_string(hits.size()) + " hits");
+    if (rays.size() >= ray_top_min_rays(scene)) {
+        const SceneRayTop<T> top(scene);
+        for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = top.closest_hit(rays[i]);
+        return;
+    }
     for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(scene, rays[i]);
+}
+
+/// hit[i] = any_hit(scene, rays[i]) for every ray, as closest_hits goes (serial; a large batch
+/// through a SceneRayTop). Error when the spans' lengths differ.
+template <class T>
+void any_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays, std::span<bool> hit) {
+    if (rays.size() != hit.size())
+        throw Error("any_hits(Scene): " + std::to_string(rays.size()) + " rays but " +
+                    std::to_string(hit.size()) + " answers");
+    if (rays.size() >= ray_top_min_rays(scene)) {
+        const SceneRayTop<T> top(scene);
+        for (std::size_t i = 0; i < rays.size(); ++i) hit[i] = top.any_hit(rays[i]);
+        return;
+    }
+    for (std::size_t i = 0; i < rays.size(); ++i) hit[i] = any_hit(scene, rays[i]);
 }
 
 }  // namespace bvhkit
