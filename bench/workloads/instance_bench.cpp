@@ -194,15 +194,21 @@ std::vector<Row> run_instance_bench(const InstanceBenchOptions& options, std::FI
              {Workload{"S3-R1", &r1, false}, Workload{"S3-R1-any", &r1, true},
               Workload{"S3-R2", &r2, false}, Workload{"S3-R2-any", &r2, true}}) {
             if (progress) std::fprintf(progress, "  %s ...\n", w.name);
-            std::size_t hits[2] = {0, 0};
+            std::size_t hits[3] = {0, 0, 0};
+            std::vector<SceneHit<float>> batch_hits(w.occlusion ? 0 : w.rays->size());
+            std::unique_ptr<bool[]> batch_flags(new bool[w.occlusion ? w.rays->size() : 0]);
+            const std::span<bool> flags(batch_flags.get(), w.occlusion ? w.rays->size() : 0);
             std::vector<std::function<void()>> runs{
-                [&] { hits[0] = trace_scene_rays(*scene, *w.rays, w.occlusion); }};
+                [&] { hits[0] = trace_scene_rays(*scene, *w.rays, w.occlusion); },
+                [&] {
+                    hits[1] = trace_scene_batch(*scene, *w.rays, w.occlusion, batch_hits, flags);
+                }};
 #if BVHKIT_HAVE_EMBREE
             runs.push_back([&] {
                 std::size_t n = 0;
                 for (const Ray3f& r : *w.rays)
                     n += w.occlusion ? embree.any_hit(r) : bool(embree.closest_hit(r));
-                hits[1] = n;
+                hits[2] = n;
             });
 #endif
             const std::vector<double> ms = median_ms_interleaved(options.repetitions, runs);
@@ -210,17 +216,22 @@ std::vector<Row> run_instance_bench(const InstanceBenchOptions& options, std::FI
             Row row = row_for(w.name, "bvhkit");
             row.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[0]);
             row.set("ms", ms[0]).set("mrays_per_s", n / ms[0] / 1e3);
+            Row batch = row_for(w.name, "bvhkit-batch");
+            batch.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[1]);
+            batch.set("ms", ms[1]).set("mrays_per_s", n / ms[1] / 1e3);
 #if BVHKIT_HAVE_EMBREE
             const Agreement agree = compare(*scene, mesh, poses, embree, *w.rays, w.occlusion);
-            row.set("speedup", ms[1] / ms[0]).set("disagree", agree.disagree);
+            row.set("speedup", ms[2] / ms[0]).set("disagree", agree.disagree);
             row.set("ties", agree.ties).set("bvhkit_right", agree.bvhkit_right);
             row.set("embree_right", agree.embree_right);
+            batch.set("speedup", ms[2] / ms[1]);
 #endif
             rows.push_back(row);
+            rows.push_back(batch);
             if (peer) {
                 Row p = row_for(w.name, "embree3");
-                p.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[1]);
-                p.set("ms", ms[1]).set("mrays_per_s", n / ms[1] / 1e3);
+                p.set("rays", (long long)w.rays->size()).set("hits", (long long)hits[2]);
+                p.set("ms", ms[2]).set("mrays_per_s", n / ms[2] / 1e3);
                 rows.push_back(p);
             }
         }

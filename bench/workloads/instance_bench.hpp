@@ -17,7 +17,9 @@
 namespace bvhkit {
 template <class T>
 class Scene;
-}
+template <class T>
+struct SceneHit;
+}  // namespace bvhkit
 
 namespace bvhkit::bench {
 
@@ -39,7 +41,9 @@ struct InstanceBenchOptions {
 std::vector<Transform<float>> crowd_poses(const Aabb3f& bounds, std::size_t count, double density,
                                           std::uint64_t seed);
 
-/// One row per (workload, instance count, library); bvhkit's rows carry `speedup` = Embree ms /
+/// One row per (workload, instance count, library): bvhkit (one call per ray), bvhkit-batch (the
+/// batch call on all the rays, the flat top level's build included) and embree3 (rtcIntersect1 /
+/// rtcOccluded1 per ray). bvhkit's rows carry `speedup` = Embree ms /
 /// bvhkit ms and, with Embree, `disagree`: the rays whose answers differ (hit or miss, instance,
 /// or t beyond a relative 1e-4 or an absolute 1e-6 of the crowd's size), of which `ties` (two
 /// instances hit at the same t), and of the rest how many each library got right by a brute-force
@@ -50,5 +54,11 @@ std::vector<Row> run_instance_bench(const InstanceBenchOptions& options, std::FI
 /// of every ray over the scene; returns how many rays hit.
 std::size_t trace_scene_rays(const Scene<float>& scene, std::span<const Ray3f> rays,
                              bool occlusion);
+
+/// The same through the batch calls (closest_hits into `hits`, or any_hits into `flags`, each as
+/// long as `rays`), which trace a large batch through a flat top level made for the call.
+std::size_t trace_scene_batch(const Scene<float>& scene, std::span<const Ray3f> rays,
+                              bool occlusion, std::span<SceneHit<float>> hits,
+                              std::span<bool> flags);
 
 }  // namespace bvhkit::bench

@@ -14,4 +14,18 @@ std::size_t trace_scene_rays(const Scene<float>& scene, std::span<const Ray3f> r
     return hits;
 }
 
+std::size_t trace_scene_batch(const Scene<float>& scene, std::span<const Ray3f> rays,
+                              bool occlusion, std::span<SceneHit<float>> hits,
+                              std::span<bool> flags) {
+    std::size_t n = 0;
+    if (occlusion) {
+        any_hits(scene, rays, flags);
+        for (const bool f : flags) n += f;
+    } else {
+        closest_hits(scene, rays, hits);
+        for (const SceneHit<float>& h : hits) n += bool(h);
+    }
+    return n;
+}
+
 }  // namespace bvhkit::bench
