@@ -184,17 +184,21 @@ class SceneRayTop {
         Hit<T> best_local;
         const Entry* best_entry = nullptr;
         Ray<T, 3> walk = ray;
-        traverse_ray(bvh_, walk, [&](const BvhNode<Aabb<T, 3>>& leaf) {
-            const Entry& e = entries_[bvh_.primitive_indices[leaf.first]];
-            const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, walk.tmax);
-            if (!is_traceable(local)) return false;  // overflowed in the instance's frame
-            const Hit<T> h = e.tree->closest_hit(local);
-            if (!h || !(h.t < best_local.t)) return false;
-            best_local = h;
-            best_entry = &e;
-            walk.tmax = h.t;
-            return h.t == T(0);  // a hit at the origin: nothing can be nearer
-        });
+        // The ray was checked above and the tree is not empty: the walk's own checks are skipped.
+        traverse_ray(
+            bvh_view(bvh_), walk, RaySlabData<T, 3>(ray),
+            [&](const BvhNode<Aabb<T, 3>>& leaf) {
+                const Entry& e = entries_[bvh_.primitive_indices[leaf.first]];
+                const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, walk.tmax);
+                if (!is_traceable(local)) return false;  // overflowed in the instance's frame
+                const Hit<T> h = e.tree->closest_hit(local);
+                if (!h || !(h.t < best_local.t)) return false;
+                best_local = h;
+                best_entry = &e;
+                walk.tmax = h.t;
+                return h.t == T(0);  // a hit at the origin: nothing can be nearer
+            },
+            NoStats{});
         if (best_entry) {
             best.instance = InstanceId(best_entry->proxy);
             best.geometry = best_entry->geometry;
@@ -214,12 +218,15 @@ class SceneRayTop {
             return false;
         bool hit = false;
         Ray<T, 3> walk = ray;
-        traverse_ray(bvh_, walk, [&](const BvhNode<Aabb<T, 3>>& leaf) {
-            const Entry& e = entries_[bvh_.primitive_indices[leaf.first]];
-            const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, ray.tmax);
-            hit = is_traceable(local) && e.tree->any_hit(local);
-            return hit;
-        });
+        traverse_ray(
+            bvh_view(bvh_), walk, RaySlabData<T, 3>(ray),
+            [&](const BvhNode<Aabb<T, 3>>& leaf) {
+                const Entry& e = entries_[bvh_.primitive_indices[leaf.first]];
+                const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, ray.tmax);
+                hit = is_traceable(local) && e.tree->any_hit(local);
+                return hit;
+            },
+            NoStats{});
         return hit;
     }
 
