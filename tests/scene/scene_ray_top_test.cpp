@@ -78,6 +78,17 @@ std::vector<Ray<T, 3>> random_rays(const Scene<T>& scene, std::size_t count, std
     rays.emplace_back(rays[1].origin, rays[1].direction, T(0.1), std::numeric_limits<T>::max());
     const Vec<T, 3> c = (box.min + box.max) * T(0.5);
     rays.emplace_back(Vec<T, 3>{box.min[0] - T(1), c[1], c[2]}, Vec<T, 3>{T(1), T(0), T(0)});
+    // Axis-aligned rays (zero components: infinite reciprocals, and NaN slab distances where the
+    // origin lies on a box's plane) and a subnormal component (a NaN reciprocal: the axis is
+    // ignored, which must not let the ray into an empty lane of a wide node).
+    const T tiny = std::numeric_limits<T>::denorm_min() * T(8);
+    for (std::size_t i = 0; i < 40; ++i) {
+        const Vec<T, 3> o = rays[i].origin;
+        rays.emplace_back(o, Vec<T, 3>{T(0), T(0), i % 2 ? T(1) : T(-1)});
+        rays.emplace_back(o, Vec<T, 3>{T(0), i % 2 ? T(1) : T(-1), T(0)});
+        rays.emplace_back(o, Vec<T, 3>{tiny, T(1), T(0.5)});
+        rays.emplace_back(Vec<T, 3>{c[0], o[1], o[2]}, Vec<T, 3>{T(1), T(0), tiny});
+    }
     return rays;
 }
 

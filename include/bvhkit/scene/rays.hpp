@@ -24,6 +24,7 @@
 
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/query/ray.hpp"
+#include "bvhkit/scene/ray_top_wide.hpp"
 #include "bvhkit/scene/scene.hpp"
 
 namespace bvhkit {
@@ -173,6 +174,9 @@ class SceneRayTop {
         options.max_leaf_size = 1;  // an instance costs a whole tree walk: never two per leaf
         options.threads = 1;
         bvh_ = build_bvh<T, 3>(boxes, centres, options);
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>) wide_ = scene_detail::WideTop4(bvh_);
+#endif
     }
 
     /// As closest_hit(scene, ray) for the scene when this was made (of hits at the same t, the
@@ -183,22 +187,18 @@ class SceneRayTop {
             return best;
         Hit<T> best_local;
         const Entry* best_entry = nullptr;
-        Ray<T, 3> walk = ray;
-        // The ray was checked above and the tree is not empty: the walk's own checks are skipped.
-        traverse_ray(
-            bvh_view(bvh_), walk, RaySlabData<T, 3>(ray),
-            [&](const BvhNode<Aabb<T, 3>>& leaf) {
-                const Entry& e = entries_[bvh_.primitive_indices[leaf.first]];
-                const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, walk.tmax);
-                if (!is_traceable(local)) return false;  // overflowed in the instance's frame
-                const Hit<T> h = e.tree->closest_hit(local);
-                if (!h || !(h.t < best_local.t)) return false;
-                best_local = h;
-                best_entry = &e;
-                walk.tmax = h.t;
-                return h.t == T(0);  // a hit at the origin: nothing can be nearer
-            },
-            NoStats{});
+        T tmax = ray.tmax;
+        walk<true>(ray, tmax, [&](std::uint32_t i) {
+            const Entry& e = entries_[i];
+            const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, tmax);
+            if (!is_traceable(local)) return false;  // overflowed in the instance's frame
+            const Hit<T> h = e.tree->closest_hit(local);
+            if (!h || !(h.t < best_local.t)) return false;
+            best_local = h;
+            best_entry = &e;
+            tmax = h.t;
+            return h.t == T(0);  // a hit at the origin: nothing can be nearer
+        });
         if (best_entry) {
             best.instance = InstanceId(best_entry->proxy);
             best.geometry = best_entry->geometry;
@@ -217,16 +217,13 @@ class SceneRayTop {
         if (!scene_detail::check_scene_ray(ray, "SceneRayTop::any_hit") || bvh_.nodes.empty())
             return false;
         bool hit = false;
-        Ray<T, 3> walk = ray;
-        traverse_ray(
-            bvh_view(bvh_), walk, RaySlabData<T, 3>(ray),
-            [&](const BvhNode<Aabb<T, 3>>& leaf) {
-                const Entry& e = entries_[bvh_.primitive_indices[leaf.first]];
-                const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, ray.tmax);
-                hit = is_traceable(local) && e.tree->any_hit(local);
-                return hit;
-            },
-            NoStats{});
+        T tmax = ray.tmax;
+        walk<false>(ray, tmax, [&](std::uint32_t i) {
+            const Entry& e = entries_[i];
+            const Ray<T, 3> local = scene_detail::local_ray(e.pose, ray, ray.tmax);
+            hit = is_traceable(local) && e.tree->any_hit(local);
+            return hit;
+        });
         return hit;
     }
 
@@ -237,7 +234,36 @@ class SceneRayTop {
         ProxyId proxy;
         GeometryId geometry;
     };
+    /// on_instance(index in entries_) -> bool (true stops) for each instance whose box the ray
+    /// meets within [tmin, tmax], which on_instance may lower; a checked ray, a tree not empty.
+    template <bool NearestFirst, class F>
+    void walk(const Ray<T, 3>& ray, T& tmax, F&& on_instance) const {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>) {
+            wide_.template walk<NearestFirst>(ray, tmax, on_instance);
+            return;
+        }
+#endif
+        Ray<T, 3> narrowed = ray;
+        // The ray was checked by the caller and the tree is not empty: the walk's own checks are
+        // skipped.
+        traverse_ray(
+            bvh_view(bvh_), narrowed, RaySlabData<T, 3>(ray),
+            [&](const BvhNode<Aabb<T, 3>>& leaf) {
+                for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
+                    const bool stop = on_instance(bvh_.primitive_indices[s]);
+                    narrowed.tmax = tmax;
+                    if (stop) return true;
+                }
+                return false;
+            },
+            NoStats{});
+    }
+
     Bvh<Aabb<T, 3>> bvh_;
+#if defined(__SSE2__)
+    scene_detail::WideTop4 wide_;  // float scenes: the same tree, four children a node
+#endif
     std::vector<Entry> entries_;  // by the tree's primitive index
 };
 
