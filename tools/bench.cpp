@@ -1,12 +1,17 @@
-// `bvhkit bench rays|dynamic|nearest|collide|files ...`: the same-run comparisons against the
-// peers.
+// `bvhkit bench rays|instances|dynamic|nearest|collide|files ...`: the same-run comparisons against
+// the peers.
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 #include "args.hpp"
+#include "bvhkit/error.hpp"
 #include "commands.hpp"
 #include "file_bench.hpp"
+#include "instance_bench.hpp"
 #include "nearest_bench.hpp"
 #include "output.hpp"
 #include "ray_bench.hpp"
@@ -53,6 +58,71 @@ int bench_rays(int argc, char** argv) {
                      "Embree 3 was not found at build time (apt-get install libembree-dev): "
                      "only bvhkit is measured\n");
     const auto rows = bench::run_ray_bench(o, args.flag("--json") ? nullptr : stderr);
+    print_rows(rows, args.flag("--json"));
+    return 0;
+}
+
+constexpr const char* kInstancesHelp =
+    R"(usage: bvhkit bench instances [MESH] [--json] [--reps N] [--rays N] [--size N]
+                              [--counts N,N,...] [--density D] [--seed S]
+
+Workload S3 (issue 40) for bvhkit's Scene and Embree 3's instances (RTC_GEOMETRY_TYPE_INSTANCE, when
+installed), in this process, one thread each: a crowd of instances of one mesh at random rigid poses,
+then closest and any hit for camera rays framing the crowd (S3-R1, SIZE x SIZE) and random rays from
+inside the crowd's box (S3-R2). Build and ray times are medians of N interleaved repetitions;
+speedup = Embree ms / bvhkit ms (> 1: bvhkit is faster). disagree: rays whose answers differ (hit or
+miss, instance, t beyond a relative 1e-4); ties: of those, two instances hit at the same t; bvhkit_right
+and embree_right: of the rest, which answer a brute-force referee in double confirms. MESH is a
+file or a generator spec; the default is the shared bunny when present, else a procedural sphere.
+
+  --json          print a JSON array of rows instead of a table
+  --reps N        repetitions per figure (default 5)
+  --rays N        rays in S3-R2 (default 1000000)
+  --size N        S3-R1 image side (default 1024)
+  --counts LIST   instances per scene, comma separated (default 100,10000)
+  --density D     fraction of the crowd's cube the instances' bounding spheres fill (default 0.3)
+  --seed S        poses and random rays (default 1)
+)";
+
+int bench_instances(int argc, char** argv) {
+    const Args args(argc, argv, {"--reps", "--rays", "--size", "--counts", "--density", "--seed"},
+                    {"--json"});
+    if (args.help()) {
+        std::fputs(kInstancesHelp, stdout);
+        return 0;
+    }
+    bench::InstanceBenchOptions o;
+    const auto meshes = args.positional();
+    if (meshes.size() > 1) throw Error("bench instances: one mesh at most");
+    o.mesh = meshes.empty() ? default_bench_meshes().front() : meshes.front();
+    o.repetitions = int(args.integer("--reps", 5, 1, 1000));
+    o.random_rays = std::size_t(args.integer("--rays", 1000000, 1, 100000000));
+    o.camera_size = std::uint32_t(args.integer("--size", 1024, 1, 16384));
+    o.counts.clear();
+    const std::string counts = args.value("--counts", "100,10000");
+    for (std::size_t b = 0; b <= counts.size();) {
+        const std::size_t e = std::min(counts.find(',', b), counts.size());
+        const std::string item = counts.substr(b, e - b);
+        char* end = nullptr;
+        const unsigned long long n = std::strtoull(item.c_str(), &end, 10);
+        if (item.empty() || *end != 0 || n < 1 || n > 10000000)
+            throw Error("--counts: '" + item + "' is not a count of instances in [1, 10000000]");
+        o.counts.push_back(std::size_t(n));
+        b = e + 1;
+    }
+    if (args.has("--density")) {
+        const std::string v = args.value("--density");
+        char* end = nullptr;
+        o.density = std::strtod(v.c_str(), &end);
+        if (v.empty() || *end != 0 || !(o.density > 0 && o.density <= 1))
+            throw Error("option --density: '" + v + "' is not a number in (0, 1]");
+    }
+    o.seed = std::uint64_t(args.integer("--seed", 1, 0, 1000000000));
+    if (!bench::have_embree())
+        std::fprintf(stderr,
+                     "Embree 3 was not found at build time (apt-get install libembree-dev): "
+                     "only bvhkit is measured\n");
+    const auto rows = bench::run_instance_bench(o, args.flag("--json") ? nullptr : stderr);
     print_rows(rows, args.flag("--json"));
     return 0;
 }
@@ -132,12 +202,14 @@ int bench_files(int argc, char** argv) {
 int bench_command(int argc, char** argv) {
     const std::string_view what = argc > 1 ? argv[1] : "";
     if (what == "rays") return bench_rays(argc - 1, argv + 1);
+    if (what == "instances") return bench_instances(argc - 1, argv + 1);
     if (what == "dynamic") return bench_dynamic_command(argc - 1, argv + 1);
     if (what == "collide") return bench_collide_command(argc - 1, argv + 1);
     if (what == "nearest") return bench_nearest(argc - 1, argv + 1);
     if (what == "files") return bench_files(argc - 1, argv + 1);
     std::fprintf(what == "--help" || what == "-h" ? stdout : stderr,
-                 "usage: bvhkit bench rays|dynamic|nearest|collide|files [...]   (bvhkit bench "
+                 "usage: bvhkit bench rays|instances|dynamic|nearest|collide|files [...]   (bvhkit "
+                 "bench "
                  "WORKLOAD --help for each)\n");
     return what == "--help" || what == "-h" ? 0 : 2;
 }

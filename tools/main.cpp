@@ -17,7 +17,8 @@ struct Subcommand {
 };
 
 const Subcommand kSubcommands[] = {
-    {"bench", "same-run benchmarks against the peers (rays, dynamic, nearest, collide, files)",
+    {"bench",
+     "same-run benchmarks against the peers (rays, instances, dynamic, nearest, collide, files)",
      bvhkit::tools::bench_command},
     {"bsp", "the BSP tree of a mesh and its statistics", bvhkit::tools::bsp_command},
     {"closest", "closest points on a mesh for a points file", bvhkit::tools::closest_command},

@@ -43,6 +43,7 @@
 #include "bvhkit/scene/configurations.hpp"
 #include "bvhkit/scene/distance.hpp"
 #include "bvhkit/scene/face_contacts.hpp"
+#include "bvhkit/scene/ray_batches.hpp"
 #include "bvhkit/scene/rays.hpp"
 #include "bvhkit/scene/scene_file.hpp"
 #include "bvhkit/scene/signed_distance.hpp"

@@ -11,6 +11,7 @@
 
 #include "bvhkit/mesh/procedural.hpp"
 #include "bvhkit/scene/closest_point.hpp"
+#include "bvhkit/scene/ray_batches.hpp"
 #include "bvhkit/scene/rays.hpp"
 #include "scene_support.hpp"
 

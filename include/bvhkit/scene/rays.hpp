@@ -18,13 +18,10 @@
 // leaves T's finite range in an instance's frame (a direction of 3e38 rotated 45 degrees, an
 // origin 3e38 from an instance at -3e38) misses that instance.
 #include <algorithm>
-#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
 
-#include "bvhkit/exec/executor.hpp"
-#include "bvhkit/query/triangle_rays.hpp"
 #include "bvhkit/scene/scene.hpp"
 
 namespace bvhkit {
@@ -148,40 +145,6 @@ void all_hits(const Scene<T>& scene, const Ray<T, 3>& ray, std::vector<SceneHit<
             return a.instance.index() < b.instance.index();
         return a.face < b.face;
     });
-}
-
-/// hits[i] = closest_hit(scene, rays[i]) for every ray, on `threads` threads (0 = every core, 1 =
-/// the calling thread; several only when bvhkit has oneTBB) or on an Executor. Rays go in fixed
-/// chunks and each answer is its ray's alone, so the answers equal the one-by-one calls for any
-/// thread count. The first rays to reach a geometry build its ray tree (once, under call_once).
-/// Error when the spans' lengths differ.
-template <class T>
-void closest_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
-                  std::span<SceneHit<T>> hits, const Executor& exec) {
-    scene_detail::check_batch(rays.size(), hits.size(), "closest_hits(Scene): hits");
-    exec.parallel_for(rays.size(), ray_batch_grain, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) hits[i] = closest_hit(scene, rays[i]);
-    });
-}
-template <class T>
-void closest_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
-                  std::span<SceneHit<T>> hits, unsigned threads = 0) {
-    closest_hits(scene, rays, hits, Executor(threads));
-}
-
-/// occluded[i] = any_hit(scene, rays[i]) (1 or 0) for every ray, threads as closest_hits.
-template <class T>
-void any_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
-              std::span<std::uint8_t> occluded, const Executor& exec) {
-    scene_detail::check_batch(rays.size(), occluded.size(), "any_hits(Scene): occluded");
-    exec.parallel_for(rays.size(), ray_batch_grain, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) occluded[i] = std::uint8_t(any_hit(scene, rays[i]));
-    });
-}
-template <class T>
-void any_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
-              std::span<std::uint8_t> occluded, unsigned threads = 0) {
-    any_hits(scene, rays, occluded, Executor(threads));
 }
 
 }  // namespace bvhkit

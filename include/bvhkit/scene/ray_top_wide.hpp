@@ -1,0 +1,176 @@
+#pragma once
+// The four-wide top level of SceneRayTop (scene/rays.hpp) for float scenes: the binary tree over
+// the instances' world boxes collapsed into nodes of four children, whose boxes are held one array
+// per axis and bound, so one SSE pass clips the ray against all four (Wald, Benthin and Boulos,
+// "Getting rid of packets", 2008; Dammertz et al., "Shallow bounding volume hierarchies", 2008).
+// A top level has one instance a leaf and its leaves cost a whole bottom-level walk each, so
+// its nodes are few and the walk is the simple one: the children hit are sorted by entry distance
+// and pushed farthest first; an entry beyond the closest hit so far is dropped when popped.
+//
+// The slab test is RaySlabData's (math/ray.hpp) lane by lane: the near and far planes chosen by
+// the direction's signs, the far distance scaled up by 1 + 2 gamma(3) (so rounding never loses a
+// box the ray meets), and a NaN distance (a zero or subnormal direction component on a plane)
+// leaving the interval as it was. An empty lane is marked in the node's mask, not by its box, so
+// a ray that ignores an axis (a subnormal component: NaN distances) cannot enter it.
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/math/ray.hpp"
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+namespace bvhkit::scene_detail {
+
+#if defined(__SSE2__)
+
+class WideTop4 {
+  public:
+    WideTop4() = default;
+    /// From a binary tree: each wide node takes a binary node's two children and opens the
+    /// largest internal one among them until it has four; a leaf keeps its run of primitives.
+    explicit WideTop4(const Bvh<Aabb<float, 3>>& bvh) : primitives_(bvh.primitive_indices) {
+        if (bvh.nodes.empty()) return;
+        nodes_.reserve(bvh.nodes.size() / 2 + 1);
+        nodes_.emplace_back();
+        fill(bvh, 0, 0);
+    }
+    bool empty() const { return nodes_.empty(); }
+
+    /// Walks the leaves the ray meets within [ray.tmin, tmax], for a traceable ray:
+    /// on_leaf(primitive) -> bool for each primitive of each, true stops the walk; it may lower
+    /// tmax (a closest hit), and with NearestFirst the leaves are reached in order of their boxes'
+    /// entry distance.
+    template <bool NearestFirst, class OnLeaf>
+    void walk(const Ray<float, 3>& ray, float& tmax, OnLeaf&& on_leaf) const {
+        if (nodes_.empty()) return;
+        constexpr float far_scale = 1.0f + 2.0f * rounding_gamma<float>(3);
+        const RaySlabData<float, 3> slab(ray);
+        __m128 origin[3], inv[3];
+        std::uint32_t near_row[3];
+        for (std::size_t a = 0; a < 3; ++a) {
+            origin[a] = _mm_set1_ps(slab.origin[a]);
+            inv[a] = _mm_set1_ps(slab.inv_direction[a]);
+            near_row[a] = (slab.octant >> a) & 1u;  // 1: the near plane is the box's max
+        }
+        const __m128 scale = _mm_set1_ps(far_scale);
+        struct Pending {
+            std::int32_t child;
+            float entry;
+        };
+        // Depth of the collapsed tree times three (each node pushes at most three besides the
+        // one walked next), with room to spare: a binary top level is at most max_bvh_depth deep.
+        Pending stack[3 * max_bvh_depth + 4];
+        int size = 0;
+        std::int32_t current = 0;
+        while (true) {
+            if (current >= 0) {
+                const Node& n = nodes_[std::size_t(current)];
+                __m128 t0 = _mm_set1_ps(ray.tmin), t1 = _mm_set1_ps(tmax);
+                for (std::size_t a = 0; a < 3; ++a) {
+                    const __m128 lo = _mm_load_ps(n.bound[near_row[a]][a]);
+                    const __m128 hi = _mm_load_ps(n.bound[1 - near_row[a]][a]);
+                    const __m128 tn = _mm_mul_ps(_mm_sub_ps(lo, origin[a]), inv[a]);
+                    const __m128 tf =
+                        _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(hi, origin[a]), inv[a]), scale);
+                    // SSE's max and min return their second operand when either is NaN: a NaN
+                    // distance leaves the interval as it was.
+                    t0 = _mm_max_ps(tn, t0);
+                    t1 = _mm_min_ps(tf, t1);
+                }
+                unsigned hits = unsigned(_mm_movemask_ps(_mm_cmple_ps(t0, t1))) & n.mask;
+                alignas(16) float entry[4];
+                _mm_store_ps(entry, t0);
+                Pending found[4];
+                int k = 0;
+                for (; hits; hits &= hits - 1) {
+                    const int lane = __builtin_ctz(hits);
+                    found[k++] = {n.child[lane], entry[lane]};
+                }
+                if (NearestFirst)  // insertion sort, farthest first
+                    for (int i = 1; i < k; ++i)
+                        for (int j = i; j > 0 && found[j - 1].entry < found[j].entry; --j)
+                            std::swap(found[j - 1], found[j]);
+                for (int i = 0; i < k; ++i) stack[size++] = found[i];
+            } else {
+                const Leaf leaf = leaves_[std::size_t(~current)];
+                for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i)
+                    if (on_leaf(primitives_[i])) return;
+            }
+            // The next pending subtree or leaf still within [tmin, tmax].
+            do {
+                if (size == 0) return;
+                --size;
+            } while (stack[size].entry > tmax);
+            current = stack[size].child;
+        }
+    }
+
+  private:
+    struct alignas(16) Node {
+        float bound[2][3][4];   // [min or max][axis][lane]
+        std::int32_t child[4];  // >= 0: a node; < 0: ~ the leaf's index in leaves_
+        unsigned mask = 0;      // the lanes in use
+    };
+    struct Leaf {
+        std::uint32_t first, count;  // a run of primitives_
+    };
+
+    void fill(const Bvh<Aabb<float, 3>>& bvh, std::size_t wide, std::uint32_t binary) {
+        std::uint32_t open[4];
+        int k = 0;
+        const auto& b = bvh.nodes[binary];
+        if (b.is_leaf()) {
+            open[k++] = binary;
+        } else {
+            open[k++] = b.left();
+            open[k++] = b.right();
+            while (k < 4) {  // open the internal child with the largest box
+                int pick = -1;
+                float area = -1;
+                for (int i = 0; i < k; ++i) {
+                    const auto& c = bvh.nodes[open[i]];
+                    if (!c.is_leaf() && c.bounds.area() > area)
+                        pick = i, area = c.bounds.area();
+                }
+                if (pick < 0) break;
+                const auto& c = bvh.nodes[open[pick]];
+                open[pick] = c.left();
+                open[k++] = c.right();
+            }
+        }
+        for (int lane = 0; lane < 4; ++lane) {
+            Node& n = nodes_[wide];
+            if (lane >= k) {
+                for (int s = 0; s < 2; ++s)
+                    for (int a = 0; a < 3; ++a) n.bound[s][a][lane] = 0;
+                n.child[lane] = -1;
+                continue;
+            }
+            const auto& c = bvh.nodes[open[lane]];
+            for (int a = 0; a < 3; ++a)
+                n.bound[0][a][lane] = c.bounds.min[a], n.bound[1][a][lane] = c.bounds.max[a];
+            n.mask |= 1u << lane;
+            if (c.is_leaf()) {
+                n.child[lane] = ~std::int32_t(leaves_.size());
+                leaves_.push_back({c.first, c.count});
+            } else {
+                const std::size_t child = nodes_.size();
+                n.child[lane] = std::int32_t(child);
+                nodes_.emplace_back();  // may move nodes_: n is not used below
+                fill(bvh, child, open[lane]);
+            }
+        }
+    }
+
+    std::vector<Node> nodes_;
+    std::vector<Leaf> leaves_;
+    std::vector<std::uint32_t> primitives_;
+};
+
+#endif
+
+}  // namespace bvhkit::scene_detail
