@@ -16,12 +16,14 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "bvhkit/scene/closest_point.hpp"
+#include "bvhkit/scene/ray_batches.hpp"
 #include "bvhkit/scene/rays.hpp"
 #include "bvhkit/scene/scene.hpp"
 #include "bvhkit/scene/scene_file.hpp"
@@ -277,7 +279,9 @@ class InstancedScene {
         return {tmin, tmax};
     }
 
-    /// per_ray(i, ray) for each ray, over the pool, without the GIL, under the shared lock.
+    /// per_ray(i, ray, top) for each ray, over the pool, without the GIL, under the shared lock.
+    /// `top`: for a batch of at least ray_top_min_rays rays, the scene's top level flattened once
+    /// for the call (SceneRayTop, scene/ray_batches.hpp, as the C++ batches do), else null.
     template <class Limits, class PerRay>
     void rays(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Limits& limits,
               unsigned threads, PerRay&& per_ray) const {
@@ -286,9 +290,12 @@ class InstancedScene {
         const T *o = origins.data(), *d = directions.data();
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock(mutex_);
+        std::optional<SceneRayTop<T>> top;
+        if (k >= ray_top_min_rays(scene_)) top.emplace(scene_);
+        const SceneRayTop<T>* flat = top ? &*top : nullptr;
         run_batch(k, 256, threads, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i)
-                per_ray(i, Ray<T, 3>(at(o, i), at(d, i), limits.tmin(i), limits.tmax(i)));
+                per_ray(i, Ray<T, 3>(at(o, i), at(d, i), limits.tmin(i), limits.tmax(i)), flat);
         });
     }
 
@@ -319,18 +326,19 @@ class InstancedScene {
         expect_rows(normal, k, "normal");
         T *tp = t.data(), *bp = barycentric.data(), *np_ = normal.data();
         std::int64_t *ip = instance.data(), *gp = geometry.data(), *fp = face.data();
-        rays(origins, directions, limits, threads, [&](std::size_t i, const Ray<T, 3>& ray) {
-            const SceneHit<T> h = closest_hit(scene_, ray);
-            tp[i] = h.t;
-            ip[i] = h ? bits_of(h.instance) : -1;
-            gp[i] = h ? std::int64_t(h.geometry.index()) : -1;
-            fp[i] = h ? std::int64_t(h.face) : -1;
-            bp[3 * i] = h ? T(1) - h.u - h.v : T(0);
-            bp[3 * i + 1] = h.u;
-            bp[3 * i + 2] = h.v;
-            const Vec<T, 3> n = unit(h.normal);
-            for (std::size_t a = 0; a < 3; ++a) np_[3 * i + a] = n[a];
-        });
+        rays(origins, directions, limits, threads,
+             [&](std::size_t i, const Ray<T, 3>& ray, const SceneRayTop<T>* top) {
+                 const SceneHit<T> h = top ? top->closest_hit(ray) : closest_hit(scene_, ray);
+                 tp[i] = h.t;
+                 ip[i] = h ? bits_of(h.instance) : -1;
+                 gp[i] = h ? std::int64_t(h.geometry.index()) : -1;
+                 fp[i] = h ? std::int64_t(h.face) : -1;
+                 bp[3 * i] = h ? T(1) - h.u - h.v : T(0);
+                 bp[3 * i + 1] = h.u;
+                 bp[3 * i + 2] = h.v;
+                 const Vec<T, 3> n = unit(h.normal);
+                 for (std::size_t a = 0; a < 3; ++a) np_[3 * i + a] = n[a];
+             });
     }
 
     void occluded(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Column<T>& tmin,
@@ -338,7 +346,9 @@ class InstancedScene {
         expect_rows(out, origins.shape(0), "out");
         bool* op = out.data();
         rays(origins, directions, limits(tmin, tmax, origins.shape(0)), threads,
-             [&](std::size_t i, const Ray<T, 3>& ray) { op[i] = any_hit(scene_, ray); });
+             [&](std::size_t i, const Ray<T, 3>& ray, const SceneRayTop<T>* top) {
+                 op[i] = top ? top->any_hit(ray) : any_hit(scene_, ray);
+             });
     }
 
     /// Every hit of every ray, sorted by ray then t: (ray_index, t, instance, geometry, face,
@@ -353,7 +363,7 @@ class InstancedScene {
         std::vector<std::vector<SceneHit<T>>> parts((k + grain - 1) / grain);
         std::vector<std::int64_t> splits(k + 1, 0);
         rays(origins, directions, limits(tmin, tmax, origins.shape(0)), threads,
-             [&](std::size_t i, const Ray<T, 3>& ray) {
+             [&](std::size_t i, const Ray<T, 3>& ray, const SceneRayTop<T>*) {
                  thread_local std::vector<SceneHit<T>> hits;
                  all_hits(scene_, ray, hits);
                  auto& part = parts[i / grain];
