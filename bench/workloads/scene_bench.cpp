@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -67,6 +68,8 @@ Environment make_environment(const SceneBenchOptions& o) {
         const Aabb<float, 3> b = f.bounds();
         double extent = 0;
         for (std::size_t a = 0; a < 3; ++a) extent = std::max(extent, double(b.max[a] - b.min[a]));
+        if (!(extent > 0 && std::isfinite(extent)))
+            throw Error("bench scene: mesh " + o.meshes[i] + " has no finite extent to scale");
         BasicTriangleMesh<double> m;
         m.triangles = f.triangles;
         for (const auto& v : f.vertices) {
@@ -92,7 +95,7 @@ Transform<double> translation(const Vec<double, 3>& t) {
     return p;
 }
 
-/// A way of answering the configurations: fills answers[begin, end).
+/// A way of answering every configuration: fills answers[i] for each.
 using Job = std::function<void(std::vector<Answer>&)>;
 
 constexpr std::uint32_t kWorld = 1, kArm = 2;
@@ -422,17 +425,22 @@ std::vector<Row> run_scene_bench(const SceneBenchOptions& o, std::FILE* progress
     // round that also records the answers compared below.
     const std::size_t n = runners.size();
     std::vector<std::vector<Answer>> answers(n, std::vector<Answer>(poses.size()));
-    std::vector<std::vector<double>> times(n);
+    // The process's CPU time beside the wall time: on a shared machine the batched rows' ratio
+    // of the two says how many cores they really got.
+    std::vector<std::vector<double>> times(n), cpu(n);
     for (std::size_t k = 0; k < n; ++k) runners[k].job(answers[k]);
     std::vector<Answer> scratch(poses.size());
     for (int r = 0; r < std::max(1, o.repetitions); ++r)
         for (std::size_t k = 0; k < n; ++k) {
+            const std::clock_t c0 = std::clock();
             const double t0 = now_ms();
             runners[k].job(scratch);
             times[k].push_back(now_ms() - t0);
+            cpu[k].push_back(1000.0 * double(std::clock() - c0) / CLOCKS_PER_SEC);
             if (progress)
-                std::fprintf(progress, "  rep %d %s %s: %.1f ms\n", r, runners[k].library.c_str(),
-                             runners[k].mode.c_str(), times[k].back());
+                std::fprintf(progress, "  rep %d %s %s: %.1f ms (cpu %.1f ms)\n", r,
+                             runners[k].library.c_str(), runners[k].mode.c_str(), times[k].back(),
+                             cpu[k].back());
         }
 
     // Agreement with the last runner (FCL when present, else bvhkit's scene).
@@ -464,6 +472,7 @@ std::vector<Row> run_scene_bench(const SceneBenchOptions& o, std::FILE* progress
         row.set("threads", (long long)runners[k].threads);
         row.set("configurations", (long long)poses.size()).set("colliding", (long long)colliding);
         row.set("ms", ms).set("us_per_config", ms * 1000.0 / double(poses.size()));
+        row.set("cpu_ms", median(cpu[k]));
         if (fcl_ms > 0 && k != ref) row.set("vs_fcl", fcl_ms / ms);
         if (k != ref) {
             row.set("flags_differ", (long long)flag_diff);
