@@ -58,6 +58,24 @@ void check_distance(const BasicTriangleMesh<double>& ma, const BasicTriangleMesh
             EXPECT_LT(length(closest_point(tri_a, d.point_a).point - d.point_a), 1e-9);
             EXPECT_LT(length(closest_point(tri_b, d.point_b).point - d.point_b), 1e-9);
         }
+        // An upper bound above the distance changes nothing; one below it cuts the walk, and what
+        // comes back (a measured pair, or +inf) is never below the true distance; at zero no
+        // volume bound can be below it, so nothing is measured.
+        const auto plain = distance(a, b, poses[k]);
+        DistanceOptions<double> above, below, zero;
+        above.upper_bound = truth[k] * 1.001;
+        below.upper_bound = truth[k] * 0.999;
+        zero.upper_bound = 0;
+        EXPECT_EQ(distance(a, b, poses[k], above).distance, plain.distance) << "pose " << k;
+        EXPECT_GE(distance(a, b, poses[k], below).distance, truth[k] * (1 - 1e-9)) << "pose " << k;
+        const auto none = distance(a, b, poses[k], zero);
+        EXPECT_EQ(none.distance, std::numeric_limits<double>::infinity()) << "pose " << k;
+        EXPECT_EQ(none.stats.primitive_tests, 0u) << "pose " << k;
+        if (k == 0) {
+            DistanceOptions<double> nan;
+            nan.upper_bound = std::numeric_limits<double>::quiet_NaN();
+            EXPECT_THROW((void)distance(a, b, poses[k], nan), Error);
+        }
         // A tolerance may stop early but never undershoots, nor overshoots by more than allowed.
         DistanceOptions<double> loose;
         loose.relative_tolerance = 0.1;

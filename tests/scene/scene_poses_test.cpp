@@ -199,7 +199,7 @@ TEST(ScenePoses, LargeMarginStaysWithItsInstance) {
     colliding_pairs(scene, pairs);
     std::set<std::pair<std::int32_t, std::int32_t>> found, expected;
     for (const auto& p : pairs) found.insert({p.a.index(), p.b.index()});
-    const CollisionModel<Aabb<float, 3>>& model = scene.geometry(g).collision_model();
+    const auto& model = scene.geometry(g).collision_model();
     for (std::size_t i = 0; i < ids.size(); ++i)
         for (std::size_t j = i + 1; j < ids.size(); ++j) {
             const Transform<float>& pa = scene.pose(ids[i]);

@@ -33,6 +33,11 @@ struct DistanceOptions {
     T absolute_tolerance = 0;
     T relative_tolerance = 0;
     DescentRule rule = DescentRule::Larger;  // Larger, A, B or Simultaneous (ByOverlap = Larger)
+    /// Node pairs whose lower bound reaches this are not opened: a caller that keeps a running
+    /// minimum over many pairs of meshes (a scene's closest pair) passes it, so a mesh pair that
+    /// cannot beat it ends early. When the meshes' distance is below it, the result is the same as
+    /// without it; otherwise it is some distance at or above it, or +inf (nothing measured).
+    T upper_bound = std::numeric_limits<T>::infinity();
 };
 
 template <class T>
@@ -291,6 +296,7 @@ DistanceResult<typename V::Scalar> distance(
     using T = typename V::Scalar;
     using Traits = VolumeTraits<V>;
     check_rigid_pose(pose_of_b_in_a, "distance", "pose_of_b_in_a");
+    if (std::isnan(options.upper_bound)) throw Error("distance: options.upper_bound is NaN");
     DistanceResult<T> result;
     if (a.bvh().empty() || b.bvh().empty()) return result;
     const auto& na_ = a.bvh().nodes;
@@ -308,7 +314,9 @@ DistanceResult<typename V::Scalar> distance(
     // root in T, feeds the volumes' bounds.
     detail::ScaledSquare best2;
     T best = std::numeric_limits<T>::infinity();
+    const T cap = options.upper_bound;
     const auto hopeless = [&](T lb) {
+        if (lb >= cap) return true;
         if (!(best2.s2 < std::numeric_limits<double>::infinity())) return false;
         const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
         return lb >= best - tol;
@@ -321,7 +329,8 @@ DistanceResult<typename V::Scalar> distance(
                           Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose, best);
                       }) {
             const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
-            return Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose, best - tol);
+            return Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose,
+                                                std::min(best - tol, cap));
         } else {
             return Traits::distance_lower_bound(na_[x].bounds, nb_[y].bounds, pose);
         }
@@ -331,7 +340,7 @@ DistanceResult<typename V::Scalar> distance(
         result.stats.node();
         if constexpr (requires { Traits::distance_lower_bound_placed(x, w, slack, best); }) {
             const T tol = std::max(options.absolute_tolerance, options.relative_tolerance * best);
-            return Traits::distance_lower_bound_placed(x, w, slack, best - tol);
+            return Traits::distance_lower_bound_placed(x, w, slack, std::min(best - tol, cap));
         } else if constexpr (detail::Placeable<V>) {
             return Traits::distance_lower_bound_placed(x, w, slack);
         } else {

@@ -117,14 +117,29 @@ NearestWalkScalar<T> walk_bound(T best, AccurateScalar<T> reach, AccurateScalar<
 }
 
 /// The distance of geometry ga at pose_a and gb at pose_b less `margins`, with world witnesses
-/// (into `out`, a and b left to the caller). False, out unchanged, when either has no extent.
+/// (into `out`, a and b left to the caller). False, out unchanged, when either has no extent, or
+/// when the pair's distance (less the margins) is sure to exceed `best`: the mesh walk is cut
+/// there (DistanceOptions::upper_bound, set just above best + margins so that a pair at exactly
+/// best, a tie, is still measured).
 template <class T>
 bool measure(const SceneGeometry<T>& ga, const Transform<T>& pose_a, const SceneGeometry<T>& gb,
-             const Transform<T>& pose_b, T margins, SceneDistance<T>& out) {
+             const Transform<T>& pose_b, T margins, SceneDistance<T>& out,
+             T best = std::numeric_limits<T>::infinity()) {
     using W = AccurateScalar<T>;
     if (!ga.has_extent() || !gb.has_extent()) return false;
     const Transform<T> b_in_a = relative_pose<W>(pose_a, pose_b);
-    const DistanceResult<T> d = distance(ga.collision_model(), gb.collision_model(), b_in_a);
+    DistanceOptions<T> options;
+    if (best < std::numeric_limits<T>::infinity()) {
+        // The pair is kept when narrow(W(d) - W(margins)) <= best, so d up to best + margins and
+        // the two roundings; 4 eps_T of the sum's size covers them.
+        const W sum = W(best) + W(margins);
+        const W room =
+            W(4) * W(std::numeric_limits<T>::epsilon()) * (std::fabs(W(best)) + W(margins));
+        options.upper_bound =
+            std::nextafter(narrow<T>(sum + room), std::numeric_limits<T>::infinity());
+    }
+    const DistanceResult<T> d =
+        distance(ga.collision_model(), gb.collision_model(), b_in_a, options);
     if (!(d.distance < std::numeric_limits<T>::infinity())) return false;
     out.distance = margins == T(0) ? d.distance : narrow<T>(W(d.distance) - W(margins));
     // Both points are in a's frame (distance()'s convention).
@@ -166,7 +181,8 @@ SceneDistance<T> closest_of(const Scene<T>& first, const Scene<T>& second, Wante
             SceneDistance<T> d;
             if (wanted(a, b) && may_collide(ra.options, rb.options) &&
                 may_beat(box_gap(ra.box, rb.box), m, best.distance) &&
-                measure(ga, ra.pose, second.geometry_at(rb.geometry), rb.pose, m, d) &&
+                measure(ga, ra.pose, second.geometry_at(rb.geometry), rb.pose, m, d,
+                        best.distance) &&
                 (d.distance < best.distance ||
                  (d.distance == best.distance && pair_before(a, b, best.a, best.b)))) {
                 d.a = a, d.b = b;
@@ -232,7 +248,7 @@ void within_of(const Scene<T>& first, const Scene<T>& second, T threshold, Wante
             SceneDistance<T> d;
             if (wanted(a, b) && may_collide(ra.options, rb.options) &&
                 may_beat(box_gap(ra.box, rb.box), m, threshold) &&
-                measure(ga, ra.pose, second.geometry_at(rb.geometry), rb.pose, m, d) &&
+                measure(ga, ra.pose, second.geometry_at(rb.geometry), rb.pose, m, d, threshold) &&
                 d.distance <= threshold) {
                 d.a = a, d.b = b;
                 out.push_back(d);
@@ -313,7 +329,8 @@ SceneDistance<T> closest_instance(const Scene<T>& scene, GeometryId geometry,
         SceneDistance<T> d;
         if (may_collide(options, rb.options) &&
             scene_detail::may_beat(scene_detail::box_gap(box, rb.box), m, best.distance) &&
-            scene_detail::measure(g, pose, scene.geometry_at(rb.geometry), rb.pose, m, d) &&
+            scene_detail::measure(g, pose, scene.geometry_at(rb.geometry), rb.pose, m, d,
+                                  best.distance) &&
             (d.distance < best.distance ||
              (d.distance == best.distance && b.index() < best.b.index()))) {
             d.b = b;

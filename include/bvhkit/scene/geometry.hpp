@@ -32,6 +32,7 @@
 #include "bvhkit/volumes/aabb_volume.hpp"
 #include "bvhkit/volumes/convex_hull.hpp"
 #include "bvhkit/volumes/hull_support.hpp"
+#include "bvhkit/volumes/obb_rss.hpp"
 
 namespace bvhkit {
 
@@ -328,9 +329,12 @@ class SceneGeometry {
                        [&] { points_ = std::make_unique<ClosestPointMesh<T>>(mesh_); });
         return *points_;
     }
-    const CollisionModel<Aabb<T, 3>>& collision_model() const {
+    /// OBB+RSS volumes (as FCL's OBBRSS): the OBB test for collision, the rectangle-swept-sphere
+    /// bound for distance, both tight for the rotated relative poses that instances meet (an
+    /// axis-aligned box's distance bound loosens as the pose turns, docs/benchmarks.md C2).
+    const CollisionModel<ObbRss<T>>& collision_model() const {
         std::call_once(collision_once_,
-                       [&] { collision_ = std::make_unique<CollisionModel<Aabb<T, 3>>>(mesh_); });
+                       [&] { collision_ = std::make_unique<CollisionModel<ObbRss<T>>>(mesh_); });
         return *collision_;
     }
     /// The signed distance and inside/outside structures (scene/geometry_solid.hpp), built at
@@ -356,7 +360,7 @@ class SceneGeometry {
     mutable std::once_flag rays_once_, points_once_, collision_once_;
     mutable std::unique_ptr<TriangleBvh<T>> rays_;
     mutable std::unique_ptr<ClosestPointMesh<T>> points_;
-    mutable std::unique_ptr<CollisionModel<Aabb<T, 3>>> collision_;
+    mutable std::unique_ptr<CollisionModel<ObbRss<T>>> collision_;
     scene_detail::GeometrySolid<T> solid_;
 };
 
