@@ -91,16 +91,9 @@ struct CastSegment {
     CastSegment(const Vec<T, N>& o, const Vec<T, N>& d) : slab(Ray<T, N>(o, d)) {}
 
     /// The entry fraction (0 when the origin is inside), or a negative value on a miss.
-    /// `Octant`: the segment's (slab.octant), fixed for a whole walk.
-    template <unsigned Octant>
     T entry(const Aabb<T, N>& box, const Vec<T, N>& pad, T max_fraction) const {
         T t0 = T(0), t1 = max_fraction;
-        return slab.template clip<Octant>(Aabb<T, N>(box.min - pad, box.max + pad), t0, t1) ? t0
-                                                                                            : T(-1);
-    }
-    T entry(const Aabb<T, N>& box, const Vec<T, N>& pad, T max_fraction) const {
-        return slab.with_octant(
-            [&](auto o) { return entry<decltype(o)::value>(box, pad, max_fraction); });
+        return slab.clip(Aabb<T, N>(box.min - pad, box.max + pad), t0, t1) ? t0 : T(-1);
     }
 };
 
@@ -115,9 +108,10 @@ struct CastSegment {
 /// Children are clipped before they are pushed and the nearer one (by entry fraction) is walked
 /// first, so a callback that clips (closest hit) shortens the segment early and the farther
 /// subtrees are dropped when popped: their entry then lies beyond the new max fraction.
-template <unsigned Octant, class T, std::size_t N, class U, class F>
-void cast_in_octant(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, CastInput<T, N> in,
-                    F& callback, QueryStats* stats) {
+template <class T, std::size_t N, class U, class F>
+void cast(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, CastInput<T, N> in,
+          F&& callback, QueryStats* stats) {
+    if (t.root == kNullNode) return;
     const Vec<T, N> pad = in.half_extent;
     T& max_fraction = in.max_fraction;
     std::uint64_t visited = 1, tested = 0;
@@ -125,7 +119,7 @@ void cast_in_octant(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, Ca
         std::int32_t node;
         T entry;
     };
-    const T root_entry = seg.template entry<Octant>(t.nodes[t.root].box, pad, max_fraction);
+    const T root_entry = seg.entry(t.nodes[t.root].box, pad, max_fraction);
     if (root_entry < T(0)) {
         if (stats) stats->nodes_visited += visited;
         return;
@@ -138,8 +132,7 @@ void cast_in_octant(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, Ca
         const Node<T, N>& n = t.nodes[p.node];
         if (n.is_leaf()) {
             ++tested;
-            if (seg.template entry<Octant>(t.proxies[n.value()].box, pad, max_fraction) < T(0))
-                continue;
+            if (seg.entry(t.proxies[n.value()].box, pad, max_fraction) < T(0)) continue;
             T value;
             if constexpr (std::is_invocable_v<F&, const CastInput<T, N>&, ProxyId>)
                 value = callback(std::as_const(in), proxy_id(t, n.value()));
@@ -151,8 +144,8 @@ void cast_in_octant(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, Ca
             continue;
         }
         visited += 2;
-        const T e1 = seg.template entry<Octant>(t.nodes[n.child1].box, pad, max_fraction);
-        const T e2 = seg.template entry<Octant>(t.nodes[n.child2].box, pad, max_fraction);
+        const T e1 = seg.entry(t.nodes[n.child1].box, pad, max_fraction);
+        const T e2 = seg.entry(t.nodes[n.child2].box, pad, max_fraction);
         // The farther child goes on the stack first, so the nearer is popped next.
         const bool first_is_1 = e1 <= e2;
         const Pending near{first_is_1 ? n.child1 : n.child2, first_is_1 ? e1 : e2};
@@ -167,16 +160,6 @@ void cast_in_octant(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, Ca
         }
     }
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
-}
-
-/// The walk above, its slab tests compiled for the segment's octant (chosen once here, not at
-/// every box).
-template <class T, std::size_t N, class U, class F>
-void cast(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, CastInput<T, N> in,
-          F&& callback, QueryStats* stats) {
-    if (t.root == kNullNode) return;
-    seg.slab.with_octant(
-        [&](auto o) { cast_in_octant<decltype(o)::value>(t, seg, in, callback, stats); });
 }
 
 /// Every pair (proxy of a, proxy of b) whose boxes overlap. callback(ProxyId a, ProxyId b) -> bool.
