@@ -194,8 +194,8 @@ class ScenePairs:
         scene unchanged. One configuration (``rotations`` (n, 3, 3), ``translations`` (n, 3)):
         a bool. Many (``rotations`` (K, n, 3, 3), ``translations`` (K, n, 3)): (K,) bool, the
         configurations spread over ``threads`` threads (0 = every core) without the GIL, each
-        answer the same for any count. Every configuration is checked before any is tested: a
-        stale or repeated id, or a bad pose, raises ValueError naming the configuration."""
+        answer the same for any count. A stale or repeated id, or a bad pose, raises ValueError
+        naming the lowest bad configuration, and no answer is returned."""
         i, r, t, k = self._configurations(ids, rotations, translations)
         n = _a.threads(threads)
         if len(i) == 0:  # nothing moved: no pair to test

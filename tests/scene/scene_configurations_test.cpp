@@ -144,6 +144,66 @@ TEST(SceneConfigurations, FiltersMarginsAndTheBatch) {
     }
 }
 
+// At contact the exact test decides for the relative pose as rounded, which depends on the order
+// of the pair: the configuration calls run it in slot order, as colliding_pairs does, so the two
+// agree ulp by ulp through contact (a moved instance in the higher slot, bisected onto contact).
+template <class T>
+void sweep_through_contact(T margin, std::uint64_t seed) {
+    SplitMix64 rng(seed);
+    int steps = 0, touching = 0;
+    for (int trial = 0; trial < 25; ++trial) {
+        Scene<T> fixed, moved;
+        Transform<T> pa, pb;
+        pa.rotation = scene_test::random_rotation<T>(rng);
+        pb.rotation = scene_test::random_rotation<T>(rng);
+        const Vec3d dir = rng.unit_vector();
+        InstanceId a, b;
+        for (Scene<T>* s : {&fixed, &moved}) {
+            s->add_mesh(sphere_mesh<T>(0, 1.0));
+            a = s->add_instance(GeometryId(0), pa, {.margin = margin});
+            b = s->add_instance(GeometryId(0), pb, {.margin = margin});
+        }
+        ASSERT_LT(a.index(), b.index());
+        const auto placed = [&](double along) {
+            Transform<T> p = pb;
+            for (std::size_t i = 0; i < 3; ++i) p.translation[i] = T(dir[i] * along);
+            return p;
+        };
+        const auto reference = [&](const Transform<T>& p) {
+            moved.set_pose(b, p);
+            return any_collision(moved);
+        };
+        double lo = 0, hi = 6;  // colliding at lo, apart at hi
+        for (int it = 0; it < 80; ++it) {
+            const double mid = (lo + hi) / 2;
+            (reference(placed(mid)) ? lo : hi) = mid;
+        }
+        for (int k = -10; k <= 10; ++k) {
+            Transform<T> p = placed(lo);
+            for (std::size_t i = 0; i < 3; ++i)
+                for (int j = 0; j < std::abs(k); ++j)
+                    p.translation[i] =
+                        std::nextafter(p.translation[i], T((k > 0 ? 1 : -1) * dir[i] * 1e30));
+            const bool expected = reference(p);
+            const InstanceId ids[1] = {b};
+            const Transform<T> poses[1] = {p};
+            EXPECT_EQ(any_collision_at(fixed, std::span(ids), std::span(poses)), expected)
+                << "trial " << trial << " step " << k;
+            ++steps;
+            touching += expected;
+        }
+    }
+    EXPECT_GT(touching, steps / 4);
+    EXPECT_LT(touching, 3 * steps / 4);
+}
+
+TEST(SceneConfigurations, ThroughContactAsCollidingPairsDecides) {
+    sweep_through_contact<float>(0.0f, 1);
+    sweep_through_contact<float>(0.05f, 2);
+    sweep_through_contact<double>(0.0, 3);
+    sweep_through_contact<double>(0.05, 4);
+}
+
 TEST(SceneConfigurations, Errors) {
     Twin twin(0, false, 7);
     const std::vector<InstanceId> which = {twin.ids[0], twin.ids[1]};
