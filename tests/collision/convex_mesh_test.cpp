@@ -250,6 +250,24 @@ TEST(ConvexMesh, EmptyMeshesAndBadPoses) {
     Transformd nan_pose;
     nan_pose.translation[0] = std::nan("");
     EXPECT_THROW(convex_mesh_distance(sphere, nan_pose, model, identity), Error);
+    // A shape beyond double's range from the mesh: no contact, +inf; a tiny point near a tiny
+    // triangle: its subnormal distance, not NaN.
+    Transformd far_out, far_mesh;
+    far_out.translation = Vec3d{1e308, 0, 0};
+    far_mesh.translation = Vec3d{-1e308, 0, 0};
+    EXPECT_FALSE(convex_mesh_collides(sphere, far_out, model, far_mesh));
+    EXPECT_TRUE(std::isinf(convex_mesh_distance(sphere, far_out, model, far_mesh).distance));
+    BasicTriangleMesh<double> speck;
+    speck.vertices = {{0, 0, 0}, {1e-309, 0, 0}, {0, 1e-309, 0}};
+    speck.triangles = {{0, 1, 2}};
+    const CollisionModel<Aabb<double, 3>> tiny(speck);
+    const ConvexShape<double> point{SphereShape<double>(0)};
+    Transformd above;
+    above.translation = Vec3d{0, 0, 3e-309};
+    const auto near = convex_mesh_distance(point, above, tiny, identity);
+    EXPECT_FALSE(std::isnan(near.point_mesh[0]));
+    EXPECT_NEAR(near.distance, 3e-309, 1e-320);
+    EXPECT_EQ(near.face, 0u);
 }
 
 }  // namespace

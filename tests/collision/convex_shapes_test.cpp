@@ -536,6 +536,35 @@ TEST(ConvexShapes, ExtremeScalesArePowersOfTwoOfTheUnitAnswer) {
     EXPECT_LT(overlapping, 6 * 120 - 60);
 }
 
+TEST(ConvexShapes, OffsetsBeyondTheRangeAndSubnormalPairs) {
+    // Poses at -1e308 and 1e308: the offset overflows a double, the distance is beyond its range
+    // (+inf, or the largest finite values near it), never "overlapping".
+    const ConvexShape<double> ball{SphereShape<double>(1)};
+    Transformd left, right;
+    left.translation = Vec3d{-1e308, 0, 0};
+    right.translation = Vec3d{1e308, 0, 0};
+    const auto far = bvhkit::convex_distance(ball, left, ball, right);
+    EXPECT_FALSE(far.overlap);
+    EXPECT_GT(far.distance, 1.7e308);
+    const auto far_signed = bvhkit::convex_signed_distance(ball, left, ball, right);
+    EXPECT_GT(far_signed.signed_distance, 1.7e308);
+    EXPECT_NEAR(far_signed.normal[0], 1.0, 1e-12);
+    // Two points 3e-310 apart (a subnormal distance): found apart, by that distance.
+    const ConvexShape<double> point{SphereShape<double>(0)};
+    Transformd here, there;
+    there.translation = Vec3d{3e-310, 0, 0};
+    const auto tiny = bvhkit::convex_distance(point, here, point, there);
+    EXPECT_FALSE(tiny.overlap);
+    EXPECT_EQ(tiny.distance, 3e-310);
+    EXPECT_FALSE(std::isnan(tiny.point_b[0]));
+    const auto tiny_f = bvhkit::convex_distance(
+        ConvexShape<float>{SphereShape<float>(0)}, bvhkit::Transformf{},
+        ConvexShape<float>{SphereShape<float>(0)},
+        bvhkit::Transformf{bvhkit::Mat3<float>::identity(), bvhkit::Vec3f{1e-40f, 0, 0}});
+    EXPECT_FALSE(tiny_f.overlap);
+    EXPECT_EQ(tiny_f.distance, 1e-40f);
+}
+
 TEST(ConvexShapes, ContinuousThroughContact) {
     // B moves along a fixed direction through A in small steps: the signed distance changes by at
     // most the step (it is 1-Lipschitz in a translation), and the normal never flips.

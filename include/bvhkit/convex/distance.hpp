@@ -17,6 +17,7 @@
 // relative tolerance (gjk_relative_tolerance) plus an absolute one scaled by the shapes' size, when
 // w is already in the simplex, when |v| stops shrinking (rounding), or after gjk_max_iterations.
 // Each of these leaves an answer: nothing loops for ever on degenerate input.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -24,6 +25,7 @@
 
 #include "bvhkit/convex/convex_shape.hpp"
 #include "bvhkit/math/transform.hpp"
+#include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/volumes/gjk.hpp"
 
 namespace bvhkit {
@@ -96,27 +98,35 @@ struct ShapePair {
     Vec<T, 3> initial_direction() const { return b.offset; }
 };
 
-/// The pair's size: the larger bounding radius, or the offset's largest coordinate. A radius
-/// computed from squares underflows for shapes below about the square root of T's smallest
-/// normal number and overflows above the root of its largest; there the shapes' own extents
-/// along the axes (six supports each) stand in.
+/// The shapes' size: the larger bounding radius. A radius computed from squares underflows for
+/// shapes below about the square root of T's smallest normal number and overflows above the root
+/// of its largest; there the shapes' own extents along the axes (six supports each) stand in.
 template <class T>
-T pair_scale(const ConvexShape<T>& a, const ConvexShape<T>& b, const Vec<T, 3>& offset) {
-    T scale = std::max({a.bounding_radius(), b.bounding_radius(), std::fabs(offset[0]),
-                        std::fabs(offset[1]), std::fabs(offset[2])});
+T shapes_size(const ConvexShape<T>& a, const ConvexShape<T>& b) {
+    T size = std::max(a.bounding_radius(), b.bounding_radius());
     const T low = std::sqrt(std::numeric_limits<T>::min()) * T(1024);
     const T high = std::sqrt(std::numeric_limits<T>::max()) / T(1024);
-    if (scale >= low && scale <= high) return scale;
-    scale = std::max({std::fabs(offset[0]), std::fabs(offset[1]), std::fabs(offset[2])});
+    if (size >= low && size <= high) return size;
+    size = T(0);
     for (const ConvexShape<T>* s : {&a, &b})
         for (std::size_t i = 0; i < 3; ++i)
             for (const T sign : {T(1), T(-1)}) {
                 Vec<T, 3> d{};
                 d[i] = sign;
                 const Vec<T, 3> p = s->support(d);
-                scale = std::max({scale, std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
+                size = std::max({size, std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])});
             }
-    return scale;
+    return size;
+}
+
+/// The power of two 2^e that brings `scale` near [1, 2): e = ilogb(scale), kept where both 2^e and
+/// 2^-e are normal numbers of T (a subnormal scale, or an offset beyond T's range measured in the
+/// wider type, would otherwise make one of them 0 or infinite). 0 for a zero or non-finite scale.
+template <class T, class W>
+int unit_exponent(W scale) {
+    if (!(scale > W(0)) || !std::isfinite(scale)) return 0;
+    return std::clamp(int(std::ilogb(scale)), std::numeric_limits<T>::min_exponent,
+                      std::numeric_limits<T>::max_exponent - 2);
 }
 
 template <class T>
@@ -125,16 +135,24 @@ ShapePair<T> make_shape_pair(const ConvexShape<T>& a, const Transform<T>& pose_a
                              const char* where) {
     check_rigid_pose(pose_a, where, "pose_a");
     check_rigid_pose(pose_b, where, "pose_b");
-    const Vec<T, 3> offset = pose_b.translation - pose_a.translation;
-    const T scale = pair_scale(a, b, offset);
-    // A power of two that brings the scale into [1, 2) (none for a pair of points at one place).
-    const int e = scale > T(0) && std::isfinite(scale) ? std::ilogb(scale) : 0;
+    // B's position from A's in the wider type, where two finite translations' difference is
+    // finite (as a T it could overflow: poses at -1e308 and 1e308); scaled, then narrowed.
+    using W = AccurateScalar<T>;
+    Vec<W, 3> offset;
+    W scale = W(shapes_size(a, b));
+    for (std::size_t i = 0; i < 3; ++i) {
+        offset[i] = W(pose_b.translation[i]) - W(pose_a.translation[i]);
+        scale = std::max(scale, W(std::fabs(offset[i])));
+    }
+    const int e = unit_exponent<T>(scale);
     const T factor = std::ldexp(T(1), -e), unscale = std::ldexp(T(1), e);
+    Vec<T, 3> scaled_offset;
+    for (std::size_t i = 0; i < 3; ++i) scaled_offset[i] = T(offset[i] * W(factor));
     constexpr std::uint32_t none = HullSupport<T>::none;
     return {{&a, pose_a.rotation, Vec<T, 3>{}, core, none, factor},
-            {&b, pose_b.rotation, offset * factor, core, none, factor},
+            {&b, pose_b.rotation, scaled_offset, core, none, factor},
             pose_a.translation,
-            T(64) * std::numeric_limits<T>::epsilon() * scale * factor,
+            T(W(64) * W(std::numeric_limits<T>::epsilon()) * scale * W(factor)),
             unscale};
 }
 

@@ -145,7 +145,7 @@ TriangleAnswer<typename V::Scalar> shape_triangle(const PlacedShape<V>& s,
     const Vec<T, 3> rel[3] = {tri.p0 - origin, tri.p1 - origin, tri.p2 - origin};
     T scale = s.reach;
     for (const Vec<T, 3>& r : rel) scale = std::max(scale, max_component(bvhkit::max(r, -r)));
-    const int e = scale > T(0) && std::isfinite(scale) ? std::ilogb(scale) : 0;
+    const int e = convex_detail::unit_exponent<T>(scale);
     const T factor = std::ldexp(T(1), -e), unscale = std::ldexp(T(1), e);
     ShapeTrianglePair<T> pair{
         {s.shape, s.in_mesh.rotation, Vec<T, 3>{}, true, HullSupport<T>::none, factor},
@@ -185,7 +185,7 @@ bool convex_mesh_collides(const ConvexShape<typename V::Scalar>& shape,
     const auto s =
         convex_mesh_detail::place(shape, shape_pose, mesh, mesh_pose, "convex_mesh_collides");
     const auto& bvh = mesh.bvh();
-    if (bvh.empty()) return false;
+    if (bvh.empty() || !is_finite(s.in_mesh.translation)) return false;
     const auto tris = mesh.slot_triangles();
     std::uint32_t stack[max_bvh_depth * 2];
     std::size_t top = 0;
@@ -206,7 +206,8 @@ bool convex_mesh_collides(const ConvexShape<typename V::Scalar>& shape,
 
 /// The distance between `shape` at `shape_pose` and the triangles of `mesh` at `mesh_pose` (world
 /// poses, finite and rigid: Error otherwise), with the closest points and the mesh's triangle.
-/// Of triangles at the same distance, the first the walk reaches wins.
+/// Of triangles at the same distance, the first the walk reaches wins. A shape placed beyond T's
+/// range from the mesh (poses at -3e38 and 3e38 in float) gets +inf and no face.
 template <BoundingVolume V>
 ConvexMeshDistance<typename V::Scalar> convex_mesh_distance(
     const ConvexShape<typename V::Scalar>& shape, const Transform<typename V::Scalar>& shape_pose,
@@ -216,7 +217,9 @@ ConvexMeshDistance<typename V::Scalar> convex_mesh_distance(
         convex_mesh_detail::place(shape, shape_pose, mesh, mesh_pose, "convex_mesh_distance");
     ConvexMeshDistance<T> best;
     const auto& bvh = mesh.bvh();
-    if (bvh.empty()) return best;
+    // A shape whose position in the mesh's frame is beyond T's range is farther than any
+    // distance T holds: +inf, no face.
+    if (bvh.empty() || !is_finite(s.in_mesh.translation)) return best;
     const auto tris = mesh.slot_triangles();
     struct Entry {
         T bound;
