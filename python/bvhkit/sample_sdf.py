@@ -306,15 +306,16 @@ def _client(scheduler: str, stack: contextlib.ExitStack) -> Any:
         cluster = stack.enter_context(
             LocalCluster(n_workers=k, threads_per_worker=1, processes=True, dashboard_address=None)
         )
-        return stack.enter_context(Client(cluster))
+        return stack.enter_context(Client(cluster, set_as_default=False))
     import dask
 
-    # A Client that cannot connect may already have made itself dask's scheduler (a config change
-    # its close() would undo, but close() never runs): put the config back, so that the caller's
-    # later dask work does not go to a scheduler that is not there.
+    # The Client is used through its own submit only, so it is never made the default one: a
+    # Client that cannot connect would otherwise stay the process's default client, "connecting"
+    # for good, and every later dask compute in the process would wait on it. A failed one may
+    # still have changed dask's config: that is put back too.
     saved = copy.deepcopy(dask.config.config)
     try:
-        return stack.enter_context(Client(scheduler))
+        return stack.enter_context(Client(scheduler, set_as_default=False))
     except BaseException:
         dask.config.config.clear()
         dask.config.config.update(saved)
@@ -561,7 +562,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                     client.submit(_task, *job(file, name), pure=False): (file, name)
                     for file, name in todo
                 }
-                for future in as_completed(futures):
+                for future in as_completed(futures, loop=client.loop):  # not the default client
                     file, name = futures[future]
                     try:
                         result, error = future.result(), None

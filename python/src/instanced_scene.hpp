@@ -280,18 +280,19 @@ class InstancedScene {
     }
 
     /// per_ray(i, ray, top) for each ray, over the pool, without the GIL, under the shared lock.
-    /// `top`: for a batch of at least ray_top_min_rays rays, the scene's top level flattened once
-    /// for the call (SceneRayTop, scene/ray_batches.hpp, as the C++ batches do), else null.
+    /// `top`: with flat_top, for a batch of at least ray_top_min_rays rays, the scene's top level
+    /// flattened once for the call (SceneRayTop, scene/ray_batches.hpp, as the C++ batches do),
+    /// else null.
     template <class Limits, class PerRay>
     void rays(const Rows<T, 3>& origins, const Rows<T, 3>& directions, const Limits& limits,
-              unsigned threads, PerRay&& per_ray) const {
+              unsigned threads, PerRay&& per_ray, bool flat_top = true) const {
         const std::size_t k = origins.shape(0);
         expect_rows(directions, k, "directions");
         const T *o = origins.data(), *d = directions.data();
         nb::gil_scoped_release release;
         const std::shared_lock<std::shared_mutex> lock(mutex_);
         std::optional<SceneRayTop<T>> top;
-        if (k >= ray_top_min_rays(scene_)) top.emplace(scene_);
+        if (flat_top && k >= ray_top_min_rays(scene_)) top.emplace(scene_);
         const SceneRayTop<T>* flat = top ? &*top : nullptr;
         run_batch(k, 256, threads, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i)
@@ -362,14 +363,16 @@ class InstancedScene {
         // parts need no lock, and joined in order they are sorted by ray.
         std::vector<std::vector<SceneHit<T>>> parts((k + grain - 1) / grain);
         std::vector<std::int64_t> splits(k + 1, 0);
-        rays(origins, directions, limits(tmin, tmax, origins.shape(0)), threads,
-             [&](std::size_t i, const Ray<T, 3>& ray, const SceneRayTop<T>*) {
-                 thread_local std::vector<SceneHit<T>> hits;
-                 all_hits(scene_, ray, hits);
-                 auto& part = parts[i / grain];
-                 part.insert(part.end(), hits.begin(), hits.end());
-                 splits[i + 1] = std::int64_t(hits.size());
-             });
+        rays(
+            origins, directions, limits(tmin, tmax, origins.shape(0)), threads,
+            [&](std::size_t i, const Ray<T, 3>& ray, const SceneRayTop<T>*) {
+                thread_local std::vector<SceneHit<T>> hits;
+                all_hits(scene_, ray, hits);
+                auto& part = parts[i / grain];
+                part.insert(part.end(), hits.begin(), hits.end());
+                splits[i + 1] = std::int64_t(hits.size());
+            },
+            false);  // all hits walk the dynamic top level
         for (std::size_t i = 0; i < k; ++i) splits[i + 1] += splits[i];
         const std::size_t n = std::size_t(splits[k]);
         std::vector<std::int64_t> ray(n), instance(n), geometry(n), face(n);

@@ -149,8 +149,9 @@ std::size_t ray_top_min_rays(const Scene<T>& scene) {
 /// ray_top_min_rays rays goes through one SceneRayTop made for the call (so of two instances hit
 /// at exactly the same t, the one it reaches first wins, which may be another than closest_hit's);
 /// otherwise each ray takes closest_hit. Rays go in fixed chunks and each answer is its ray's
-/// alone, so the answers are the same for any thread count. The first rays to reach a geometry
-/// build its ray tree (once, under call_once). Error when the spans' lengths differ.
+/// alone, so the answers are the same for any thread count. A geometry's ray tree is built by the
+/// first ray to reach it (once, under call_once), or for every geometry by the SceneRayTop's
+/// constructor, on the calling thread. Error when the spans' lengths differ.
 template <class T>
 void closest_hits(const Scene<T>& scene, std::span<const Ray<T, 3>> rays,
                   std::span<SceneHit<T>> hits, const Executor& exec) {
