@@ -97,6 +97,13 @@ class ScenePairs:
 
     def _one_against(self, geometry: Any, rotation: Any, translation: Any, group: Any,
                      mask: Any, margin: Any, first: bool) -> np.ndarray:
+        posed = self._posed(geometry, rotation, translation, group, mask, margin)
+        return self._impl.colliding_instances(*posed, first)
+
+    def _posed(self, geometry: Any, rotation: Any, translation: Any, group: Any, mask: Any,
+               margin: Any) -> tuple:
+        """One more posed mesh of the scene's, its arguments checked and named: (geometry,
+        rotation (1, 3, 3), translation (1, 3), group, mask, margin)."""
         g = _index("geometry", geometry, _I64)
         r = _rotations("rotation", _one_rotation(rotation), 1, self.dtype)
         t = _translations("translation", _one_translation(translation), 1, self.dtype)
@@ -105,7 +112,7 @@ class ScenePairs:
         m = _a.number("margin", margin)
         if not 0 <= m < math.inf:
             raise ValueError(f"margin: must be finite and >= 0, not {margin}")
-        return self._impl.colliding_instances(g, r, t, gr, ma, m, first)
+        return g, r, t, gr, ma, m
 
     def _other(self, other: Any) -> Any:
         if not isinstance(other, ScenePairs):  # bvhkit.Scene is the one class built on this
@@ -254,12 +261,5 @@ class ScenePairs:
         the filter and margin an instance with that group, mask and margin would have:
         :class:`SceneDistances` with one entry (pairs[0] = (-1, id); point_a on the posed mesh)
         or none."""
-        g = _index("geometry", geometry, _I64)
-        r = _rotations("rotation", _one_rotation(rotation), 1, self.dtype)
-        t = _translations("translation", _one_translation(translation), 1, self.dtype)
-        gr = _index("group", group, _U32)
-        ma = _index("mask", mask, _U32)
-        m = _a.number("margin", margin)
-        if not 0 <= m < math.inf:
-            raise ValueError(f"margin: must be finite and >= 0, not {margin}")
-        return SceneDistances(*self._impl.closest_instance(g, r, t, gr, ma, m))
+        posed = self._posed(geometry, rotation, translation, group, mask, margin)
+        return SceneDistances(*self._impl.closest_instance(*posed))

@@ -133,8 +133,7 @@ class WideTop4 {
                 float area = -1;
                 for (int i = 0; i < k; ++i) {
                     const auto& c = bvh.nodes[open[i]];
-                    if (!c.is_leaf() && c.bounds.area() > area)
-                        pick = i, area = c.bounds.area();
+                    if (!c.is_leaf() && c.bounds.area() > area) pick = i, area = c.bounds.area();
                 }
                 if (pick < 0) break;
                 const auto& c = bvh.nodes[open[pick]];
