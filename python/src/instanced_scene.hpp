@@ -20,6 +20,7 @@
 #include <shared_mutex>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bvhkit/scene/closest_point.hpp"
@@ -405,30 +406,11 @@ class InstancedScene {
                        OutColumn<std::int64_t> instance, OutColumn<std::int64_t> geometry,
                        OutColumn<std::int64_t> face, OutRows<T, 3> barycentric,
                        unsigned threads) const {
-        const std::size_t k = points.shape(0);
-        expect_rows(distance, k, "distance");
-        expect_rows(point, k, "point");
-        for (const auto* c : {&instance, &geometry, &face}) expect_rows(*c, k, "out");
-        expect_rows(barycentric, k, "barycentric");
-        const T* p = points.data();
-        T *dp = distance.data(), *cp = point.data(), *bp = barycentric.data();
-        std::int64_t *ip = instance.data(), *gp = geometry.data(), *fp = face.data();
-        nb::gil_scoped_release release;
-        const std::shared_lock<std::shared_mutex> lock(mutex_);
-        run_batch(k, 64, threads, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) {
-                const ScenePoint<T> c = bvhkit::closest_point(scene_, at(p, i));
-                const T nan = std::numeric_limits<T>::quiet_NaN();
-                dp[i] = c.distance;
-                for (std::size_t a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;
-                ip[i] = c ? bits_of(c.instance) : -1;
-                gp[i] = c ? std::int64_t(c.geometry.index()) : -1;
-                fp[i] = c ? std::int64_t(c.face) : -1;
-                bp[3 * i] = c ? T(1) - c.u - c.v : T(0);
-                bp[3 * i + 1] = c.u;
-                bp[3 * i + 2] = c.v;
-            }
-        });
+        point_answers(points, distance, point, instance, geometry, face, barycentric, threads,
+                      [&](const Vec<T, 3>& q) {
+                          const ScenePoint<T> c = bvhkit::closest_point(scene_, q);
+                          return std::pair(c.distance, c);
+                      });
     }
 
     /// closest_point's answers with the distance signed (scene/signed_distance.hpp): negative
@@ -444,6 +426,20 @@ class InstancedScene {
             rule = SceneSign::winding_number;
         else
             throw Error("sign: '" + sign + "' is not one of 'pseudonormal', 'winding_number'");
+        point_answers(points, distance, point, instance, geometry, face, barycentric, threads,
+                      [&](const Vec<T, 3>& q) {
+                          const SceneSignedDistance<T> s = bvhkit::signed_distance(scene_, q, rule);
+                          return std::pair(s.distance, s.closest);
+                      });
+    }
+
+    /// query(point) -> (distance, ScenePoint) for each point, over the pool, without the GIL,
+    /// under the shared lock, written to the arrays (NaN points and -1 ids where nothing is found).
+    template <class Query>
+    void point_answers(const Rows<T, 3>& points, OutColumn<T> distance, OutRows<T, 3> point,
+                       OutColumn<std::int64_t> instance, OutColumn<std::int64_t> geometry,
+                       OutColumn<std::int64_t> face, OutRows<T, 3> barycentric, unsigned threads,
+                       Query&& query) const {
         const std::size_t k = points.shape(0);
         expect_rows(distance, k, "distance");
         expect_rows(point, k, "point");
@@ -456,10 +452,9 @@ class InstancedScene {
         const std::shared_lock<std::shared_mutex> lock(mutex_);
         run_batch(k, 64, threads, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
-                const SceneSignedDistance<T> s = bvhkit::signed_distance(scene_, at(p, i), rule);
-                const ScenePoint<T>& c = s.closest;
+                const auto [d, c] = query(at(p, i));
                 const T nan = std::numeric_limits<T>::quiet_NaN();
-                dp[i] = s.distance;
+                dp[i] = d;
                 for (std::size_t a = 0; a < 3; ++a) cp[3 * i + a] = c ? c.point[a] : nan;
                 ip[i] = c ? bits_of(c.instance) : -1;
                 gp[i] = c ? std::int64_t(c.geometry.index()) : -1;

@@ -5,9 +5,9 @@
 // One set of faces for every structure: the faces the ray tree left out at the build (a NaN or
 // infinite coordinate then) stay out of every query for the scene's life, as TriangleBvh::refit
 // keeps them out of the ray tree. A refit that makes them finite does not bring them back into
-// the proximity structures rebuilt after it (LeftOut below), so rays, closest points, signed
-// distances and winding numbers always see the same faces; a refit that gives a face of the set a
-// non-finite coordinate is refused (TriangleBvh::refit).
+// the proximity structures rebuilt after it (MeshWithoutTriangles, primitives/triangle_mesh.hpp),
+// so rays, closest points, signed distances and winding numbers always see the same faces; a
+// refit that gives a face of the set a non-finite coordinate is refused (TriangleBvh::refit).
 //
 // Thread safety: queries hold a shared lock, refit an exclusive one, so Python threads may call
 // anything at any time (the GIL is released during the work).
@@ -44,32 +44,6 @@ template <class T>
 Vec<T, 3> row(const T* p, std::size_t i) {
     return {p[3 * i], p[3 * i + 1], p[3 * i + 2]};
 }
-
-/// The scene's mesh as the proximity structures' builders read it: each face of `faces` names only
-/// an extra vertex with NaN coordinates, so the builders leave it out as they leave out any face
-/// with a non-finite corner (and it adds nothing to the pseudonormals of its neighbours), while
-/// every face keeps its index.
-template <class T>
-struct LeftOut {
-    using Scalar = T;
-    const BasicTriangleMesh<T>& mesh;
-    std::vector<std::uint8_t> out;  // per face
-
-    LeftOut(const BasicTriangleMesh<T>& m, std::span<const std::uint32_t> faces)
-        : mesh(m), out(m.triangles.size(), 0) {
-        for (const std::uint32_t f : faces) out[f] = 1;
-    }
-    std::size_t vertex_count() const { return mesh.vertices.size() + 1; }
-    std::size_t triangle_count() const { return mesh.triangles.size(); }
-    Vec<T, 3> vertex(std::size_t k) const {
-        const T nan = std::numeric_limits<T>::quiet_NaN();
-        return k < mesh.vertices.size() ? mesh.vertices[k] : Vec<T, 3>{nan, nan, nan};
-    }
-    std::array<std::uint32_t, 3> triangle(std::size_t i) const {
-        const auto extra = std::uint32_t(mesh.vertices.size());
-        return out[i] ? std::array<std::uint32_t, 3>{extra, extra, extra} : mesh.triangles[i];
-    }
-};
 
 template <class T>
 class Scene {
@@ -486,7 +460,7 @@ class Scene {
         if (rays_.skipped().empty())
             build(mesh_);
         else
-            build(LeftOut<T>(mesh_, rays_.skipped()));
+            build(MeshWithoutTriangles<T>(mesh_, rays_.skipped()));
     }
 
     /// is_closed(), found once (the caller holds the shared lock and build_mutex_).

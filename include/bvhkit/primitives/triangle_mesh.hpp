@@ -13,6 +13,7 @@
 #include <concepts>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -144,5 +145,31 @@ auto mesh_triangles(const M& mesh) {
     for (std::size_t i = 0; i < mesh.triangle_count(); ++i) out.push_back(triangle_at<R>(mesh, i));
     return out;
 }
+
+/// A mesh seen with some triangles left out, every triangle keeping its index: each listed
+/// triangle's corners are one extra vertex at NaN, which the builders skip (and which shares no
+/// edge with a kept triangle, so it adds nothing to their pseudonormals). For structures rebuilt
+/// over the finite triangles of a mesh whose answers must still name the mesh's own faces.
+template <class T>
+struct MeshWithoutTriangles {
+    using Scalar = T;
+    const BasicTriangleMesh<T>& mesh;
+    std::vector<std::uint8_t> dropped;  // per triangle
+
+    MeshWithoutTriangles(const BasicTriangleMesh<T>& m, std::span<const std::uint32_t> which)
+        : mesh(m), dropped(m.triangles.size(), 0) {
+        for (const std::uint32_t f : which) dropped[f] = 1;
+    }
+    std::size_t vertex_count() const { return mesh.vertices.size() + 1; }
+    std::size_t triangle_count() const { return mesh.triangles.size(); }
+    Vec<T, 3> vertex(std::size_t k) const {
+        const T nan = std::numeric_limits<T>::quiet_NaN();
+        return k < mesh.vertices.size() ? mesh.vertices[k] : Vec<T, 3>{nan, nan, nan};
+    }
+    std::array<std::uint32_t, 3> triangle(std::size_t i) const {
+        const auto extra = std::uint32_t(mesh.vertices.size());
+        return dropped[i] ? std::array<std::uint32_t, 3>{extra, extra, extra} : mesh.triangles[i];
+    }
+};
 
 }  // namespace bvhkit

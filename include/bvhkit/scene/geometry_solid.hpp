@@ -39,31 +39,6 @@ std::vector<std::uint32_t> non_finite_triangles(const BasicTriangleMesh<T>& mesh
     return out;
 }
 
-/// The mesh with each listed triangle's corners replaced by one extra vertex at NaN: the
-/// builders skip such a triangle, it shares no edge with a kept one (so it adds nothing to their
-/// pseudonormals), and every triangle keeps its index, which the answers report.
-template <class T>
-struct MeshWithoutTriangles {
-    using Scalar = T;
-    const BasicTriangleMesh<T>& mesh;
-    std::vector<std::uint8_t> dropped;  // per triangle
-
-    MeshWithoutTriangles(const BasicTriangleMesh<T>& m, const std::vector<std::uint32_t>& which)
-        : mesh(m), dropped(m.triangles.size(), 0) {
-        for (const std::uint32_t f : which) dropped[f] = 1;
-    }
-    std::size_t vertex_count() const { return mesh.vertices.size() + 1; }
-    std::size_t triangle_count() const { return mesh.triangles.size(); }
-    Vec<T, 3> vertex(std::size_t k) const {
-        const T nan = std::numeric_limits<T>::quiet_NaN();
-        return k < mesh.vertices.size() ? mesh.vertices[k] : Vec<T, 3>{nan, nan, nan};
-    }
-    std::array<std::uint32_t, 3> triangle(std::size_t i) const {
-        const auto extra = std::uint32_t(mesh.vertices.size());
-        return dropped[i] ? std::array<std::uint32_t, 3>{extra, extra, extra} : mesh.triangles[i];
-    }
-};
-
 template <class T>
 class GeometrySolid {
   public:
