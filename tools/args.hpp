@@ -25,6 +25,7 @@ inline constexpr OldSpelling kOldSpellings[] = {
     {"-o", "--out"},
     {"--bv", "--volume"},
     {"--n", "--boxes"},
+    {"--size", "--extent"},  // bench scene's mesh size; --size is an image's size elsewhere
 };
 
 class Args {

@@ -53,6 +53,11 @@ TEST(OptionVocabulary, OldSpellingsAreReadWithOneNoteEach) {
     EXPECT_FALSE(bytes_of_file(new_svg).empty());
     EXPECT_EQ(bytes_of_file(old_svg), bytes_of_file(new_svg));
 
+    // bench scene's mesh size was --size, which is an image's size in render and bench rays.
+    const auto scene = run_bench_cli("scene --size 0.5 --help");
+    EXPECT_EQ(scene.status, 0) << scene.output;
+    EXPECT_EQ(occurrences(scene.output, "note: --size is now --extent\n"), 1u) << scene.output;
+
     const auto poses = write_touching_poses(dir);
     const std::string meshes = "torus sphere:subdiv=2 --poses " + poses.string();
     for (const char* command : {"collide ", "distance "}) {
@@ -106,6 +111,8 @@ TEST(OptionVocabulary, ThreadsChangeNoOutput) {
         if (o.status != 0 && o.output.find("libpng") != std::string::npos)
             GTEST_SKIP() << "built without libpng";
         ASSERT_EQ(o.status, 0) << o.output;
+        EXPECT_EQ(o.output.find("note:"), std::string::npos) << "--size is render's own:\n"
+                                                             << o.output;
         if (first.empty()) first = bytes_of_file(png);
         EXPECT_EQ(bytes_of_file(png), first) << "--threads " << threads;
     }

@@ -227,7 +227,7 @@ namespace {
 
 constexpr const char* kSceneHelp =
     R"(usage: bvhkit-bench scene [MESH ...] [--json] [--reps N] [--configurations N]
-                         [--size S] [--threads N] [--seed N]
+                         [--extent S] [--threads N] [--seed N]
 
 Workload S1 of docs/workloads.md, a collision manager called per robot configuration: a six-link
 arm of capsules (960 triangles each) and a gripper among an environment of MESH files, each scaled
@@ -242,7 +242,8 @@ shared bunny, dragon-lowres, teapot and suzanne (99,605 triangles).
   --json              print a JSON array of rows instead of a table
   --reps N            repetitions per figure (default 3)
   --configurations N  robot configurations (default 10000)
-  --size S            each environment mesh's largest extent (default 0.7; the arm reaches 1.8)
+  --extent S          each environment mesh's largest extent (default 0.7; the arm reaches 1.8;
+                      --size is its earlier name)
   --threads N         threads of the batched rows (default 0: every core)
   --seed N            the configurations' seed (default 2026)
 )";
@@ -250,7 +251,7 @@ shared bunny, dragon-lowres, teapot and suzanne (99,605 triangles).
 }  // namespace
 
 int bench_scene(int argc, char** argv) {
-    const Args args(argc, argv, {"--reps", "--configurations", "--size", "--threads", "--seed"},
+    const Args args(argc, argv, {"--reps", "--configurations", "--extent", "--threads", "--seed"},
                     {"--json"});
     if (args.help()) {
         std::fputs(kSceneHelp, stdout);
@@ -265,12 +266,12 @@ int bench_scene(int argc, char** argv) {
     if (o.meshes.empty()) o.meshes = {"sphere:subdiv=6", "torus", "spot.obj", "teapot.obj"};
     o.repetitions = int(args.integer("--reps", 3, 1, 1000));
     o.configurations = std::size_t(args.integer("--configurations", 10000, 1, 100000000));
-    if (args.has("--size")) {
-        const std::string v = args.value("--size");
+    if (args.has("--extent")) {
+        const std::string v = args.value("--extent");
         char* end = nullptr;
         o.object_size = std::strtod(v.c_str(), &end);
         if (v.empty() || *end != '\0' || !(o.object_size > 0 && o.object_size < 1e6))
-            throw Error("option --size: '" + v + "' is not a number in (0, 1e6)");
+            throw Error("option --extent: '" + v + "' is not a number in (0, 1e6)");
     }
     o.threads = args.threads();
     o.seed = std::uint64_t(args.integer("--seed", 2026, 0, std::numeric_limits<long long>::max()));
