@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <string>
 
 #include "run_cli.hpp"
@@ -117,6 +118,24 @@ TEST(OptionVocabulary, ThreadsChangeNoOutput) {
         EXPECT_EQ(bytes_of_file(png), first) << "--threads " << threads;
     }
     EXPECT_NE(run_cli("collide " + meshes + " --threads -1 --out /dev/null").status, 0);
+}
+
+// info's --threads is the builders': every tree and its ray costs are the same, only the build
+// times may differ. 81,920 triangles: past the size where the builders split their work.
+TEST(OptionVocabulary, InfoThreadsChangeNoTree) {
+    for (const char* builder : {"binned-sah --spatial-splits", "bottom-up", "lbvh"}) {
+        std::string first;
+        for (const char* threads : {"1", "2", "0"}) {
+            const auto o = run_cli("info sphere:subdiv=6 --json --builder " + std::string(builder) +
+                                   " --threads " + threads);
+            ASSERT_EQ(o.status, 0) << o.output;
+            const std::string rows =
+                std::regex_replace(o.output, std::regex("\"build_ms\": *[-0-9.eE+]+"), "");
+            ASSERT_NE(rows.find("sah_cost"), std::string::npos) << o.output;
+            if (first.empty()) first = rows;
+            EXPECT_EQ(rows, first) << builder << ", --threads " << threads;
+        }
+    }
 }
 
 // `bvhkit bench WORKLOAD ...` still runs, through bvhkit-bench beside the command, with a note.
