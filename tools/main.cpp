@@ -5,22 +5,17 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <exception>
 #include <filesystem>
 #include <string>
 #include <string_view>
 #include <system_error>
 
-#include "bvhkit/error.hpp"
 #include "commands.hpp"
+#include "dispatch.hpp"
 
 namespace {
 
-struct Subcommand {
-    const char* name;
-    const char* summary;
-    int (*run)(int argc, char** argv);  // argv[0] is the subcommand's name
-};
+using bvhkit::tools::Subcommand;
 
 const Subcommand kSubcommands[] = {
     {"bsp", "the BSP tree of a mesh and its statistics", bvhkit::tools::bsp_command},
@@ -40,7 +35,7 @@ void print_usage(std::FILE* out) {
     std::fprintf(out,
                  "usage: bvhkit SUBCOMMAND [ARGS...]   (bvhkit SUBCOMMAND --help for details)\n"
                  "       bvhkit --version\n\n");
-    for (const auto& s : kSubcommands) std::fprintf(out, "  %-12s %s\n", s.name, s.summary);
+    bvhkit::tools::print_subcommands(out, kSubcommands);
     std::fprintf(out, "\nThe same-run benchmarks against the peer libraries are bvhkit-bench.\n");
 }
 
@@ -73,19 +68,6 @@ int main(int argc, char** argv) {
         std::string_view(argv[1]) == "--version" || std::string_view(argv[1]) == "-V" ? "version"
                                                                                       : argv[1];
     if (name == "bench") return run_bvhkit_bench(argv);
-    for (const auto& s : kSubcommands) {
-        if (name != s.name) continue;
-        try {
-            return s.run(argc - 1, argv + 1);
-        } catch (const bvhkit::Error& e) {
-            std::fprintf(stderr, "bvhkit %s: error: %s\n", s.name, e.what());
-            return 1;
-        } catch (const std::exception& e) {
-            std::fprintf(stderr, "bvhkit %s: unexpected error: %s\n", s.name, e.what());
-            return 1;
-        }
-    }
-    std::fprintf(stderr, "bvhkit: unknown subcommand '%s'\n\n", argv[1]);
-    print_usage(stderr);
-    return 2;
+    return bvhkit::tools::run_subcommand("bvhkit", name, kSubcommands, argc - 1, argv + 1,
+                                         print_usage);
 }

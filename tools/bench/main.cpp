@@ -1,22 +1,17 @@
 // bvhkit-bench: the same-run comparisons against the peer libraries, `bvhkit-bench WORKLOAD
 // [ARGS...]`. Apart from the bvhkit command so that the command a user installs links no peer.
 #include <cstdio>
-#include <exception>
 #include <string_view>
 
 #include "bench_commands.hpp"
-#include "bvhkit/error.hpp"
 #include "bvhkit/version.hpp"
+#include "dispatch.hpp"
 
 namespace {
 
-struct Workload {
-    const char* name;
-    const char* summary;
-    int (*run)(int argc, char** argv);  // argv[0] is the workload's name
-};
+using bvhkit::tools::Subcommand;
 
-const Workload kWorkloads[] = {
+const Subcommand kWorkloads[] = {
     {"rays", "workload R against Embree 3", bvhkit::tools::bench_rays},
     {"instances", "workload S3 (instanced rays) against Embree 3", bvhkit::tools::bench_instances},
     {"dynamic", "workloads D1-D4 against Box2D and Bullet", bvhkit::tools::bench_dynamic},
@@ -31,7 +26,7 @@ void print_usage(std::FILE* out) {
                  "usage: bvhkit-bench WORKLOAD [ARGS...]   (bvhkit-bench WORKLOAD --help for "
                  "details)\n"
                  "       bvhkit-bench --version\n\n");
-    for (const auto& w : kWorkloads) std::fprintf(out, "  %-10s %s\n", w.name, w.summary);
+    bvhkit::tools::print_subcommands(out, kWorkloads);
 }
 
 }  // namespace
@@ -46,19 +41,6 @@ int main(int argc, char** argv) {
         std::printf("bvhkit-bench %s\n", bvhkit::version_string);
         return 0;
     }
-    for (const auto& w : kWorkloads) {
-        if (first != w.name) continue;
-        try {
-            return w.run(argc - 1, argv + 1);
-        } catch (const bvhkit::Error& e) {
-            std::fprintf(stderr, "bvhkit-bench %s: error: %s\n", w.name, e.what());
-            return 1;
-        } catch (const std::exception& e) {
-            std::fprintf(stderr, "bvhkit-bench %s: unexpected error: %s\n", w.name, e.what());
-            return 1;
-        }
-    }
-    std::fprintf(stderr, "bvhkit-bench: unknown workload '%s'\n\n", argv[1]);
-    print_usage(stderr);
-    return 2;
+    return bvhkit::tools::run_subcommand("bvhkit-bench", first, kWorkloads, argc - 1, argv + 1,
+                                         print_usage);
 }
