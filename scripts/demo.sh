@@ -32,7 +32,7 @@ echo "== bvhkit info $mesh --all-builders"
 "$bin" info "$mesh" --all-builders
 echo
 echo "== bvhkit render"
-"$bin" render "$mesh" "${view[@]}" -o "$out/bvhkit-demo.png"
-"$bin" render "$mesh" "${view[@]}" --heatmap -o "$out/bvhkit-demo-heatmap.png"
+"$bin" render "$mesh" "${view[@]}" --out "$out/bvhkit-demo.png"
+"$bin" render "$mesh" "${view[@]}" --heatmap --out "$out/bvhkit-demo-heatmap.png"
 echo
 echo "Open $out/bvhkit-demo.png (shaded) and $out/bvhkit-demo-heatmap.png (BVH nodes visited per ray)."

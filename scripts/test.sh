@@ -50,7 +50,7 @@ cmake -S . -B build/bare -G Ninja -DCMAKE_BUILD_TYPE=Debug "${disabled[@]}" > "$
 grep -E "not found|skipped|not used" "$logs/bare-configure.log" || true
 cmake --build build/bare -j "$jobs"
 build/bare/tools/bvhkit info sphere:subdiv=5
-build/bare/tools/bvhkit bench rays sphere:subdiv=5 --rays 20000 --size 128 --reps 1
+build/bare/tools/bvhkit-bench rays sphere:subdiv=5 --rays 20000 --size 128 --reps 1
 build/bare/examples/bvhkit_example_quickstart
 
 stage "Install and consume with find_package(bvhkit)"

@@ -54,7 +54,7 @@ int closest_command(int argc, char** argv) {
     if (args.positional().size() != 1) throw Error("closest takes one mesh (see --help)");
     if (!args.has("--points") || !args.has("--out"))
         throw Error("closest needs --points FILE and --out FILE");
-    const auto threads = unsigned(args.integer("--threads", 0, 0, 1024));
+    const auto threads = unsigned(args.threads());
     const auto format = int(args.integer("--format", 2, 1, 2));
     const TriangleMesh mesh = load_mesh(args.positional()[0]);
     const std::vector<Vec3f> points = read_points(args.value("--points"));

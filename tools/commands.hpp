@@ -5,16 +5,13 @@
 namespace bvhkit::tools {
 
 int version_command(int argc, char** argv);
-int bench_command(int argc, char** argv);
 int info_command(int argc, char** argv);
 int render_command(int argc, char** argv);
 int trace_command(int argc, char** argv);
-int bench_dynamic_command(int argc, char** argv);  // tools/bench_dynamic.cpp
-int draw_tree_command(int argc, char** argv);      // tools/draw_tree.cpp
-int closest_command(int argc, char** argv);        // tools/closest.cpp
-int collide_command(int argc, char** argv);        // tools/collide.cpp
-int bench_collide_command(int argc, char** argv);  // tools/collide.cpp
-int distance_command(int argc, char** argv);       // tools/distance.cpp
-int bsp_command(int argc, char** argv);            // tools/bsp.cpp
+int draw_tree_command(int argc, char** argv);  // tools/draw_tree.cpp
+int closest_command(int argc, char** argv);    // tools/closest.cpp
+int collide_command(int argc, char** argv);    // tools/collide.cpp
+int distance_command(int argc, char** argv);   // tools/distance.cpp
+int bsp_command(int argc, char** argv);        // tools/bsp.cpp
 
 }  // namespace bvhkit::tools

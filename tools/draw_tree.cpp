@@ -43,7 +43,7 @@ void append(std::string& out, const char* format, ...) {
 void draw_tree_usage(std::FILE* out) {
     std::fprintf(
         out,
-        "usage: bvhkit draw-tree [-o FILE.svg] [--n N] [--seed S] [--scene random|battle]\n"
+        "usage: bvhkit draw-tree [--out FILE.svg] [--boxes N] [--seed S] [--scene random|battle]\n"
         "              [--strategy guided|bnb|greedy] [--moves M]\n"
         "  Builds a 2D dynamic tree and writes it as SVG (default tree.svg): internal nodes\n"
         "  coloured by depth, fat boxes dashed, proxy boxes filled. --moves moves every box\n"
@@ -72,15 +72,17 @@ std::vector<Aabb2f> battle_scene(std::mt19937& rng) {
 }  // namespace
 
 int draw_tree_command(int argc, char** argv) {
-    const Args args(argc, argv, {"-o", "--n", "--seed", "--moves", "--scene", "--strategy"}, {});
+    const Args args(argc, argv, {"--out", "--boxes", "--seed", "--moves", "--scene", "--strategy"},
+                    {});
     if (args.help()) {
         draw_tree_usage(stdout);
         return 0;
     }
     if (!args.positional().empty())
         throw Error("unexpected argument '" + args.positional()[0] + "'");
-    const std::string out = args.value("-o", "tree.svg"), scene = args.value("--scene", "random");
-    const long n = long(args.integer("--n", 200, 0, 10000000));
+    const std::string out = args.value("--out", "tree.svg"),
+                      scene = args.value("--scene", "random");
+    const long n = long(args.integer("--boxes", 200, 0, 10000000));
     const long moves = long(args.integer("--moves", 0, 0, 10000000));
     const auto seed = unsigned(args.integer("--seed", 1, 0, 4294967295LL));
     if (scene != "random" && scene != "battle")

@@ -1,25 +1,23 @@
 // The bvhkit command: `bvhkit SUBCOMMAND [ARGS...]`. Each subcommand lives in its own file and is
 // listed in the table below; `bvhkit help` (or no argument) prints the list.
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <exception>
+#include <filesystem>
+#include <string>
 #include <string_view>
+#include <system_error>
 
-#include "bvhkit/error.hpp"
 #include "commands.hpp"
+#include "dispatch.hpp"
 
 namespace {
 
-struct Subcommand {
-    const char* name;
-    const char* summary;
-    int (*run)(int argc, char** argv);  // argv[0] is the subcommand's name
-};
+using bvhkit::tools::Subcommand;
 
 const Subcommand kSubcommands[] = {
-    {"bench",
-     "same-run benchmarks against the peers (rays, instances, dynamic, nearest, collide, files)",
-     bvhkit::tools::bench_command},
     {"bsp", "the BSP tree of a mesh and its statistics", bvhkit::tools::bsp_command},
     {"closest", "closest points on a mesh for a points file", bvhkit::tools::closest_command},
     {"collide", "collision of two meshes at the poses of a file", bvhkit::tools::collide_command},
@@ -37,7 +35,25 @@ void print_usage(std::FILE* out) {
     std::fprintf(out,
                  "usage: bvhkit SUBCOMMAND [ARGS...]   (bvhkit SUBCOMMAND --help for details)\n"
                  "       bvhkit --version\n\n");
-    for (const auto& s : kSubcommands) std::fprintf(out, "  %-12s %s\n", s.name, s.summary);
+    bvhkit::tools::print_subcommands(out, kSubcommands);
+    std::fprintf(out, "\nThe same-run benchmarks against the peer libraries are bvhkit-bench.\n");
+}
+
+// `bvhkit bench ...` from before the benchmarks were their own program: runs bvhkit-bench from this
+// program's folder with the same arguments, so that this program links no peer library.
+int run_bvhkit_bench(char** argv) {
+    std::fprintf(stderr, "note: bvhkit bench moved to bvhkit-bench\n");
+    std::error_code ec;
+    std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (ec) self = argv[0];
+    const std::filesystem::path bench = self.parent_path() / "bvhkit-bench";
+    std::string name = bench.string();
+    argv[1] = name.data();
+    ::execv(name.c_str(), argv + 1);
+    std::fprintf(stderr,
+                 "bvhkit bench: error: cannot run %s (%s); build the bvhkit_bench_cli target\n",
+                 name.c_str(), std::strerror(errno));
+    return 1;
 }
 
 }  // namespace
@@ -51,19 +67,7 @@ int main(int argc, char** argv) {
     const std::string_view name =
         std::string_view(argv[1]) == "--version" || std::string_view(argv[1]) == "-V" ? "version"
                                                                                       : argv[1];
-    for (const auto& s : kSubcommands) {
-        if (name != s.name) continue;
-        try {
-            return s.run(argc - 1, argv + 1);
-        } catch (const bvhkit::Error& e) {
-            std::fprintf(stderr, "bvhkit %s: error: %s\n", s.name, e.what());
-            return 1;
-        } catch (const std::exception& e) {
-            std::fprintf(stderr, "bvhkit %s: unexpected error: %s\n", s.name, e.what());
-            return 1;
-        }
-    }
-    std::fprintf(stderr, "bvhkit: unknown subcommand '%s'\n\n", argv[1]);
-    print_usage(stderr);
-    return 2;
+    if (name == "bench") return run_bvhkit_bench(argv);
+    return bvhkit::tools::run_subcommand("bvhkit", name, kSubcommands, argc - 1, argv + 1,
+                                         print_usage);
 }

@@ -10,6 +10,7 @@
 #include "args.hpp"
 #include "bvhkit/bsp/bsp_tree.hpp"
 #include "bvhkit/bsp/ray.hpp"
+#include "bvhkit/exec/executor.hpp"
 #include "bvhkit/mesh/load_mesh.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "commands.hpp"
@@ -20,14 +21,14 @@ namespace bvhkit::tools {
 namespace {
 
 constexpr const char* kRenderHelp =
-    R"(usage: bvhkit render [MESH] -o IMAGE.png [--heatmap [--scale N]] [--size WxH] [--builder NAME]
-                     [--structure bvh|bsp]
+    R"(usage: bvhkit render [MESH] --out IMAGE.png [--heatmap [--scale N]] [--size WxH]
+                     [--builder NAME] [--structure bvh|bsp] [--turn DEG] [--threads N]
 
 Renders MESH (a file or a generator spec; default: sphere:subdiv=7,displacement=0.25) through its BVH
 with the camera of workload R1. The default picture is shaded by the surface normal; --heatmap colours
 each pixel by the number of BVH nodes its ray tested, with the scale drawn at the bottom.
 
-  -o FILE         the PNG to write (required)
+  --out FILE      the PNG to write (required; -o is its earlier name)
   --heatmap       traversal-cost heat map instead of shading
   --scale N       heat map: a fixed scale whose top is N nodes per ray, so that pictures of
                   different trees compare (default: the 99.5th percentile of this picture)
@@ -37,6 +38,8 @@ each pixel by the number of BVH nodes its ray tested, with the scale drawn at th
   --builder NAME  builder (default binned-sah; see bvhkit info --all-builders)
   --structure S   bvh (default) or bsp: trace through a BSP tree (docs/bsp.md, double, default
                   options) instead; the heat map then counts BSP nodes visited per ray
+  --threads N     threads tracing the picture (default 0: every core when bvhkit has oneTBB);
+                  the picture is the same for any number
 )";
 
 // A picture takes about 48 bytes a pixel while it is traced (the ray, its cost, the colour), so the
@@ -121,13 +124,15 @@ void draw_scale(Image& image, std::uint32_t scale_top, bool fixed) {
 }  // namespace
 
 int render_command(int argc, char** argv) {
-    const Args args(argc, argv, {"-o", "--size", "--builder", "--scale", "--turn", "--structure"},
-                    {"--heatmap"});
+    const Args args(
+        argc, argv,
+        {"--out", "--size", "--builder", "--scale", "--turn", "--structure", "--threads"},
+        {"--heatmap"});
     if (args.help()) {
         std::fputs(kRenderHelp, stdout);
         return 0;
     }
-    if (!args.has("-o")) throw Error("missing -o IMAGE.png (see --help)");
+    if (!args.has("--out")) throw Error("missing --out IMAGE.png (see --help)");
     if (args.positional().size() > 1) throw Error("render takes one mesh (see --help)");
     const std::string spec =
         args.positional().empty() ? "sphere:subdiv=7,displacement=0.25" : args.positional()[0];
@@ -142,6 +147,7 @@ int render_command(int argc, char** argv) {
     if (structure == "bsp" && args.has("--builder"))
         throw Error("--builder applies to --structure bvh only");
     const bool use_bsp = structure == "bsp";
+    const Executor executor(args.threads());
 
     TriangleMesh mesh = load_mesh(spec);
     if (args.has("--turn")) turn_about_vertical(mesh, parse_degrees(args.value("--turn")));
@@ -159,40 +165,45 @@ int render_command(int argc, char** argv) {
     Image image(width, height);
     const bool heatmap = args.flag("--heatmap");
     std::vector<std::uint32_t> cost(rays.size());
-    std::uint32_t max_cost = 1;
     const auto t1 = std::chrono::steady_clock::now();
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-        Hit<float> hit;
-        if (use_bsp) {
-            BspRayStats stats;
-            const Ray<double, 3> ray(Vec<double, 3>(rays[i].origin),
-                                     Vec<double, 3>(rays[i].direction), rays[i].tmin, rays[i].tmax);
-            const BspHit<double> h = closest_hit(bsp, ray, &stats);
-            if (h) hit.t = float(h.t), hit.primitive = h.source;
-            cost[i] = std::uint32_t(stats.nodes_visited);
-        } else {
-            TraversalStats stats;
-            hit = bvh.closest_hit(rays[i], stats);
-            cost[i] = std::uint32_t(stats.nodes_visited);
+    // Every pixel is its own: chunks of rays on any number of threads make the same picture.
+    executor.parallel_for(rays.size(), 1024, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            Hit<float> hit;
+            if (use_bsp) {
+                BspRayStats stats;
+                const Ray<double, 3> ray(Vec<double, 3>(rays[i].origin),
+                                         Vec<double, 3>(rays[i].direction), rays[i].tmin,
+                                         rays[i].tmax);
+                const BspHit<double> h = closest_hit(bsp, ray, &stats);
+                if (h) hit.t = float(h.t), hit.primitive = h.source;
+                cost[i] = std::uint32_t(stats.nodes_visited);
+            } else {
+                TraversalStats stats;
+                hit = bvh.closest_hit(rays[i], stats);
+                cost[i] = std::uint32_t(stats.nodes_visited);
+            }
+            Rgb& px = image.pixels[i];
+            if (!hit) {  // background: a soft vertical gradient
+                const double y = double(i / width) / height;
+                px = {std::uint8_t(40 + 30 * y), std::uint8_t(44 + 34 * y),
+                      std::uint8_t(52 + 40 * y)};
+                continue;
+            }
+            const auto& t = mesh.triangles[hit.primitive];
+            const Vec3f n = normalize(cross(mesh.vertices[t[1]] - mesh.vertices[t[0]],
+                                            mesh.vertices[t[2]] - mesh.vertices[t[0]]));
+            // Two-sided Lambert from a light over the camera's shoulder plus a little ambient.
+            const Vec3f light = normalize(Vec3f(-0.4f, 0.8f, 0.45f) - rays[i].direction);
+            const float lambert = std::fabs(dot(n, light));
+            const float facing = std::fabs(dot(n, rays[i].direction));
+            const float v = 0.12f + 0.68f * lambert + 0.2f * facing;
+            px = {std::uint8_t(std::min(255.0f, 235 * v)), std::uint8_t(std::min(255.0f, 210 * v)),
+                  std::uint8_t(std::min(255.0f, 175 * v))};
         }
-        max_cost = std::max(max_cost, cost[i]);
-        Rgb& px = image.pixels[i];
-        if (!hit) {  // background: a soft vertical gradient
-            const double y = double(i / width) / height;
-            px = {std::uint8_t(40 + 30 * y), std::uint8_t(44 + 34 * y), std::uint8_t(52 + 40 * y)};
-            continue;
-        }
-        const auto& t = mesh.triangles[hit.primitive];
-        const Vec3f n = normalize(cross(mesh.vertices[t[1]] - mesh.vertices[t[0]],
-                                        mesh.vertices[t[2]] - mesh.vertices[t[0]]));
-        // Two-sided Lambert from a light over the camera's shoulder plus a little ambient.
-        const Vec3f light = normalize(Vec3f(-0.4f, 0.8f, 0.45f) - rays[i].direction);
-        const float lambert = std::fabs(dot(n, light));
-        const float facing = std::fabs(dot(n, rays[i].direction));
-        const float v = 0.12f + 0.68f * lambert + 0.2f * facing;
-        px = {std::uint8_t(std::min(255.0f, 235 * v)), std::uint8_t(std::min(255.0f, 210 * v)),
-              std::uint8_t(std::min(255.0f, 175 * v))};
-    }
+    });
+    const std::uint32_t max_cost =
+        std::max<std::uint32_t>(1, *std::max_element(cost.begin(), cost.end()));
     const double trace_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
 
@@ -208,7 +219,7 @@ int render_command(int argc, char** argv) {
             image.pixels[i] = heat_colour(double(cost[i]) / scale_top);
         draw_scale(image, scale_top, fixed_scale != 0);
     }
-    write_png(args.value("-o"), image);
+    write_png(args.value("--out"), image);
 
     double mean_cost = 0;
     for (auto c : cost) mean_cost += c;
@@ -227,7 +238,7 @@ int render_command(int argc, char** argv) {
     std::printf(
         "traced %zu rays in %.1f ms (%.1f Mrays/s); nodes tested per ray: mean %.1f, max %u\n",
         rays.size(), trace_ms, rays.size() / trace_ms / 1e3, mean_cost, max_cost);
-    std::printf("wrote %s (%ux%u, %s)\n", args.value("-o").c_str(), width, height,
+    std::printf("wrote %s (%ux%u, %s)\n", args.value("--out").c_str(), width, height,
                 heatmap ? "traversal-cost heat map" : "shaded");
     return 0;
 }

@@ -73,7 +73,7 @@ int trace_command(int argc, char** argv) {
         throw Error("option --structure: '" + structure + "' is not one of bvh, bsp");
     if (structure == "bsp" && args.has("--builder"))
         throw Error("--builder applies to --structure bvh only");
-    const auto threads = unsigned(args.integer("--threads", 0, 0, 1024));
+    const auto threads = unsigned(args.threads());
     const TriangleMesh mesh = load_mesh(args.positional()[0]);
     const std::vector<Ray3f> rays = read_rays(args.value("--rays"));
     if (structure == "bsp") return trace_bsp(mesh, rays, args.value("--out"));

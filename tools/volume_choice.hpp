@@ -1,6 +1,6 @@
 #pragma once
-// `--bv NAME` of the collide and distance commands: the bounding volume types a CollisionModel can
-// be built with, by name, written once for every command that offers the choice.
+// `--volume NAME` of the collide and distance commands: the bounding volume types a CollisionModel
+// can be built with, by name, written once for every command that offers the choice.
 #include <string>
 
 #include "bvhkit/error.hpp"
@@ -39,7 +39,7 @@ void with_volume(const std::string& name, Run&& run) {
     else if (name == "hull")
         run(VolumeTag<ConvexHull<float>>{});
     else
-        throw Error("--bv: unknown bounding volume '" + name + "' (" + kVolumeNames + ")");
+        throw Error("--volume: unknown bounding volume '" + name + "' (" + kVolumeNames + ")");
 }
 
 }  // namespace bvhkit::tools

@@ -99,14 +99,15 @@ TEST(BspCommand, TraceThroughTheBspEqualsTheBvh) {
 TEST(BspCommand, RenderThroughTheBsp) {
     const bvhkit::test::ScratchFile png("bsp_test", "render.png");
     const Result r =
-        run_cli("render torus:u=24,v=12 --structure bsp --size 64x64 -o " + png.string());
+        run_cli("render torus:u=24,v=12 --structure bsp --size 64x64 --out " + png.string());
     if (r.status != 0 && r.output.find("libpng") != std::string::npos)
         GTEST_SKIP() << "built without libpng";
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("BSP of"), std::string::npos) << r.output;
     EXPECT_GT(std::filesystem::file_size(png.path()), 100u);
-    EXPECT_NE(run_cli("render torus --structure octree -o " + png.string()).status, 0);
-    EXPECT_NE(run_cli("render torus --structure bsp --builder lbvh -o " + png.string()).status, 0);
+    EXPECT_NE(run_cli("render torus --structure octree --out " + png.string()).status, 0);
+    EXPECT_NE(run_cli("render torus --structure bsp --builder lbvh --out " + png.string()).status,
+              0);
 }
 
 }  // namespace

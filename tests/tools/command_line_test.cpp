@@ -41,16 +41,17 @@ TEST(CommandLine, VersionFlag) {
 }
 
 TEST(CommandLine, BenchHelpListsEveryWorkload) {
-    const Outcome o = run("bench --help");
+    const Outcome o = bvhkit::test::run_bench_cli("--help");
     EXPECT_EQ(o.status, 0);
-    for (const char* w : {"rays", "dynamic", "nearest", "collide", "files"})
+    for (const char* w : {"rays", "instances", "dynamic", "nearest", "collide", "scene", "files"})
         EXPECT_NE(o.output.find(w), std::string::npos) << w << " missing from: " << o.output;
 }
 
 // The saved-tree benchmark on a small mesh: every operation gets a row, and the mapped tree and
 // the trees in memory hit the same rays.
 TEST(CommandLine, BenchFilesMeasuresEveryOperation) {
-    const Outcome o = run("bench files sphere:subdiv=3 --reps 1 --rays 2000 --json");
+    const Outcome o =
+        bvhkit::test::run_bench_cli("files sphere:subdiv=3 --reps 1 --rays 2000 --json");
     ASSERT_EQ(o.status, 0) << o.output;
     for (const char* op : {"\"build\"", "\"save\"", "\"load\"", "\"map\"", "\"map-novalidate\"",
                            "\"R2-mapped\"", "\"R2-memory-binary\"", "\"R2-memory-default\""})
@@ -94,7 +95,7 @@ std::string read_all(const std::filesystem::path& p) {
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// Every volume --bv names gives the same answers (the AABB's) on a pose list where some poses
+// Every volume --volume names gives the same answers (the AABB's) on a pose list where some poses
 // touch, and an unknown name is an error that lists the names.
 TEST(CommandLine, EveryVolumeAnswersAlike) {
     const float poses[3][12] = {{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0},
@@ -107,8 +108,8 @@ TEST(CommandLine, EveryVolumeAnswersAlike) {
     std::string first_c, first_d;
     for (const char* bv : {"aabb", "obb", "rss", "obbrss", "sphere", "kdop18", "hull"}) {
         const auto c = temp_file(std::string("c_") + bv), d = temp_file(std::string("d_") + bv);
-        const Outcome oc = run("collide " + meshes + " --out " + c.string() + " --bv " + bv);
-        const Outcome od = run("distance " + meshes + " --out " + d.string() + " --bv " + bv);
+        const Outcome oc = run("collide " + meshes + " --out " + c.string() + " --volume " + bv);
+        const Outcome od = run("distance " + meshes + " --out " + d.string() + " --volume " + bv);
         ASSERT_EQ(oc.status, 0) << bv << ": " << oc.output;
         ASSERT_EQ(od.status, 0) << bv << ": " << od.output;
         if (first_c.empty()) {
@@ -130,7 +131,7 @@ TEST(CommandLine, EveryVolumeAnswersAlike) {
             EXPECT_NEAR(x, y, 1e-5f * (1 + std::fabs(y))) << bv << " pose " << k;
         }
     }
-    const Outcome bad = run("collide " + meshes + " --out /dev/null --bv cone");
+    const Outcome bad = run("collide " + meshes + " --out /dev/null --volume cone");
     EXPECT_NE(bad.status, 0);
     EXPECT_NE(bad.output.find("hull"), std::string::npos) << bad.output;
 }
@@ -162,7 +163,7 @@ TEST(CommandLine, InfoReportsTheSpatialSplitBuild) {
 
 TEST(CommandLine, RenderSizeIsCheckedNotWrapped) {
     for (const char* size : {"4294967312x16", "16384x16384", "15x16", "x16", "16x", "-16x16"}) {
-        const Outcome o = run(std::string("render sphere:subdiv=1 --size ") + size + " -o " +
+        const Outcome o = run(std::string("render sphere:subdiv=1 --size ") + size + " --out " +
                               temp_file("r.png").string());
         EXPECT_EQ(o.status, 1) << size << ": " << o.output;
         EXPECT_NE(o.output.find("--size"), std::string::npos) << size << ": " << o.output;

@@ -1,6 +1,7 @@
 #pragma once
-// Runs the bvhkit command (BVHKIT_CLI, set by tests/CMakeLists.txt) with arguments, for the tests
-// of tests/tools: its exit status and everything it printed.
+// Runs the bvhkit command (BVHKIT_CLI, set by tests/CMakeLists.txt) or the bvhkit-bench program
+// (BVHKIT_BENCH_CLI) with arguments, for the tests of tests/tools: its exit status and everything
+// it printed.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -46,16 +47,28 @@ class ScratchFile {
     std::filesystem::path path_;
 };
 
-/// `shell_prefix` goes before the command in the same shell ("ulimit -f 8;", "timeout 20").
-inline CliOutcome run_cli(const std::string& args, const std::string& shell_prefix = "") {
+/// Runs `program` (a path) with `args`; `shell_prefix` goes before it in the same shell
+/// ("ulimit -f 8;", "timeout 20").
+inline CliOutcome run_program(const std::string& program, const std::string& args,
+                              const std::string& shell_prefix = "") {
     static int counter = 0;
     const ScratchFile log("cli_log", std::to_string(counter++) + ".txt");
     const std::string command =
-        shell_prefix + " " + std::string(BVHKIT_CLI) + " " + args + " > " + log.string() + " 2>&1";
+        shell_prefix + " " + program + " " + args + " > " + log.string() + " 2>&1";
     const int raw = std::system(command.c_str());
     std::ifstream in(log.path());
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, text};
+}
+
+/// The bvhkit command.
+inline CliOutcome run_cli(const std::string& args, const std::string& shell_prefix = "") {
+    return run_program(BVHKIT_CLI, args, shell_prefix);
+}
+
+/// The bvhkit-bench program.
+inline CliOutcome run_bench_cli(const std::string& args) {
+    return run_program(BVHKIT_BENCH_CLI, args);
 }
 
 }  // namespace bvhkit::test

@@ -1,5 +1,5 @@
-// `bvhkit bench rays|instances|dynamic|nearest|collide|scene|files ...`: the same-run comparisons
-// against the peers.
+// `bvhkit-bench rays|instances|nearest|scene|files ...`: the same-run comparisons against the peers
+// (dynamic and collide have their own files).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -8,10 +8,10 @@
 #include <string_view>
 
 #include "args.hpp"
+#include "bench_commands.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/mesh/data_files.hpp"
 #include "collide_bench.hpp"
-#include "commands.hpp"
 #include "file_bench.hpp"
 #include "instance_bench.hpp"
 #include "nearest_bench.hpp"
@@ -20,11 +20,20 @@
 #include "scene_bench.hpp"
 
 namespace bvhkit::tools {
+
+std::vector<std::string> default_bench_meshes(const char* fallback) {
+    std::vector<std::string> meshes;
+    for (const char* m : {"stanford-bunny.obj", "igea.ply"})
+        if (const auto p = find_data_file(m, data_dirs()); !p.empty()) meshes.push_back(p.string());
+    if (meshes.empty()) meshes.push_back(fallback);
+    return meshes;
+}
+
 namespace {
 
 constexpr const char* kRaysHelp =
-    R"(usage: bvhkit bench rays [MESH ...] [--json] [--reps N] [--rays N]
-                         [--size N] [--builder NAME] [--high-quality]
+    R"(usage: bvhkit-bench rays [MESH ...] [--json] [--reps N] [--rays N]
+                        [--size N] [--builder NAME] [--high-quality]
 
 Workload R of docs/workloads.md for bvhkit and Embree 3 (when installed), in this process, one thread
 each: build, R1 (camera rays, SIZE x SIZE), R2 (random rays), R3 (R2 as occlusion queries).
@@ -40,6 +49,8 @@ shared bunny and igea meshes when present, else a procedural sphere.
   --high-quality  also bvhkit with spatial splits (bvhkit-sbvh) against Embree's high-quality
                   build (embree3-high); bvhkit-sbvh's speedup is over embree3-high
 )";
+
+}  // namespace
 
 int bench_rays(int argc, char** argv) {
     const Args args(argc, argv, {"--reps", "--rays", "--size", "--builder"},
@@ -65,9 +76,11 @@ int bench_rays(int argc, char** argv) {
     return 0;
 }
 
+namespace {
+
 constexpr const char* kInstancesHelp =
-    R"(usage: bvhkit bench instances [MESH] [--json] [--reps N] [--rays N] [--size N]
-                              [--counts N,N,...] [--density D] [--seed S]
+    R"(usage: bvhkit-bench instances [MESH] [--json] [--reps N] [--rays N] [--size N]
+                             [--counts N,N,...] [--density D] [--seed S]
 
 Workload S3 (issue 40) for bvhkit's Scene and Embree 3's instances (RTC_GEOMETRY_TYPE_INSTANCE, when
 installed), in this process, one thread each: a crowd of instances of one mesh at random rigid poses,
@@ -86,6 +99,8 @@ file or a generator spec; the default is the shared bunny when present, else a p
   --density D     fraction of the crowd's cube the instances' bounding spheres fill (default 0.3)
   --seed S        poses and random rays (default 1)
 )";
+
+}  // namespace
 
 int bench_instances(int argc, char** argv) {
     const Args args(argc, argv, {"--reps", "--rays", "--size", "--counts", "--density", "--seed"},
@@ -130,9 +145,11 @@ int bench_instances(int argc, char** argv) {
     return 0;
 }
 
+namespace {
+
 constexpr const char* kNearestHelp =
-    R"(usage: bvhkit bench nearest [MESH ...] [--json] [--reps N] [--points N] [--builder NAME]
-                            [--scaling]
+    R"(usage: bvhkit-bench nearest [MESH ...] [--json] [--reps N] [--points N] [--builder NAME]
+                           [--scaling]
 
 Workload N1 of docs/workloads.md for bvhkit and CGAL 5.5's AABB_tree (when installed), in this process,
 one thread each: closest point, squared distance and triangle for N points uniform in the mesh's
@@ -146,6 +163,8 @@ speedup = bvhkit queries/s over CGAL's. Default meshes: the shared bunny and ige
   --scaling       also bvhkit on one thread against all threads (oneTBB): batched N1 queries,
                   bottom-up and LBVH builds (interleaved medians)
 )";
+
+}  // namespace
 
 int bench_nearest(int argc, char** argv) {
     const Args args(argc, argv, {"--reps", "--points", "--builder"}, {"--json", "--scaling"});
@@ -169,8 +188,10 @@ int bench_nearest(int argc, char** argv) {
     return 0;
 }
 
+namespace {
+
 constexpr const char* kFilesHelp =
-    R"(usage: bvhkit bench files [MESH ...] [--json] [--reps N] [--rays N]
+    R"(usage: bvhkit-bench files [MESH ...] [--json] [--reps N] [--rays N]
 
 Saved trees (docs/serialization.md): for a TriangleBvh<float> over each mesh, the median times of
 build, save, load (copied into memory) and map (read in place), with and without validation; what
@@ -183,6 +204,8 @@ shared bunny and igea when present.
   --reps N        repetitions per figure (default 5)
   --rays N        random rays (default 200000)
 )";
+
+}  // namespace
 
 int bench_files(int argc, char** argv) {
     const Args args(argc, argv, {"--reps", "--rays"}, {"--json"});
@@ -200,9 +223,11 @@ int bench_files(int argc, char** argv) {
     return 0;
 }
 
+namespace {
+
 constexpr const char* kSceneHelp =
-    R"(usage: bvhkit bench scene [MESH ...] [--json] [--reps N] [--configurations N]
-                          [--size S] [--threads N] [--seed N]
+    R"(usage: bvhkit-bench scene [MESH ...] [--json] [--reps N] [--configurations N]
+                         [--extent S] [--threads N] [--seed N]
 
 Workload S1 of docs/workloads.md, a collision manager called per robot configuration: a six-link
 arm of capsules (960 triangles each) and a gripper among an environment of MESH files, each scaled
@@ -217,13 +242,16 @@ shared bunny, dragon-lowres, teapot and suzanne (99,605 triangles).
   --json              print a JSON array of rows instead of a table
   --reps N            repetitions per figure (default 3)
   --configurations N  robot configurations (default 10000)
-  --size S            each environment mesh's largest extent (default 0.7; the arm reaches 1.8)
+  --extent S          each environment mesh's largest extent (default 0.7; the arm reaches 1.8;
+                      --size is its earlier name)
   --threads N         threads of the batched rows (default 0: every core)
   --seed N            the configurations' seed (default 2026)
 )";
 
+}  // namespace
+
 int bench_scene(int argc, char** argv) {
-    const Args args(argc, argv, {"--reps", "--configurations", "--size", "--threads", "--seed"},
+    const Args args(argc, argv, {"--reps", "--configurations", "--extent", "--threads", "--seed"},
                     {"--json"});
     if (args.help()) {
         std::fputs(kSceneHelp, stdout);
@@ -238,14 +266,14 @@ int bench_scene(int argc, char** argv) {
     if (o.meshes.empty()) o.meshes = {"sphere:subdiv=6", "torus", "spot.obj", "teapot.obj"};
     o.repetitions = int(args.integer("--reps", 3, 1, 1000));
     o.configurations = std::size_t(args.integer("--configurations", 10000, 1, 100000000));
-    if (args.has("--size")) {
-        const std::string v = args.value("--size");
+    if (args.has("--extent")) {
+        const std::string v = args.value("--extent");
         char* end = nullptr;
         o.object_size = std::strtod(v.c_str(), &end);
         if (v.empty() || *end != '\0' || !(o.object_size > 0 && o.object_size < 1e6))
-            throw Error("option --size: '" + v + "' is not a number in (0, 1e6)");
+            throw Error("option --extent: '" + v + "' is not a number in (0, 1e6)");
     }
-    o.threads = unsigned(args.integer("--threads", 0, 0, 4096));
+    o.threads = args.threads();
     o.seed = std::uint64_t(args.integer("--seed", 2026, 0, std::numeric_limits<long long>::max()));
     if (!bench::have_fcl())
         std::fprintf(stderr,
@@ -254,23 +282,6 @@ int bench_scene(int argc, char** argv) {
     const auto rows = bench::run_scene_bench(o, args.flag("--json") ? nullptr : stderr);
     print_rows(rows, args.flag("--json"));
     return 0;
-}
-
-}  // namespace
-
-int bench_command(int argc, char** argv) {
-    const std::string_view what = argc > 1 ? argv[1] : "";
-    if (what == "rays") return bench_rays(argc - 1, argv + 1);
-    if (what == "instances") return bench_instances(argc - 1, argv + 1);
-    if (what == "dynamic") return bench_dynamic_command(argc - 1, argv + 1);
-    if (what == "collide") return bench_collide_command(argc - 1, argv + 1);
-    if (what == "nearest") return bench_nearest(argc - 1, argv + 1);
-    if (what == "scene") return bench_scene(argc - 1, argv + 1);
-    if (what == "files") return bench_files(argc - 1, argv + 1);
-    std::fprintf(what == "--help" || what == "-h" ? stdout : stderr,
-                 "usage: bvhkit bench rays|instances|dynamic|nearest|collide|scene|files [...]   "
-                 "(bvhkit bench WORKLOAD --help for each)\n");
-    return what == "--help" || what == "-h" ? 0 : 2;
 }
 
 }  // namespace bvhkit::tools

@@ -1,4 +1,4 @@
-// `bvhkit bench dynamic`: workloads D1-D4 (the dynamic tree against Box2D's and Bullet's
+// `bvhkit-bench dynamic`: workloads D1-D4 (the dynamic tree against Box2D's and Bullet's
 // broadphases and Box2D's tree ray cast); see bench/workloads/dynamic_bench.hpp.
 #include <cstdio>
 #include <cstdlib>
@@ -6,8 +6,8 @@
 #include <string_view>
 
 #include "args.hpp"
+#include "bench_commands.hpp"
 #include "bvhkit/error.hpp"
-#include "commands.hpp"
 #include "dynamic_bench.hpp"
 #include "output.hpp"
 
@@ -18,9 +18,10 @@ namespace {
 void bench_dynamic_usage(std::FILE* out) {
     std::fprintf(
         out,
-        "usage: bvhkit bench dynamic [--json] [--n N] [--steps S] [--reps R] [--only D1|D2|D3|D4]\n"
+        "usage: bvhkit-bench dynamic [--json] [--boxes N] [--steps S] [--reps R] [--only "
+        "D1|D2|D3|D4]\n"
         "  D1 2D crowd (vs Box2D b2BroadPhase), D2 3D crowd (vs Bullet btDbvtBroadphase),\n"
-        "  D3 churn, D4 closest-hit ray casts (vs Box2D b2DynamicTree). Defaults: --n 100000 "
+        "  D3 churn, D4 closest-hit ray casts (vs Box2D b2DynamicTree). Defaults: --boxes 100000 "
         "--steps 40 --reps 3 (bvhkit-exact, bvhkit-greedy: 1 rep).\n"
         "  step_ms: ms per step (D3: per round of 1,000 ops); speedup: that row's step_ms over\n"
         "  bvhkit's; pairs: pairs found over all steps; agree: same pairs as bvhkit every step.\n");
@@ -28,8 +29,8 @@ void bench_dynamic_usage(std::FILE* out) {
 
 }  // namespace
 
-int bench_dynamic_command(int argc, char** argv) {
-    const Args args(argc, argv, {"--n", "--steps", "--reps", "--only"}, {"--json"});
+int bench_dynamic(int argc, char** argv) {
+    const Args args(argc, argv, {"--boxes", "--steps", "--reps", "--only"}, {"--json"});
     if (args.help()) {
         bench_dynamic_usage(stdout);
         return 0;
@@ -37,7 +38,7 @@ int bench_dynamic_command(int argc, char** argv) {
     if (!args.positional().empty())
         throw Error("unexpected argument '" + args.positional()[0] + "'");
     bench::DynamicBenchConfig c;
-    c.n = int(args.integer("--n", c.n, 1, 100000000));
+    c.n = int(args.integer("--boxes", c.n, 1, 100000000));
     c.steps = int(args.integer("--steps", c.steps, 1, 100000000));
     c.reps = int(args.integer("--reps", c.reps, 1, 100000000));
     if (args.has("--only")) {
