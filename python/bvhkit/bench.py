@@ -28,6 +28,9 @@ Workloads (sizes times --scale):
       bunny and igea), per colliding pose: the pairs, the manifold three ways, and python-fcl's
       collide with contacts; where FCL's triangle-pair contacts lie against bvhkit's intersection
       segments (bvhkit/_bench_contacts.py)
+  P10 warp-lang's mesh queries on the CPU (wp.Mesh: mesh_query_ray, mesh_query_point_no_sign,
+      the winding-number sign) beside bvhkit's intersect, closest_point and signed_distance, 1M
+      rays or points on the P1 mesh; Warp's first-launch compile reported apart (bvhkit/_bench_warp.py)
 
 A peer runs when it imports and sets up; a peer that fails is listed with the reason and the rest
 go on. Peers: Open3D (RaycastingScene), Embree 4 through embreex (its scene's `run`, one
@@ -475,7 +478,7 @@ def main(argv=None) -> None:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scale", type=float, default=1.0, help="workload size factor (1 = full)")
     ap.add_argument("--reps", type=int, default=3, help="repetitions (median reported)")
-    ap.add_argument("--only", default="P1,P2,P3,P4,P5,P6,P7,P8,P9",
+    ap.add_argument("--only", default="P1,P2,P3,P4,P5,P6,P7,P8,P9,P10",
                     help="comma-separated workloads")
     ap.add_argument("--mesh", default="igea.ply", help="mesh file or spec for P1 and P2")
     ap.add_argument("--big-mesh", default="sphere:subdiv=8,displacement=0.2",
@@ -556,6 +559,18 @@ def main(argv=None) -> None:
         for m in ("teapot.obj", "stanford-bunny.obj", "igea.ply"):
             cv, cf, name = _mesh(m)
             show(p9(cv, cf, name, max(10, int(200 * s)), args.reps, mods.get("fcl")))
+    if "P10" in only:
+        from ._bench_warp import p10
+
+        v, f, name = _mesh(args.mesh)
+        print(f"P10: {name}, {len(f)} triangles, warp-lang on the CPU")
+        warp = _optional("warp")
+        if isinstance(warp, Exception):
+            print(f"  warp-lang not used: {type(warp).__name__}: {str(warp).splitlines()[0][:100]}")
+            warp = None
+        else:
+            warp.config.quiet = True  # no banner in the table
+        show(p10(v, f, int(1_000_000 * s), args.reps, warp))
 
 
 if __name__ == "__main__":
