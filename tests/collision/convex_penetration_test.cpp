@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bvhkit/convex/penetration.hpp"
+#include "convex_shapes_reference.hpp"
 #include "test_support.hpp"
 
 namespace convex_penetration_test {
@@ -26,6 +27,7 @@ using bvhkit::ConvexShape;
 using bvhkit::Transformd;
 using bvhkit::Vec3d;
 using LD = long double;
+using convex_shapes_test::random_pose;
 
 struct PointL {
     LD v[3];
@@ -143,20 +145,6 @@ std::vector<Vec3d> ellipsoid_points(std::mt19937_64& rng, std::size_t n) {
     return pts;
 }
 
-Transformd random_rotation_pose(std::mt19937_64& rng, double spread) {
-    std::normal_distribution<double> g(0, 1);
-    std::uniform_real_distribution<double> u(-spread, spread);
-    double q[4], n = 0;
-    do {
-        for (double& c : q) c = g(rng);
-        n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    } while (n < 1e-3);
-    Transformd t;
-    t.rotation = bvhkit::rotation_from_quaternion(q[0] / n, q[1] / n, q[2] / n, q[3] / n);
-    t.translation = {u(rng), u(rng), u(rng)};
-    return t;
-}
-
 /// The separation property of a penetration answer: B moved along the normal by a little more
 /// than the depth is apart, by a little less still overlaps.
 template <class T>
@@ -187,7 +175,7 @@ TEST(ConvexPenetration, RandomHullPairsMatchSeparatingAxes) {
     for (std::size_t i = 0; i < pairs; ++i) {
         const std::vector<Vec3d> la = ellipsoid_points(rng, count(rng));
         const std::vector<Vec3d> lb = ellipsoid_points(rng, count(rng));
-        const Transformd pa = random_rotation_pose(rng, 0), pb = random_rotation_pose(rng, 1.6);
+        const Transformd pa = random_pose(rng, 0), pb = random_pose(rng, 1.6);
         const ConvexShape<double> a(ConvexPolytope<double>{std::span<const Vec3d>(la)});
         const ConvexShape<double> b(ConvexPolytope<double>{std::span<const Vec3d>(lb)});
         const ReferencePolytope ra = reference(la, pa), rb = reference(lb, pb);
@@ -239,8 +227,8 @@ TEST(ConvexPenetration, MixedShapesSeparate) {
     for (std::size_t i = 0; i < shapes.size(); ++i)
         for (std::size_t j = 0; j < shapes.size(); ++j)
             for (int k = 0; k < poses; ++k) {
-                const Transformd pa = random_rotation_pose(rng, 0);
-                const Transformd pb = random_rotation_pose(rng, 0.6);
+                const Transformd pa = random_pose(rng, 0);
+                const Transformd pb = random_pose(rng, 0.6);
                 const auto r = bvhkit::convex_signed_distance(shapes[i], pa, shapes[j], pb);
                 if (-r.signed_distance > 1e-6)
                     expect_separating(shapes[i], pa, shapes[j], pb, r, int(1000 * i + 100 * j + k));
@@ -256,8 +244,8 @@ TEST(ConvexPenetration, FloatHullsSeparate) {
         for (const Vec3d& p : lb) fb.push_back(bvhkit::Vec3f(p));
         const ConvexShape<float> a(ConvexPolytope<float>{std::span<const bvhkit::Vec3f>(fa)});
         const ConvexShape<float> b(ConvexPolytope<float>{std::span<const bvhkit::Vec3f>(fb)});
-        const auto pa = bvhkit::Transformf(random_rotation_pose(rng, 0));
-        const auto pb = bvhkit::Transformf(random_rotation_pose(rng, 0.8));
+        const auto pa = bvhkit::Transformf(random_pose(rng, 0));
+        const auto pb = bvhkit::Transformf(random_pose(rng, 0.8));
         const auto r = bvhkit::convex_signed_distance(a, pa, b, pb);
         if (-r.signed_distance > 1e-3f) expect_separating(a, pa, b, pb, r, i);
     }
