@@ -9,7 +9,7 @@ if [ "${1:-}" = "--demo" ]; then
 else
   packages=(cmake ninja-build g++ make pkg-config libgtest-dev libbenchmark-dev
             libembree-dev libbox2d-dev libbullet-dev libpng-dev libfcl-dev clang libclang-rt-14-dev
-            libcgal-dev libtbb-dev)
+            libcgal-dev libtbb-dev libgmp-dev)
 fi
 missing=()
 for p in "${packages[@]}"; do

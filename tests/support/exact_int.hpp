@@ -1,14 +1,77 @@
 #pragma once
-// A small exact signed integer for test references: sign and magnitude in 32-bit limbs, with +, -,
-// * and comparison, nothing else. Floating-point inputs are dyadic rationals m * 2^e, so a set of
-// them scaled by one common power of two (scaled_integer) becomes integers, and any polynomial of
-// them (determinants, dot products) is computed exactly. Independent of the library's arithmetic.
+// An exact signed integer for test references, with +, -, * and comparison, nothing else.
+// Floating-point inputs are dyadic rationals m * 2^e, so a set of them scaled by one common power
+// of two (scaled) becomes integers, and any polynomial of them (determinants, dot products) is
+// computed exactly.
+//
+// With GMP (BVHKIT_TEST_HAVE_GMP, found by tests/CMakeLists.txt) the arithmetic and the reading of
+// a double are GMP's (mpz_class, mpq_class), apart from the library's own exact integers
+// (math/exact_integer.hpp). Without it, a sign-and-magnitude integer of 32-bit limbs written here
+// stands in; the library's DyadicInt has the same shape, so such a build's references are weaker.
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
 
+#if defined(BVHKIT_TEST_HAVE_GMP)
+#include <gmpxx.h>
+#endif
+
 namespace bvhkit::test {
+
+#if defined(BVHKIT_TEST_HAVE_GMP)
+
+class ExactInt {
+  public:
+    ExactInt() = default;
+    explicit ExactInt(std::int64_t v) : z_(static_cast<long>(v)) {
+        static_assert(sizeof(long) == sizeof(std::int64_t), "mpz_class takes a 64-bit long here");
+    }
+
+    /// x * 2^shift, which must be an integer (throws otherwise).
+    static ExactInt scaled(double x, int shift) {
+        mpq_class q(x);  // exact: every finite double is a rational with a power-of-two denominator
+        if (shift >= 0)
+            mpq_mul_2exp(q.get_mpq_t(), q.get_mpq_t(), static_cast<unsigned long>(shift));
+        else
+            mpq_div_2exp(q.get_mpq_t(), q.get_mpq_t(), static_cast<unsigned long>(-shift));
+        if (q.get_den() != 1) throw std::logic_error("ExactInt::scaled: not an integer");
+        ExactInt r;
+        r.z_ = q.get_num();
+        return r;
+    }
+
+    /// The shift that makes x * 2^shift an integer (for scaled()): the smallest one.
+    static int shift_needed(double x) {
+        if (x == 0) return -100000;
+        const mpq_class q(x);
+        if (q.get_den() != 1) return static_cast<int>(mpz_sizeinbase(q.get_den_mpz_t(), 2)) - 1;
+        return -static_cast<int>(mpz_scan1(q.get_num_mpz_t(), 0));  // trailing zero bits
+    }
+
+    int sign() const { return sgn(z_); }
+
+    friend ExactInt operator-(ExactInt a) {
+        a.z_ = -a.z_;
+        return a;
+    }
+    friend ExactInt operator+(const ExactInt& a, const ExactInt& b) {
+        return ExactInt(a.z_ + b.z_);
+    }
+    friend ExactInt operator-(const ExactInt& a, const ExactInt& b) {
+        return ExactInt(a.z_ - b.z_);
+    }
+    friend ExactInt operator*(const ExactInt& a, const ExactInt& b) {
+        return ExactInt(a.z_ * b.z_);
+    }
+    friend bool operator==(const ExactInt& a, const ExactInt& b) { return a.z_ == b.z_; }
+
+  private:
+    explicit ExactInt(mpz_class z) : z_(std::move(z)) {}
+    mpz_class z_;
+};
+
+#else
 
 class ExactInt {
   public:
@@ -173,5 +236,7 @@ class ExactInt {
     int n_ = 0;
     int sign_ = 0;
 };
+
+#endif
 
 }  // namespace bvhkit::test
