@@ -23,7 +23,7 @@
 #include "bvhkit/convex/distance.hpp"
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/query/collision_model.hpp"
-#include "bvhkit/query/min_heap.hpp"
+#include "bvhkit/bvh/min_heap.hpp"
 #include "bvhkit/query/pose_slack.hpp"
 
 namespace bvhkit {

@@ -23,7 +23,7 @@
 
 #include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/primitives/triangle_distance.hpp"
-#include "bvhkit/query/min_heap.hpp"
+#include "bvhkit/bvh/min_heap.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 
 namespace bvhkit {
