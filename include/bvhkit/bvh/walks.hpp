@@ -65,9 +65,6 @@ BvhNodes<Node> bvh_nodes(std::span<const Node> nodes) {
 
 enum class FirstChild { Left, Right };
 
-/// The stack a depth-first walk of a Bvh needs (one entry per level).
-using WalkStack = TraversalStack;
-
 /// Depth first from the view's root; see the top of this file. `first` picks the child entered
 /// first: FirstChild::Left, FirstChild::Right, or a callable first(ref) -> unsigned (0 or 1) for an
 /// order that depends on the node (nearer child first). Returns false when on_leaf stopped the
