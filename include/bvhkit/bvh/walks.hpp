@@ -4,7 +4,8 @@
 // here, once:
 //
 //   walk_depth_first  one tree, pre-order, with an optional child order: enter(ref) says whether
-//                     the walk goes into a node, on_leaf(ref) takes a leaf and may stop the walk.
+//                     the walk goes into a node (asked as it is reached, or of both children
+//                     before either is pushed), on_leaf(ref) takes a leaf and may stop the walk.
 //                     It pushes one child and goes straight on into the other, so the stack holds
 //                     at most one entry per level.
 //   walk_best_first   entries in one min-heap (MinHeap4) keyed by a lower bound on their distance;
@@ -22,6 +23,9 @@
 // index into one array. A leaf's contents are the query's business: the skeletons hand over the
 // leaf's Ref and never look inside, so a tree whose leaves are instances of other trees is walked
 // by a view of the top level whose on_leaf starts a walk of the instance's own view.
+//
+// The skeletons are forced inline: a query's callbacks then read its locals in its own frame, not
+// through a closure in memory, and the query costs what its own loop did.
 //
 // Stacks: a FixedStack (bvh/traversal_stack.hpp) for trees whose depth is bounded (max_bvh_depth:
 // every builder's tree and every tree validate() accepts), which the skeletons take from the caller
@@ -65,29 +69,52 @@ BvhNodes<Node> bvh_nodes(std::span<const Node> nodes) {
 
 enum class FirstChild { Left, Right };
 
+/// When a depth-first walk asks enter(): as it reaches a node (OnEntry), or for both children of
+/// an inner node before either is pushed (BeforePush: only children that pass are pushed, which
+/// pays where most are rejected and a push costs more than a test, as on a growable stack).
+enum class Gate { OnEntry, BeforePush };
+
 /// Depth first from the view's root; see the top of this file. `first` picks the child entered
 /// first: FirstChild::Left, FirstChild::Right, or a callable first(ref) -> unsigned (0 or 1) for an
 /// order that depends on the node (nearer child first). Returns false when on_leaf stopped the
 /// walk.
-template <NodeView View, class Stack, class Enter, class OnLeaf, class First>
-bool walk_depth_first(const View& view, Stack& stack, Enter&& enter, OnLeaf&& on_leaf,
-                      First&& first) {
+template <Gate gate = Gate::OnEntry, NodeView View, class Stack, class Enter, class OnLeaf,
+          class First>
+[[gnu::always_inline]] inline bool walk_depth_first(const View& view, Stack& stack, Enter&& enter,
+                                                    OnLeaf&& on_leaf, First&& first) {
     using Ref = typename View::Ref;
     stack.clear();
     Ref current = view.root();
+    if constexpr (gate == Gate::BeforePush)
+        if (!enter(current)) return true;
     while (true) {
-        if (enter(current)) {
+        if (gate == Gate::BeforePush || enter(current)) {
             if (!view.is_leaf(current)) {
                 unsigned k;
                 if constexpr (std::is_same_v<std::decay_t<First>, FirstChild>)
                     k = first == FirstChild::Left ? 0u : 1u;
                 else
                     k = unsigned(first(current));
-                stack.push(view.child(current, 1u - k));
-                current = view.child(current, k);
-                continue;
+                const Ref near = view.child(current, k), far = view.child(current, 1u - k);
+                if constexpr (gate == Gate::OnEntry) {
+                    stack.push(far);
+                    current = near;
+                    continue;
+                } else {
+                    const bool in_near = enter(near), in_far = enter(far);
+                    if (in_near) {
+                        if (in_far) stack.push(far);
+                        current = near;
+                        continue;
+                    }
+                    if (in_far) {
+                        current = far;
+                        continue;
+                    }
+                }
+            } else if (!on_leaf(current)) {
+                return false;
             }
-            if (!on_leaf(current)) return false;
         }
         if (stack.empty()) return true;
         current = stack.pop();
@@ -105,7 +132,7 @@ enum class Step {
 /// hopeless(key) says an entry of that key cannot improve the answer; it is asked of every popped
 /// entry, and ends the walk, the heap being ordered. step(Entry& e, Heap& heap) opens e.
 template <class Heap, class Hopeless, class StepF>
-void walk_best_first(Heap& heap, Hopeless&& hopeless, StepF&& step) {
+[[gnu::always_inline]] inline void walk_best_first(Heap& heap, Hopeless&& hopeless, StepF&& step) {
     while (!heap.empty()) {
         auto e = heap.pop();
         if (hopeless(heap.key(e))) return;
@@ -122,8 +149,9 @@ void walk_best_first(Heap& heap, Hopeless&& hopeless, StepF&& step) {
 /// walk.
 template <NodeView ViewA, NodeView ViewB, class Stack, class Pair, class Enter, class OnLeaves,
           class Open>
-bool walk_pairs(const ViewA& view_a, const ViewB& view_b, Stack& stack, const Pair& root,
-                Enter&& enter, OnLeaves&& on_leaves, Open&& open) {
+[[gnu::always_inline]] inline bool walk_pairs(const ViewA& view_a, const ViewB& view_b,
+                                              Stack& stack, const Pair& root, Enter&& enter,
+                                              OnLeaves&& on_leaves, Open&& open) {
     stack.clear();
     stack.push(root);
     while (!stack.empty()) {

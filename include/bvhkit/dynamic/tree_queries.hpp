@@ -67,15 +67,14 @@ inline void prefetch_next(const TreeView<T, N, U>& t, const Node<T, N>& n) {
 template <class T, std::size_t N, class U, class F>
 void query_box(const TreeView<T, N, U>& t, const Aabb<T, N>& box, F&& callback, QueryStats* stats) {
     if (t.root == kNullNode) return;
-    std::uint64_t visited = 1, tested = 0;
-    // A node is tested as it is entered; an inner one that passes counts its two children's
-    // tests, as they are sure to follow unless the walk stops first.
+    std::uint64_t visited = 0, tested = 0;
+    // Children are tested before they are pushed, so the stack only ever holds nodes that overlap.
     const auto enter = [&](std::int32_t i) {
+        ++visited;
         const Node<T, N>& n = t.nodes[i];
         if (!n.box.overlaps(box)) return false;
-        if (!n.is_leaf()) visited += 2;
-        // The tree is scattered in memory: ask for what the node's walk reads next (its
-        // children, or its proxy) now, so the loads overlap with other work.
+        // The tree is scattered in memory: ask for what the node will read when it is opened
+        // (its children, or its proxy) now, so the loads overlap with other work.
         prefetch_next(t, n);
         return true;
     };
@@ -85,7 +84,7 @@ void query_box(const TreeView<T, N, U>& t, const Aabb<T, N>& box, F&& callback, 
         return !t.proxies[slot].box.overlaps(box) || callback(proxy_id(t, slot));
     };
     SmallStack<std::int32_t> stack;
-    walk_depth_first(node_view(t), stack, enter, on_leaf, FirstChild::Left);
+    walk_depth_first<Gate::BeforePush>(node_view(t), stack, enter, on_leaf, FirstChild::Left);
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
 }
 

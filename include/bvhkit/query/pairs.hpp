@@ -3,8 +3,9 @@
 // A's frame by `pose_of_b_in_a`. The pose is applied to B's volumes as they are tested (a volume
 // test under a pose, volumes/*.hpp); nothing of B is copied or transformed ahead of time.
 //
-// walk_pairs (bvh/walks.hpp) over node pairs, each pushed only after its volumes were found to
-// overlap. Which node of a pair to open is the descent rule (the usual choices of tree-vs-tree
+// Iterative with an explicit stack of node pairs, each pushed only after its volumes were found to
+// overlap. Its own loop, not walk_pairs (bvh/walks.hpp): on that skeleton the first-contact query
+// took more instructions on OBB and RSS (docs/benchmarks.md, "Walk skeletons"). Which node of a pair to open is the descent rule (the usual choices of tree-vs-tree
 // collision):
 //   Larger        open the node with the larger volume (default; keeps the pair balanced)
 //   A / B         open A's node (B's node) until it is a leaf, then the other
@@ -16,7 +17,7 @@
 #include <cstdint>
 
 #include "bvhkit/bvh/bvh.hpp"
-#include "bvhkit/bvh/walks.hpp"
+#include "bvhkit/bvh/traversal_stack.hpp"
 #include "bvhkit/query/stats.hpp"
 #include "bvhkit/volumes/bounding_volume.hpp"
 
@@ -112,7 +113,7 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
         stats.node();
         return Traits::overlaps(a.nodes[x].bounds, b.nodes[y].bounds, pose);
     };
-    FixedStack<detail::NodePair, detail::pair_stack_size> pairs;
+    FixedStack<detail::NodePair, detail::pair_stack_size> stack;
     // Of two children that both overlap, the one whose centre is nearer the other node's is
     // searched first: its subtree is likelier to hold a touching pair, which ends a yes/no query.
     const auto nearer_on_top = [](const auto& nodes, const auto& w, std::uint32_t lower,
@@ -122,20 +123,19 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
             std::swap(pl, pu);
     };
     if (!overlap(0, 0)) return true;
-    const auto on_leaves = [&](const detail::NodePair& p) {
+    stack.push({0, 0});
+    while (!stack.empty()) {
+        const detail::NodePair p = stack.pop();
         const auto& na = a.nodes[p.a];
         const auto& nb = b.nodes[p.b];
-        for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa)
-            for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
-                stats.primitive();
-                if (!on_pair(sa, sb)) return false;
-            }
-        return true;
-    };
-    // The descent rule: the child pairs worth visiting, each pushed once its volumes overlap.
-    const auto open = [&](const detail::NodePair& p, auto& stack) {
-        const auto& na = a.nodes[p.a];
-        const auto& nb = b.nodes[p.b];
+        if (na.is_leaf() && nb.is_leaf()) {
+            for (std::uint32_t sa = na.first; sa < na.first + na.count; ++sa)
+                for (std::uint32_t sb = nb.first; sb < nb.first + nb.count; ++sb) {
+                    stats.primitive();
+                    if (!on_pair(sa, sb)) return false;
+                }
+            continue;
+        }
         if (rule == DescentRule::ByOverlap && !na.is_leaf() && !nb.is_leaf()) {
             const bool al = overlap(na.left(), p.b), ar = overlap(na.right(), p.b);
             const bool bl = overlap(p.a, nb.left()), br = overlap(p.a, nb.right());
@@ -150,7 +150,7 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
                 if (br) stack.push({p.a, nb.right()});
                 if (bl) stack.push({p.a, nb.left()});
             }
-            return;
+            continue;
         }
         switch (detail::choose(rule, na, nb)) {
             case detail::Open::A:
@@ -193,9 +193,8 @@ bool for_each_overlapping_pair(const Bvh<V>& a, const Bvh<V>& b,
                         if (overlap(x, y)) stack.push({x, y});
                 break;
         }
-    };
-    return walk_pairs(BvhNodes<BvhNode<V>>{a.nodes.data()}, BvhNodes<BvhNode<V>>{b.nodes.data()},
-                      pairs, detail::NodePair{0, 0}, EnterAll{}, on_leaves, open);
+    }
+    return true;
 }
 
 }  // namespace bvhkit
