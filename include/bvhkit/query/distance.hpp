@@ -369,24 +369,26 @@ DistanceResult<typename V::Scalar> distance(
     const DescentRule rule =
         options.rule == DescentRule::ByOverlap ? DescentRule::Larger : options.rule;
     heap.push(Entry{0, 0, bound(0, 0)});
-    walk_best_first(heap, hopeless, [&](Entry& e, auto& queue) {
-        const auto& na = na_[e.a];
-        const auto& nb = nb_[e.b];
-        if (na.is_leaf() && nb.is_leaf()) {
-            detail::measure_leaf_pair<T>(ta, tb, na, nb, posed, limits.window_top, best,
-                                         result.stats, take);
-            return best2.s2 == 0 ? Step::Stop : Step::Pop;
-        }
-        Entry kids[4];
-        const int n = detail::open_pair<V>(std::span(na_), std::span(nb_), e, na, nb, rule, pose,
-                                           inverse, bound, placed_bound, kids);
-        // A child that is already the least pending pair goes on without a trip through the
-        // heap (the usual case while refining toward a leaf); it is not hopeless, or it would
-        // not have been chosen.
-        bool have_next = false;
-        detail::queue_children(kids, n, hopeless, queue, e, have_next);
-        return have_next ? Step::Continue : Step::Pop;
-    });
+    // The step is forced inline: out of line it read the query's state through its closure.
+    walk_best_first(
+        heap, hopeless, [&](Entry & e, auto& queue) __attribute__((always_inline)) {
+            const auto& na = na_[e.a];
+            const auto& nb = nb_[e.b];
+            if (na.is_leaf() && nb.is_leaf()) {
+                detail::measure_leaf_pair<T>(ta, tb, na, nb, posed, limits.window_top, best,
+                                             result.stats, take);
+                return best2.s2 == 0 ? Step::Stop : Step::Pop;
+            }
+            Entry kids[4];
+            const int n = detail::open_pair<V>(std::span(na_), std::span(nb_), e, na, nb, rule,
+                                               pose, inverse, bound, placed_bound, kids);
+            // A child that is already the least pending pair goes on without a trip through the
+            // heap (the usual case while refining toward a leaf); it is not hopeless, or it would
+            // not have been chosen.
+            bool have_next = false;
+            detail::queue_children(kids, n, hopeless, queue, e, have_next);
+            return have_next ? Step::Continue : Step::Pop;
+        });
     return result;
 }
 
