@@ -14,7 +14,7 @@
 //                     entry and may hand back a child to go on with at once (a trip through the
 //                     heap saved), or stop the walk.
 //   walk_pairs        two trees (or one against itself) depth first over pairs of nodes: a pair of
-//                     leaves goes to on_leaves(a, b), which may stop the walk; any other pair to
+//                     leaves goes to on_leaves(pair), which may stop the walk; any other pair to
 //                     open(pair, stack), the descent rule, which pushes the child pairs worth
 //                     visiting (which side to split, which test, which order: the query's).
 //
@@ -29,8 +29,8 @@
 //
 // Stacks: a FixedStack (bvh/traversal_stack.hpp) for trees whose depth is bounded (max_bvh_depth:
 // every builder's tree and every tree validate() accepts), which the skeletons take from the caller
-// so a query allocates nothing. Any type with push/pop/empty works, so the dynamic tree, whose
-// depth nothing bounds, walks on its growable SmallStack.
+// so a query allocates nothing. Any type with push/pop/empty/clear works, so the dynamic tree,
+// whose depth nothing bounds, walks on its growable SmallStack.
 #include <concepts>
 #include <cstdint>
 #include <span>
