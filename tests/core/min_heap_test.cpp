@@ -5,7 +5,7 @@
 #include <set>
 
 #include "bvhkit/math/random.hpp"
-#include "bvhkit/query/min_heap.hpp"
+#include "bvhkit/bvh/min_heap.hpp"
 
 using namespace bvhkit;
 

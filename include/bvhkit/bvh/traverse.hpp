@@ -1,16 +1,12 @@
 #pragma once
-// traverse_depth_first: the one non-recursive depth-first walk over a Bvh (in the spirit of
-// madmann91/bvh v2's traverse_top_down): `enter(index, node)` says whether the walk goes into a
-// node (the root included); a leaf it goes into is handed to `on_leaf(node)`, which returns false
-// to stop the whole walk. At an inner node the walk pushes one child and goes straight on into the
-// other (FirstChild says which), so the stack holds at most one entry per level and the nodes are
-// entered in the order of a recursive pre-order walk.
+// traverse_depth_first: walk_depth_first (bvh/walks.hpp) over a Bvh's nodes, handing the callbacks
+// the node as well as its index: `enter(index, node)` says whether the walk goes into a node (the
+// root included); a leaf it goes into is handed to `on_leaf(node)`, which returns false to stop
+// the whole walk. FirstChild says which child is entered first; the nodes are entered in the
+// order of a recursive pre-order walk.
 //
-// Used by the overlap queries (query/overlap.hpp) and within_radius (query/nearest.hpp), where it
-// took fewer instructions than their own loops did. Not used by the winding number
-// (query/winding_number.hpp says why), the ray walk (nearer child first by entry distance,
-// branch-free pushes) or the tree-vs-tree walks (pairs of nodes, query/pairs.hpp), which keep their
-// own loops on a TraversalStack or their own pair stacks.
+// Used by the overlap queries (query/overlap.hpp), within_radius (query/nearest.hpp) and the
+// convex shape's collision test (query/convex_mesh.hpp).
 //
 // Leaves hand out leaf slots (positions in primitive_indices): LeafSlot keeps them apart from
 // primitive indices, so a callback cannot take one for the other by mistake.
@@ -18,7 +14,7 @@
 #include <span>
 
 #include "bvhkit/bvh/bvh.hpp"
-#include "bvhkit/bvh/traversal_stack.hpp"
+#include "bvhkit/bvh/walks.hpp"
 
 namespace bvhkit {
 
@@ -54,35 +50,16 @@ constexpr LeafSlots leaf_slots(const BvhNode<Volume>& leaf) {
     return {leaf.first, leaf.count};
 }
 
-enum class FirstChild { Left, Right };
-
 /// Walks `nodes` (a Bvh's, root at 0) depth first; see the top of this file. Returns false when
 /// on_leaf stopped the walk. No allocation: the stack is the caller's (usually a local).
 template <FirstChild first = FirstChild::Left, class Node, class Enter, class OnLeaf>
 bool traverse_depth_first(std::span<const Node> nodes, TraversalStack& stack, Enter&& enter,
                           OnLeaf&& on_leaf) {
     if (nodes.empty()) return true;
-    stack.clear();
-    std::uint32_t current = 0;
-    while (true) {
-        const Node& node = nodes[current];
-        if (enter(current, node)) {
-            if (!node.is_leaf()) {
-                const std::uint32_t l = node.left();
-                if constexpr (first == FirstChild::Left) {
-                    stack.push(l + 1);
-                    current = l;
-                } else {
-                    stack.push(l);
-                    current = l + 1;
-                }
-                continue;
-            }
-            if (!on_leaf(node)) return false;
-        }
-        if (stack.empty()) return true;
-        current = stack.pop();
-    }
+    const Node* n = nodes.data();
+    return walk_depth_first(
+        BvhNodes<Node>{n}, stack, [&](std::uint32_t i) { return enter(i, n[i]); },
+        [&](std::uint32_t i) { return on_leaf(n[i]); }, first);
 }
 
 /// The same over a whole Bvh.

@@ -15,6 +15,10 @@ class SmallStack {
   public:
     bool empty() const { return size_ == 0; }
     std::size_t size() const { return size_; }
+    void clear() {
+        size_ = 0;
+        overflow_.clear();
+    }
 
     void push(const E& e) {
         if (size_ < Inline) {

@@ -1,8 +1,10 @@
 #pragma once
 // The dynamic tree's queries, written against a read-only view of its arrays: box overlap, point,
-// ray cast, box cast and tree against tree. None recurses: each walks the tree depth first with a
-// SmallStack (on the caller's frame). Leaves are reported when the proxy's own (tight) box passes
-// the test; the fat boxes in the nodes only steer the descent.
+// ray cast, box cast and tree against tree. None recurses: box and point queries walk on
+// walk_depth_first and tree against tree on walk_pairs (bvh/walks.hpp), with a SmallStack (on the
+// caller's frame); the casts keep their own loop, whose stack entries carry the entry fraction
+// that lets a shortened segment drop them. Leaves are reported when the proxy's own (tight) box
+// passes the test; the fat boxes in the nodes only steer the descent.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +12,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "bvhkit/bvh/walks.hpp"
 #include "bvhkit/dynamic/small_stack.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
 #include "bvhkit/math/ray.hpp"
@@ -22,6 +25,23 @@ struct TreeView {
     const Proxy<T, N, U>* proxies;
     std::int32_t root;
 };
+
+/// The tree's shape as a NodeView (bvh/walks.hpp), for the walk skeletons. Its depth has no bound,
+/// so the walks run on a SmallStack, which grows past its inline entries.
+template <class T, std::size_t N>
+struct DynamicNodes {
+    using Ref = std::int32_t;
+    const Node<T, N>* nodes;
+    std::int32_t root_node;
+    Ref root() const { return root_node; }
+    bool is_leaf(Ref r) const { return nodes[r].is_leaf(); }
+    Ref child(Ref r, unsigned k) const { return k == 0 ? nodes[r].child1 : nodes[r].child2; }
+};
+
+template <class T, std::size_t N, class U>
+DynamicNodes<T, N> node_view(const TreeView<T, N, U>& t) {
+    return {t.nodes, t.root};
+}
 
 /// The id of the proxy in slot `i`: its generation sits in the record the leaf test just read.
 template <class T, std::size_t N, class U>
@@ -43,35 +63,28 @@ inline void prefetch_next(const TreeView<T, N, U>& t, const Node<T, N>& n) {
 #endif
 }
 
-/// Box overlap: callback(ProxyId) -> bool, false stops the query. A node's children are tested
-/// before they are pushed, so the stack only ever holds nodes that overlap.
+/// Box overlap: callback(ProxyId) -> bool, false stops the query. Pre-order, child1 first.
 template <class T, std::size_t N, class U, class F>
 void query_box(const TreeView<T, N, U>& t, const Aabb<T, N>& box, F&& callback, QueryStats* stats) {
     if (t.root == kNullNode) return;
-    std::uint64_t visited = 1, tested = 0;
-    if (!t.nodes[t.root].box.overlaps(box)) {
-        if (stats) stats->nodes_visited += visited;
-        return;
-    }
+    std::uint64_t visited = 0, tested = 0;
+    // Children are tested before they are pushed, so the stack only ever holds nodes that overlap.
+    const auto enter = [&](std::int32_t i) {
+        ++visited;
+        const Node<T, N>& n = t.nodes[i];
+        if (!n.box.overlaps(box)) return false;
+        // The tree is scattered in memory: ask for what the node will read when it is opened
+        // (its children, or its proxy) now, so the loads overlap with other work.
+        prefetch_next(t, n);
+        return true;
+    };
+    const auto on_leaf = [&](std::int32_t i) {
+        ++tested;
+        const std::int32_t slot = t.nodes[i].value();
+        return !t.proxies[slot].box.overlaps(box) || callback(proxy_id(t, slot));
+    };
     SmallStack<std::int32_t> stack;
-    stack.push(t.root);
-    while (!stack.empty()) {
-        const Node<T, N>& n = t.nodes[stack.pop()];
-        if (n.is_leaf()) {
-            ++tested;
-            if (t.proxies[n.value()].box.overlaps(box) && !callback(proxy_id(t, n.value()))) break;
-            continue;
-        }
-        visited += 2;
-        for (const std::int32_t c : {n.child2, n.child1}) {
-            const Node<T, N>& cn = t.nodes[c];
-            if (!cn.box.overlaps(box)) continue;
-            stack.push(c);
-            // The tree is scattered in memory: ask for what the pushed node will read when it is
-            // popped (its children, or its proxy) now, so the loads overlap with other work.
-            prefetch_next(t, cn);
-        }
-    }
+    walk_depth_first<Gate::BeforePush>(node_view(t), stack, enter, on_leaf, FirstChild::Left);
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
 }
 
@@ -173,28 +186,30 @@ void query_tree(const TreeView<T, N, U>& a, const TreeView<T, N, V>& b, F&& call
         std::int32_t a, b;
     };
     std::uint64_t visited = 0, tested = 0;
-    SmallStack<NodePair> stack;
-    stack.push({a.root, b.root});
-    while (!stack.empty()) {
-        const NodePair p = stack.pop();
+    const auto enter = [&](const NodePair& p) {
+        ++visited;
+        return a.nodes[p.a].box.overlaps(b.nodes[p.b].box);
+    };
+    const auto on_leaves = [&](const NodePair& p) {
+        ++tested;
+        const std::int32_t sa = a.nodes[p.a].value(), sb = b.nodes[p.b].value();
+        return !a.proxies[sa].box.overlaps(b.proxies[sb].box) ||
+               callback(proxy_id(a, sa), proxy_id(b, sb));
+    };
+    // The descent rule (see above); the first child's pair is pushed last, so it is walked first.
+    const auto open = [&](const NodePair& p, auto& pairs) {
         const Node<T, N>& na = a.nodes[p.a];
         const Node<T, N>& nb = b.nodes[p.b];
-        ++visited;
-        if (!na.box.overlaps(nb.box)) continue;
-        const bool leaf_a = na.is_leaf(), leaf_b = nb.is_leaf();
-        if (leaf_a && leaf_b) {
-            ++tested;
-            if (a.proxies[na.value()].box.overlaps(b.proxies[nb.value()].box) &&
-                !callback(proxy_id(a, na.value()), proxy_id(b, nb.value())))
-                break;
-        } else if (leaf_b || (!leaf_a && na.box.area() >= nb.box.area())) {
-            stack.push({na.child2, p.b});
-            stack.push({na.child1, p.b});
+        if (nb.is_leaf() || (!na.is_leaf() && na.box.area() >= nb.box.area())) {
+            pairs.push({na.child2, p.b});
+            pairs.push({na.child1, p.b});
         } else {
-            stack.push({p.a, nb.child2});
-            stack.push({p.a, nb.child1});
+            pairs.push({p.a, nb.child2});
+            pairs.push({p.a, nb.child1});
         }
-    }
+    };
+    SmallStack<NodePair> stack;
+    walk_pairs(node_view(a), node_view(b), stack, NodePair{a.root, b.root}, enter, on_leaves, open);
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
 }
 

@@ -20,10 +20,10 @@
 #include <utility>
 #include <vector>
 
+#include "bvhkit/bvh/traverse.hpp"
 #include "bvhkit/convex/distance.hpp"
 #include "bvhkit/primitives/closest_point.hpp"
 #include "bvhkit/query/collision_model.hpp"
-#include "bvhkit/query/min_heap.hpp"
 #include "bvhkit/query/pose_slack.hpp"
 
 namespace bvhkit {
@@ -187,21 +187,15 @@ bool convex_mesh_collides(const ConvexShape<typename V::Scalar>& shape,
     const auto& bvh = mesh.bvh();
     if (bvh.empty() || !is_finite(s.in_mesh.translation)) return false;
     const auto tris = mesh.slot_triangles();
-    std::uint32_t stack[max_bvh_depth * 2];
-    std::size_t top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const auto& node = bvh.nodes[stack[--top]];
-        if (!VolumeTraits<V>::overlaps(node.bounds, s.volume, s.prepared)) continue;
-        if (!node.is_leaf()) {
-            stack[top++] = node.left();
-            stack[top++] = node.right();
-            continue;
-        }
+    const auto enter = [&](std::uint32_t, const BvhNode<V>& node) {
+        return VolumeTraits<V>::overlaps(node.bounds, s.volume, s.prepared);
+    };
+    const auto on_leaf = [&](const BvhNode<V>& node) {
         for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
-            if (convex_mesh_detail::shape_triangle(s, tris[k]).overlap) return true;
-    }
-    return false;
+            if (convex_mesh_detail::shape_triangle(s, tris[k]).overlap) return false;
+        return true;
+    };
+    return !traverse_depth_first<FirstChild::Right>(bvh, enter, on_leaf);
 }
 
 /// The distance between `shape` at `shape_pose` and the triangles of `mesh` at `mesh_pose` (world
@@ -229,17 +223,16 @@ ConvexMeshDistance<typename V::Scalar> convex_mesh_distance(
     MinHeap4 heap(storage, [](const Entry& e) { return e.bound; });
     heap.push({T(0), 0});
     convex_mesh_detail::TriangleAnswer<T> found{};
-    while (!heap.empty()) {
-        const Entry e = heap.pop();
-        if (!(e.bound < best.distance)) break;  // nothing left can come nearer
+    const auto hopeless = [&](T bound) { return !(bound < best.distance); };  // nor any left
+    walk_best_first(heap, hopeless, [&](const Entry& e, auto& queue) {
         const auto& node = bvh.nodes[e.node];
         if (!node.is_leaf()) {
             for (const std::uint32_t c : {node.left(), node.right()}) {
                 const T bound = VolumeTraits<V>::distance_lower_bound(bvh.nodes[c].bounds, s.volume,
                                                                       s.prepared);
-                if (bound < best.distance) heap.push({bound, c});
+                if (bound < best.distance) queue.push({bound, c});
             }
-            continue;
+            return Step::Pop;
         }
         for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
             const auto a = convex_mesh_detail::shape_triangle(s, tris[k]);
@@ -250,8 +243,8 @@ ConvexMeshDistance<typename V::Scalar> convex_mesh_distance(
                 found = a;
             }
         }
-        if (best.overlap) break;  // 0: nothing is nearer
-    }
+        return best.overlap ? Step::Stop : Step::Pop;  // 0: nothing is nearer
+    });
     if (best.face != ConvexMeshDistance<T>{}.face) {
         best.point_shape = mesh_pose.apply(found.on_shape);
         best.point_mesh = mesh_pose.apply(found.on_triangle);

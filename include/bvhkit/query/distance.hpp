@@ -21,9 +21,9 @@
 #include <span>
 #include <vector>
 
+#include "bvhkit/bvh/walks.hpp"
 #include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/primitives/triangle_distance.hpp"
-#include "bvhkit/query/min_heap.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 
 namespace bvhkit {
@@ -366,30 +366,29 @@ DistanceResult<typename V::Scalar> distance(
     // thread's next query, so a query allocates only when it needs more room than any before.
     thread_local std::vector<Entry> heap_storage;
     MinHeap4 heap(heap_storage, [](const Entry& x) { return x.bound; });
-    // `next`: a child that is already the least pending pair goes on without a trip through
-    // the heap (the usual case while refining toward a leaf).
-    Entry next{0, 0, bound(0, 0)};
-    bool have_next = true;
     const DescentRule rule =
         options.rule == DescentRule::ByOverlap ? DescentRule::Larger : options.rule;
-    while (have_next || !heap.empty()) {
-        Entry e = next;
-        if (!have_next) e = heap.pop();
-        have_next = false;
-        if (hopeless(e.bound)) break;  // and so is every pair still waiting
-        const auto& na = na_[e.a];
-        const auto& nb = nb_[e.b];
-        if (na.is_leaf() && nb.is_leaf()) {
-            detail::measure_leaf_pair<T>(ta, tb, na, nb, posed, limits.window_top, best,
-                                         result.stats, take);
-            if (best2.s2 == 0) break;
-            continue;
-        }
-        Entry kids[4];
-        const int n = detail::open_pair<V>(std::span(na_), std::span(nb_), e, na, nb, rule, pose,
-                                           inverse, bound, placed_bound, kids);
-        detail::queue_children(kids, n, hopeless, heap, next, have_next);
-    }
+    heap.push(Entry{0, 0, bound(0, 0)});
+    // The step is forced inline: out of line it read the query's state through its closure.
+    walk_best_first(
+        heap, hopeless, [&](Entry & e, auto& queue) __attribute__((always_inline)) {
+            const auto& na = na_[e.a];
+            const auto& nb = nb_[e.b];
+            if (na.is_leaf() && nb.is_leaf()) {
+                detail::measure_leaf_pair<T>(ta, tb, na, nb, posed, limits.window_top, best,
+                                             result.stats, take);
+                return best2.s2 == 0 ? Step::Stop : Step::Pop;
+            }
+            Entry kids[4];
+            const int n = detail::open_pair<V>(std::span(na_), std::span(nb_), e, na, nb, rule,
+                                               pose, inverse, bound, placed_bound, kids);
+            // A child that is already the least pending pair goes on without a trip through the
+            // heap (the usual case while refining toward a leaf); it is not hopeless, or it would
+            // not have been chosen.
+            bool have_next = false;
+            detail::queue_children(kids, n, hopeless, queue, e, have_next);
+            return have_next ? Step::Continue : Step::Pop;
+        });
     return result;
 }
 

@@ -37,7 +37,6 @@
 #include "bvhkit/bvh/sibling_pair.hpp"
 #include "bvhkit/bvh/traverse.hpp"
 #include "bvhkit/primitives/hit.hpp"
-#include "bvhkit/query/min_heap.hpp"
 #include "bvhkit/query/stats.hpp"
 
 namespace bvhkit {
@@ -95,8 +94,8 @@ T prune_radius2(const Distance& distance, const Vec<T, N>& p, K radius2) {
         return round_up_key<T>(radius2);
 }
 
-/// The best-first walk. `radius2()` is the current squared search radius (it shrinks as
-/// on_slot(slot, d2) finds closer primitives).
+/// The best-first walk (walk_best_first, bvh/walks.hpp). `radius2()` is the current squared search
+/// radius (it shrinks as on_slot(slot, d2) finds closer primitives).
 template <class T, std::size_t N, class Radius, class OnSlot, class Stats>
 void best_first(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, NearestScratch<T>& scratch,
                 Radius&& radius2, OnSlot&& on_slot, Stats&& stats) {
@@ -107,47 +106,42 @@ void best_first(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, NearestScratch<T
     const T root_d2 = nodes[0].bounds.distance_squared(p);
     if (root_d2 > radius2()) return;
     heap.push({root_d2, 0});
-    while (!heap.empty()) {
-        const NearestEntry<T> e = heap.pop();
-        if (e.distance_squared > radius2()) break;  // every node left is farther still
-        std::uint32_t current = e.node;
-        while (true) {
-            const auto& node = nodes[current];
-            if (node.is_leaf()) {
-                for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
-                    stats.primitive();
-                    on_slot(s);
-                }
-                break;
+    const auto hopeless = [&](T d2) { return d2 > radius2(); };  // every node left is farther
+    walk_best_first(heap, hopeless, [&](NearestEntry<T>& e, auto& queue) {
+        const auto& node = nodes[e.node];
+        if (node.is_leaf()) {
+            for (std::uint32_t s = node.first; s < node.first + node.count; ++s) {
+                stats.primitive();
+                on_slot(s);
             }
-            const std::uint32_t l = node.left();
-            T d[2];
-            pair_distances_squared(nodes + l, p, d);
-            stats.node();
-            stats.node();
-            const bool right_nearer = d[1] < d[0];
-            const std::uint32_t near = l + right_nearer, far = l + !right_nearer;
-            const T dl = d[right_nearer], dr = d[!right_nearer];
-            const T r2 = radius2();
-            // A child within the radius is likely to be opened (now or from the heap): ask for its
-            // children's line, or its leaf's first primitive, before it is needed. Queries jump
-            // around a tree far larger than the caches, so this hides a miss per node (~15%).
-            for (int c = 0; c < 2; ++c) {
-                if (d[c] > r2) continue;
-                const auto& child = nodes[l + c];
-                if (child.is_leaf()) {
-                    if constexpr (requires { on_slot.prefetch(0u); }) on_slot.prefetch(child.first);
-                } else {
-                    __builtin_prefetch(nodes + child.first);
-                }
-            }
-            if (dr <= r2) {
-                heap.push({dr, far});
-            }
-            if (dl > r2) break;
-            current = near;
+            return Step::Pop;
         }
-    }
+        const std::uint32_t l = node.left();
+        T d[2];
+        pair_distances_squared(nodes + l, p, d);
+        stats.node();
+        stats.node();
+        const bool right_nearer = d[1] < d[0];
+        const std::uint32_t near = l + right_nearer, far = l + !right_nearer;
+        const T dl = d[right_nearer], dr = d[!right_nearer];
+        const T r2 = radius2();
+        // A child within the radius is likely to be opened (now or from the heap): ask for its
+        // children's line, or its leaf's first primitive, before it is needed. Queries jump
+        // around a tree far larger than the caches, so this hides a miss per node.
+        for (int c = 0; c < 2; ++c) {
+            if (d[c] > r2) continue;
+            const auto& child = nodes[l + c];
+            if (child.is_leaf()) {
+                if constexpr (requires { on_slot.prefetch(0u); }) on_slot.prefetch(child.first);
+            } else {
+                __builtin_prefetch(nodes + child.first);
+            }
+        }
+        if (dr <= r2) queue.push({dr, far});
+        if (dl > r2) return Step::Pop;
+        e.node = near;  // the nearer child goes on without a trip through the heap
+        return Step::Continue;
+    });
 }
 
 }  // namespace nearest_detail

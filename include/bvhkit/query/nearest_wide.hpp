@@ -69,56 +69,53 @@ void nearest_wide(const WideSlotBvh<T>& wide, const Vec<T, 3>& p, NearestScratch
     const WideSlotNode<T>* nodes = wide.nodes.data();
     MinHeap4 heap(scratch.heap, [](const NearestEntry<T>& e) { return e.distance_squared; });
     heap.push({T(0), 0});
-    while (!heap.empty()) {
-        const NearestEntry<T> e = heap.pop();
-        if (e.distance_squared > radius2) break;  // every node left is farther still
-        std::uint32_t current = e.node;
-        while (true) {
-            const WideSlotNode<T>& node = nodes[current];
-            T d[4];
-            const unsigned within = wide_detail::children_within(node, p, radius2, d);
-            for (int c = 0; c < 4; ++c)
-                if (node.has(c)) stats.node();
-            const unsigned leaves = wide_detail::leaf_children(node) & within;
-            // Ask for every child within the radius before opening any: the leaves' triangles
-            // and the inner nodes' lines load together instead of one after another. (The lanes'
-            // addresses chosen without jumps, for all four lanes, cost more than the jumps.)
-            for (unsigned m = within; m; m &= m - 1) {
-                const int c = __builtin_ctz(m);
-                std::uintptr_t line;
-                if (!(leaves >> c & 1u))
-                    line = reinterpret_cast<std::uintptr_t>(nodes + node.child[c]);
-                else if constexpr (requires { on_leaf.address(0u); })
-                    line = on_leaf.address(node.child[c]);
-                else
-                    continue;
-                const char* at = reinterpret_cast<const char*>(line);
-                __builtin_prefetch(at);
-                __builtin_prefetch(at + 64);
-                __builtin_prefetch(at + 128);
-            }
-            for (unsigned m = leaves; m; m &= m - 1) {
-                const int c = __builtin_ctz(m);
-                on_leaf(node.child[c], node.groups[c]);
-            }
-            // The nearest inner child within the (perhaps smaller) radius is next; the others wait.
-            unsigned inner = within & ~leaves;
-            if (leaves)
-                for (unsigned m = inner; m; m &= m - 1)
-                    inner &= ~(unsigned(d[__builtin_ctz(m)] > radius2) << __builtin_ctz(m));
-            if (!inner) break;
-            int next = __builtin_ctz(inner);
-            for (unsigned m = inner & (inner - 1); m; m &= m - 1) {
-                const int c = __builtin_ctz(m);
-                next = d[c] < d[next] ? c : next;
-            }
-            for (unsigned m = inner & ~(1u << next); m; m &= m - 1) {
-                const int c = __builtin_ctz(m);
-                heap.push({d[c], node.child[c]});
-            }
-            current = node.child[next];
+    const auto hopeless = [&](T d2) { return d2 > radius2; };  // every node left is farther
+    walk_best_first(heap, hopeless, [&](NearestEntry<T>& e, auto& queue) {
+        const WideSlotNode<T>& node = nodes[e.node];
+        T d[4];
+        const unsigned within = wide_detail::children_within(node, p, radius2, d);
+        for (int c = 0; c < 4; ++c)
+            if (node.has(c)) stats.node();
+        const unsigned leaves = wide_detail::leaf_children(node) & within;
+        // Ask for every child within the radius before opening any: the leaves' triangles
+        // and the inner nodes' lines load together instead of one after another. (The lanes'
+        // addresses chosen without jumps, for all four lanes, cost more than the jumps.)
+        for (unsigned m = within; m; m &= m - 1) {
+            const int c = __builtin_ctz(m);
+            std::uintptr_t line;
+            if (!(leaves >> c & 1u))
+                line = reinterpret_cast<std::uintptr_t>(nodes + node.child[c]);
+            else if constexpr (requires { on_leaf.address(0u); })
+                line = on_leaf.address(node.child[c]);
+            else
+                continue;
+            const char* at = reinterpret_cast<const char*>(line);
+            __builtin_prefetch(at);
+            __builtin_prefetch(at + 64);
+            __builtin_prefetch(at + 128);
         }
-    }
+        for (unsigned m = leaves; m; m &= m - 1) {
+            const int c = __builtin_ctz(m);
+            on_leaf(node.child[c], node.groups[c]);
+        }
+        // The nearest inner child within the (perhaps smaller) radius is next; the others wait.
+        unsigned inner = within & ~leaves;
+        if (leaves)
+            for (unsigned m = inner; m; m &= m - 1)
+                inner &= ~(unsigned(d[__builtin_ctz(m)] > radius2) << __builtin_ctz(m));
+        if (!inner) return Step::Pop;
+        int next = __builtin_ctz(inner);
+        for (unsigned m = inner & (inner - 1); m; m &= m - 1) {
+            const int c = __builtin_ctz(m);
+            next = d[c] < d[next] ? c : next;
+        }
+        for (unsigned m = inner & ~(1u << next); m; m &= m - 1) {
+            const int c = __builtin_ctz(m);
+            queue.push({d[c], node.child[c]});
+        }
+        e.node = node.child[next];
+        return Step::Continue;
+    });
 }
 
 }  // namespace bvhkit

@@ -4,8 +4,9 @@
 // test under a pose, volumes/*.hpp); nothing of B is copied or transformed ahead of time.
 //
 // Iterative with an explicit stack of node pairs, each pushed only after its volumes were found to
-// overlap. Which node of a pair to open is the descent rule (the usual choices of tree-vs-tree
-// collision):
+// overlap. Its own loop, not walk_pairs (bvh/walks.hpp): on that skeleton it took more
+// instructions on OBB and RSS (docs/benchmarks.md, "Walk skeletons"). Which node of a pair to open
+// is the descent rule (the usual choices of tree-vs-tree collision):
 //   Larger        open the node with the larger volume (default; keeps the pair balanced)
 //   A / B         open A's node (B's node) until it is a leaf, then the other
 //   Simultaneous  open both: four child pairs

@@ -4,12 +4,12 @@
 // by construction and are left out; a mesh whose copies of one corner are separate vertices
 // (unwelded) reports its neighbours, so weld it first.
 //
-// The traversal is the tree against itself, in one frame: a node paired with itself opens into its
-// children's self pairs and the pair of its two children; each unordered pair of triangles is
-// tested once.
+// The traversal is walk_pairs (bvh/walks.hpp), the tree against itself, in one frame: a node paired
+// with itself opens into its children's self pairs and the pair of its two children; each unordered
+// pair of triangles is tested once.
 #include <algorithm>
 
-#include "bvhkit/bvh/traversal_stack.hpp"
+#include "bvhkit/bvh/walks.hpp"
 #include "bvhkit/query/pairs_model.hpp"
 
 namespace bvhkit {
@@ -41,27 +41,28 @@ bool self_collide(const CollisionModel<V>& m, std::vector<Contact<typename V::Sc
         stats.node();
         return Traits::overlaps(nodes[x].bounds, nodes[y].bounds);
     };
-    FixedStack<detail::NodePair, detail::pair_stack_size> stack;
-    stack.push({0, 0});
-    while (!stack.empty()) {
-        const detail::NodePair p = stack.pop();
+    const auto on_leaves = [&](const detail::NodePair& p) {
         const auto& na = nodes[p.a];
         const auto& nb = nodes[p.b];
         if (p.a == p.b) {
-            if (na.is_leaf()) {
-                for (std::uint32_t s = na.first; s < na.first + na.count; ++s)
-                    for (std::uint32_t t = s + 1; t < na.first + na.count; ++t) test(s, t);
-            } else {
-                stack.push({na.left(), na.left()});
-                stack.push({na.right(), na.right()});
-                if (overlap(na.left(), na.right())) stack.push({na.left(), na.right()});
-            }
-            continue;
-        }
-        if (na.is_leaf() && nb.is_leaf()) {
+            for (std::uint32_t s = na.first; s < na.first + na.count; ++s)
+                for (std::uint32_t t = s + 1; t < na.first + na.count; ++t) test(s, t);
+        } else {
             for (std::uint32_t s = na.first; s < na.first + na.count; ++s)
                 for (std::uint32_t t = nb.first; t < nb.first + nb.count; ++t) test(s, t);
-            continue;
+        }
+        return true;
+    };
+    // The descent rule: a node with itself opens into its children's self pairs and the pair of
+    // its two children; another pair opens its larger node (never a leaf).
+    const auto open = [&](const detail::NodePair& p, auto& stack) {
+        const auto& na = nodes[p.a];
+        const auto& nb = nodes[p.b];
+        if (p.a == p.b) {
+            stack.push({na.left(), na.left()});
+            stack.push({na.right(), na.right()});
+            if (overlap(na.left(), na.right())) stack.push({na.left(), na.right()});
+            return;
         }
         const bool open_a =
             nb.is_leaf() || (!na.is_leaf() && Traits::size(na.bounds) >= Traits::size(nb.bounds));
@@ -72,7 +73,10 @@ bool self_collide(const CollisionModel<V>& m, std::vector<Contact<typename V::Sc
             if (overlap(p.a, nb.left())) stack.push({p.a, nb.left()});
             if (overlap(p.a, nb.right())) stack.push({p.a, nb.right()});
         }
-    }
+    };
+    FixedStack<detail::NodePair, detail::pair_stack_size> pairs;
+    const BvhNodes<BvhNode<V>> view{nodes.data()};
+    walk_pairs(view, view, pairs, detail::NodePair{0, 0}, EnterAll{}, on_leaves, open);
     std::sort(contacts.begin(), contacts.end(), [](const auto& x, const auto& y) {
         return x.triangle_a != y.triangle_a ? x.triangle_a < y.triangle_a
                                             : x.triangle_b < y.triangle_b;

@@ -223,14 +223,9 @@ class WindingNumberMesh {
         if (!is_finite(qw)) return std::numeric_limits<T>::quiet_NaN();
         const W beta2 = W(beta) * W(beta);
         W sum = 0;
-        // Its own walk, not traverse_depth_first (bvh/traverse.hpp): that one, entering the right
-        // child first so the sum keeps its order, took more instructions. Both children are
-        // pushed, so the stack holds one more than the depth.
-        FixedStack<std::uint32_t, max_bvh_depth + 1> stack;
-        stack.push(0);
-        while (!stack.empty()) {
-            const std::uint32_t k = stack.pop();
-            const auto& node = bvh_.nodes[k];
+        // Depth first, the right child first (the order the sum has always been taken in): a
+        // node far enough for its expansion is summed and not entered.
+        const auto enter = [&](std::uint32_t k) {
             const Dipole& d = dipoles_[k];
             const Vec<T, 3> r = d.centre - q;
             const T rr = length_squared(r);
@@ -241,21 +236,23 @@ class WindingNumberMesh {
                 if (dist > beta * d.radius) {
                     const W inv_dist = W(1) / W(dist);
                     sum += expansion(d, Vec<W, 3>(r) * inv_dist, d.scale * inv_dist, order);
-                    continue;
+                    return false;
                 }
             } else if (far_in_scale_units(d, qw, beta2, order, sum)) {
-                continue;
+                return false;
             }
-            if (node.is_leaf()) {
-                for (const LeafSlot s : leaf_slots(node)) {  // tris_ is in leaf order
-                    const Triangle<T>& t = tris_[s.value];
-                    sum += W(solid_angle(t.p0, t.p1, t.p2, q));
-                }
-                continue;
+            return true;
+        };
+        const auto on_leaf = [&](std::uint32_t k) {
+            for (const LeafSlot s : leaf_slots(bvh_.nodes[k])) {  // tris_ is in leaf order
+                const Triangle<T>& t = tris_[s.value];
+                sum += W(solid_angle(t.p0, t.p1, t.p2, q));
             }
-            stack.push(node.left());
-            stack.push(node.right());
-        }
+            return true;
+        };
+        TraversalStack stack;
+        walk_depth_first(BvhNodes<BvhNode<Aabb<T, 3>>>{bvh_.nodes.data()}, stack, enter, on_leaf,
+                         FirstChild::Right);
         return T(sum / (4 * std::numbers::pi));
     }
 

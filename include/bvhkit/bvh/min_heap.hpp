@@ -1,5 +1,5 @@
 #pragma once
-// A 4-ary min-heap over a caller's vector, for the best-first walks (nearest.hpp, distance.hpp).
+// A 4-ary min-heap over a caller's vector: the heap of the best-first walk (bvh/walks.hpp).
 // Against std::push_heap/pop_heap on a binary heap it halves the levels a pop sifts through, and
 // the least of four children is found with selects rather than jumps: the comparisons of a
 // best-first walk are unpredictable, and their mispredictions were the largest single cost of a
@@ -21,6 +21,8 @@ class MinHeap4 {
 
     bool empty() const { return v_.empty(); }
     const Entry& top() const { return v_.front(); }
+    /// The value an entry is ordered by.
+    auto key(const Entry& e) const { return key_(e); }
 
     void push(const Entry& e) {
         std::size_t i = v_.size();
