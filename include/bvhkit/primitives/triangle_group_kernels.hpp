@@ -32,6 +32,7 @@ template <int W, class OnHit>
     // Indices in size_t: row + axis cannot wrap, so the compiler folds the row into the address
     // (with uint32_t it computed and shifted each of the nine indices on every pass).
     const std::size_t kx = s.kx, ky = s.ky, kz = s.kz;
+#pragma GCC unroll 3
     for (std::size_t k = 0; k < 3; ++k) {
         const std::size_t row = 3 * k;
         z[k] = F::load(g.corner[row + kz]) - r.oz;
@@ -39,15 +40,18 @@ template <int W, class OnHit>
         y[k] = (F::load(g.corner[row + ky]) - r.oy) - r.sy * z[k];
     }
     // The edge functions eu = cx by - cy bx, ev = ax cy - ay cx, ew = bx ay - by ax in float: a
-    // lane with one strictly below zero and one strictly above misses (an exact sign).
+    // lane with one strictly below zero and one strictly above misses (an exact sign). Written
+    // out: over a table of operands the compiler kept x and y in memory.
     const F zero = F::zero();
     simd::Mask<W> negative = simd::Mask<W>::none(), positive = negative;
-    constexpr int edge[3][4] = {{2, 1, 2, 1}, {0, 2, 0, 2}, {1, 0, 1, 0}};
-    for (const auto& e : edge) {
-        const F f = x[e[0]] * y[e[1]] - y[e[2]] * x[e[3]];
+    const auto edge = [&](F x0, F y1, F y0, F x1) {
+        const F f = x0 * y1 - y0 * x1;
         negative = negative | (f < zero);
         positive = positive | (f > zero);
-    }
+    };
+    edge(x[2], y[1], y[2], x[1]);
+    edge(x[0], y[2], y[0], x[2]);
+    edge(x[1], y[0], y[1], x[0]);
     const simd::Mask<W> pad = simd::Int<W>::load(g.slot) == simd::Int<W>(-1);
     unsigned live = ~((negative & positive) | pad).bits() & ((1u << W) - 1);
     if (live == 0) return;
