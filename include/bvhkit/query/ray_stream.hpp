@@ -88,49 +88,24 @@ template <bool AnyHit, class Start, class Finish>
         for (int j = 0; j < stream_width; ++j) {
             StreamRay& s = slots[j];
             if (!s.live) continue;
-            if (s.current.groups == 0) {
-                const RayNode<8>& node = nodes[s.current.child];
-                using F = simd::Float<8>;
-                F origin[3], inv[3], inv_far[3];
-                for (int a = 0; a < 3; ++a) {
-                    origin[a] = F(s.k.origin[a]);
-                    inv[a] = F(s.k.inv[a]);
-                    inv_far[a] = F(s.k.inv_far[a]);
-                }
-                F entry(s.ray.tmin);
-                const simd::Mask<8> hit = avx2::clip<8>(node, origin, inv, inv_far, s.k.near,
-                                                        s.k.far, entry, F(s.ray.tmax));
-                const unsigned mask = hit.bits();
-                if (mask != 0) {
-                    // The push asks for the next entry's first three lines; the others here.
-                    if constexpr (AnyHit)
-                        push_in_lane_order8(entry, mask, node, s.current, s.stack, s.size, line);
-                    else
-                        push_nearest_first8(entry, hit, mask, node, s.current, s.stack, s.size,
-                                            line);
-                    ask(s.current, 3);
-                    continue;
-                }
+            // The walk's step with the slot's ray; a push asks for the next entry's first three
+            // lines, the rest of them here, and a pop for all of them.
+            const avx2::WalkRay<8> r(s.k);
+            simd::Float<8> tmax(s.ray.tmax);
+            const auto pushed = [&] { ask(s.current, 3); };
+            const auto popped = [&] { ask(s.current, 0); };
+            bool going;
+            if constexpr (AnyHit) {
+                avx2::AnyLeaves<8, NoStats> leaves{groups, s.prep, s.ray, s.found, stats};
+                going = avx2::step(nodes, r, s.k, s.ray, simd::Float<8>(s.ray.tmin), tmax,
+                                   s.current, s.stack, s.size, leaves, stats, line, pushed, popped);
             } else {
-                bool stop;
-                if constexpr (AnyHit) {
-                    avx2::AnyLeaves<8, NoStats> leaves{groups, s.prep, s.ray, s.found, stats};
-                    stop = leaves(s.current.child, s.current.groups);
-                } else {
-                    avx2::ClosestLeaves<8, NoStats> leaves{groups,      s.prep,     s.ray, s.best,
-                                                           s.hit_group, s.hit_lane, stats};
-                    stop = leaves(s.current.child, s.current.groups);
-                }
-                if (stop) {
-                    finish(s);
-                    live -= !begin(s);
-                    continue;
-                }
+                avx2::ClosestLeaves<8, NoStats> leaves{groups,      s.prep,     s.ray, s.best,
+                                                       s.hit_group, s.hit_lane, stats};
+                going = avx2::step(nodes, r, s.k, s.ray, simd::Float<8>(s.ray.tmin), tmax,
+                                   s.current, s.stack, s.size, leaves, stats, line, pushed, popped);
             }
-            if (pop(s.stack, s.size, s.ray.tmax, s.current)) {
-                ask(s.current, 0);
-                continue;
-            }
+            if (going) continue;
             finish(s);
             live -= !begin(s);
         }

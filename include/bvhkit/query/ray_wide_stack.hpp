@@ -289,7 +289,6 @@ BVHKIT_SIMD_INLINE_AVX2 void push_hits(simd::Float<8> entry, simd::Mask<8> hit, 
         push_in_lane_order8(entry, mask, node, current, stack, size, line);
     else
         push_nearest_first8(entry, hit, mask, node, current, stack, size, line);
-    ask_for_top8(stack, size, line);
 }
 
 /// pop for the eight-wide walks' stack.

@@ -4,8 +4,8 @@
 // The wide walk, written once for W = 4 (detail::sse2) and W = 8 (detail::avx2): a node's clip,
 // the push of its hit children (query/ray_wide_stack.hpp), the leaves' triangle tests
 // (primitives/triangle_group_kernels.hpp) and the pop. The streams of query/ray_stream.hpp and
-// query/ray_octant_stream.hpp take the same steps (clip_axis, clip, push_hits, the leaf tests), so
-// that all of them round alike.
+// query/ray_octant_stream.hpp take the same steps (the stream calls step; the octant stream clips
+// with clip_axis and tests leaves with intersect_watertight), so that all of them round alike.
 
 namespace bvhkit::detail::BVHKIT_SIMD_ISA {
 
@@ -99,44 +99,70 @@ struct AnyLeaves {
     }
 };
 
-/// The walk of `tree` for `ray`: calls on_leaf(first_group, groups) at each leaf it reaches, until
-/// on_leaf returns true or the stack holds nothing the ray can still reach.
+/// A ray's slab constants in every lane: made once for a one-ray walk, once a step in a stream.
+template <int W>
+struct WalkRay {
+    simd::Float<W> origin[3], inv[3], inv_far[3];
+
+    [[gnu::always_inline]] explicit WalkRay(const SlabConstants& k) {
+        for (int a = 0; a < 3; ++a) {
+            origin[a] = simd::Float<W>(k.origin[a]);
+            inv[a] = simd::Float<W>(k.inv[a]);
+            inv_far[a] = simd::Float<W>(k.inv_far[a]);
+        }
+    }
+};
+
+/// One step of the walk from `current`, the step both the one-ray walk and the streams take: a
+/// node's clip and the push of its hit children (then after_push()), or a leaf's tests
+/// (on_leaf(first_group, groups), which may shrink ray.tmax and returns true to stop) and a pop
+/// (then after_pop()). `tmax` holds ray.tmax in every lane, and is renewed after a leaf. Returns
+/// false when the walk is over: a leaf stopped it, or nothing the ray can reach is left.
+template <int W, class OnLeaf, class Stats, class Line, class AfterPush, class AfterPop>
+[[gnu::always_inline]] inline bool step(const RayNode<W>* nodes, const WalkRay<W>& r,
+                                        const SlabConstants& k, Ray<float, 3>& ray,
+                                        simd::Float<W> tmin, simd::Float<W>& tmax,
+                                        WideEntry& current, WideStack<W>& stack,
+                                        std::uint32_t& size, OnLeaf& on_leaf, Stats& stats,
+                                        Line&& line, AfterPush&& after_push, AfterPop&& after_pop) {
+    if (current.groups == 0) {
+        const RayNode<W>& node = nodes[current.child];
+        for (std::uint32_t c : node.child)  // boxes measured, as the binary walk counts
+            if (c != invalid_index) stats.node();
+        simd::Float<W> entry = tmin;
+        const simd::Mask<W> hit =
+            clip<W>(node, r.origin, r.inv, r.inv_far, k.near, k.far, entry, tmax);
+        const unsigned mask = hit.bits();
+        if (mask != 0) {
+            push_hits<OnLeaf::any_hit>(entry, hit, mask, node, current, stack, size, line);
+            after_push();
+            return true;
+        }
+    } else {
+        if (on_leaf(current.child, current.groups)) return false;
+        tmax = simd::Float<W>(ray.tmax);
+    }
+    if (!pop(stack, size, ray.tmax, current)) return false;
+    after_pop();
+    return true;
+}
+
+/// The walk of `tree` for `ray`: steps until the walk is over. After each push and pop it asks
+/// for the line of the entry on top of the stack (ask_for_top).
 template <int W, class OnLeaf, class Stats>
 void walk(WideRayView<W> tree, Ray<float, 3>& ray, const SlabConstants& k, WideStack<W>& stack,
           OnLeaf& on_leaf, Stats& stats) {
-    using F = simd::Float<W>;
-    F origin[3], inv[3], inv_far[3];
-    for (int a = 0; a < 3; ++a) {
-        origin[a] = F(k.origin[a]);
-        inv[a] = F(k.inv[a]);
-        inv_far[a] = F(k.inv_far[a]);
-    }
+    const WalkRay<W> r(k);
     const RayNode<W>* nodes = tree.nodes.data();
     const auto* groups = tree.groups.data();
     const auto line = [&](const WideEntry& e) { return entry_address(nodes, groups, e); };
     std::uint32_t size = 0;
     WideEntry current{0, 0, ray.tmin};
-    const F tmin(ray.tmin);
-    F tmax(ray.tmax);
-    while (true) {
-        if (current.groups == 0) {
-            const RayNode<W>& node = nodes[current.child];
-            for (std::uint32_t c : node.child)  // boxes measured, as the binary walk counts
-                if (c != invalid_index) stats.node();
-            F entry = tmin;
-            const simd::Mask<W> hit =
-                clip<W>(node, origin, inv, inv_far, k.near, k.far, entry, tmax);
-            const unsigned mask = hit.bits();
-            if (mask != 0) {
-                push_hits<OnLeaf::any_hit>(entry, hit, mask, node, current, stack, size, line);
-                continue;
-            }
-        } else {
-            if (on_leaf(current.child, current.groups)) return;
-            tmax = F(ray.tmax);
-        }
-        if (!pop(stack, size, ray.tmax, current)) return;
-        ask_for_top(stack, size, line);
+    const simd::Float<W> tmin(ray.tmin);
+    simd::Float<W> tmax(ray.tmax);
+    const auto ask = [&] { ask_for_top(stack, size, line); };
+    while (
+        step(nodes, r, k, ray, tmin, tmax, current, stack, size, on_leaf, stats, line, ask, ask)) {
     }
 }
 
