@@ -83,6 +83,15 @@ BVHKIT_SIMD_INLINE Float<4> min(Float<4> a, Float<4> b) {
 BVHKIT_SIMD_INLINE Float<4> max(Float<4> a, Float<4> b) {
     return Float<4>(_mm_max_ps(a.r, b.r));
 }
+/// -a: the sign bit flipped.
+BVHKIT_SIMD_INLINE Float<4> operator-(Float<4> a) {
+    return Float<4>(_mm_xor_ps(a.r, _mm_set1_ps(-0.0f)));
+}
+/// (a[I0], a[I1], b[I2], b[I3]).
+template <int I0, int I1, int I2, int I3>
+BVHKIT_SIMD_INLINE Float<4> shuffle(Float<4> a, Float<4> b) {
+    return Float<4>(_mm_shuffle_ps(a.r, b.r, _MM_SHUFFLE(I3, I2, I1, I0)));
+}
 /// |a|: the sign bit cleared.
 BVHKIT_SIMD_INLINE Float<4> abs(Float<4> a) {
     return Float<4>(_mm_andnot_ps(_mm_set1_ps(-0.0f), a.r));
