@@ -31,6 +31,7 @@ struct Float<4> {
     /// From 16-byte aligned memory.
     BVHKIT_SIMD_INLINE static Float load(const float* p) { return Float(_mm_load_ps(p)); }
     BVHKIT_SIMD_INLINE void store(float* p) const { _mm_store_ps(p, r); }
+    BVHKIT_SIMD_INLINE void store_unaligned(float* p) const { _mm_storeu_ps(p, r); }
     BVHKIT_SIMD_INLINE float first() const { return _mm_cvtss_f32(r); }
     /// Lanes (I0, I1, I2, I3) of this one.
     template <int I0, int I1, int I2, int I3>
