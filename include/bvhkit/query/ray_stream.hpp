@@ -90,20 +90,19 @@ template <bool AnyHit, class Start, class Finish>
             if (!s.live) continue;
             // The walk's step with the slot's ray; a push asks for the next entry's first three
             // lines, the rest of them here, and a pop for all of them.
-            const avx2::WalkRay<8> r(s.k);
-            simd::Float<8> tmax(s.ray.tmax);
+            avx2::FreshRegisters<8> registers{s.k, s.ray};
             const auto pushed = [&] { ask(s.current, 3); };
             const auto popped = [&] { ask(s.current, 0); };
             bool going;
             if constexpr (AnyHit) {
                 avx2::AnyLeaves<8, NoStats> leaves{groups, s.prep, s.ray, s.found, stats};
-                going = avx2::step(nodes, r, s.k, s.ray, simd::Float<8>(s.ray.tmin), tmax,
-                                   s.current, s.stack, s.size, leaves, stats, line, pushed, popped);
+                going = avx2::step(nodes, registers, s.k, s.ray, s.current, s.stack, s.size, leaves,
+                                   stats, line, pushed, popped);
             } else {
                 avx2::ClosestLeaves<8, NoStats> leaves{groups,      s.prep,     s.ray, s.best,
                                                        s.hit_group, s.hit_lane, stats};
-                going = avx2::step(nodes, r, s.k, s.ray, simd::Float<8>(s.ray.tmin), tmax,
-                                   s.current, s.stack, s.size, leaves, stats, line, pushed, popped);
+                going = avx2::step(nodes, registers, s.k, s.ray, s.current, s.stack, s.size, leaves,
+                                   stats, line, pushed, popped);
             }
             if (going) continue;
             finish(s);

@@ -113,15 +113,44 @@ struct WalkRay {
     }
 };
 
+/// The ray's registers in a one-ray walk: broadcast once, tmax again after each leaf.
+template <int W>
+struct HeldRegisters {
+    const Ray<float, 3>& ray;
+    WalkRay<W> constants;
+    simd::Float<W> tmin, tmax;
+
+    [[gnu::always_inline]] HeldRegisters(const SlabConstants& k, const Ray<float, 3>& r)
+        : ray(r), constants(k), tmin(r.tmin), tmax(r.tmax) {}
+    [[gnu::always_inline]] const WalkRay<W>& slab() const { return constants; }
+    [[gnu::always_inline]] simd::Float<W> entry() const { return tmin; }
+    [[gnu::always_inline]] simd::Float<W> exit() const { return tmax; }
+    [[gnu::always_inline]] void after_leaf() { tmax = simd::Float<W>(ray.tmax); }
+};
+
+/// The registers of a ray in a stream: broadcast at each node, since a stream keeps nothing in
+/// registers between one ray's steps.
+template <int W>
+struct FreshRegisters {
+    const SlabConstants& k;
+    const Ray<float, 3>& ray;
+
+    [[gnu::always_inline]] WalkRay<W> slab() const { return WalkRay<W>(k); }
+    [[gnu::always_inline]] simd::Float<W> entry() const { return simd::Float<W>(ray.tmin); }
+    [[gnu::always_inline]] simd::Float<W> exit() const { return simd::Float<W>(ray.tmax); }
+    [[gnu::always_inline]] void after_leaf() {}
+};
+
 /// One step of the walk from `current`, the step both the one-ray walk and the streams take: a
 /// node's clip and the push of its hit children (then after_push()), or a leaf's tests
 /// (on_leaf(first_group, groups), which may shrink ray.tmax and returns true to stop) and a pop
-/// (then after_pop()). `tmax` holds ray.tmax in every lane, and is renewed after a leaf. Returns
-/// false when the walk is over: a leaf stopped it, or nothing the ray can reach is left.
-template <int W, class OnLeaf, class Stats, class Line, class AfterPush, class AfterPop>
-[[gnu::always_inline]] inline bool step(const RayNode<W>* nodes, const WalkRay<W>& r,
-                                        const SlabConstants& k, Ray<float, 3>& ray,
-                                        simd::Float<W> tmin, simd::Float<W>& tmax,
+/// (then after_pop()). `registers` (HeldRegisters or FreshRegisters) gives the ray's constants
+/// and its [tmin, tmax] in every lane. Returns false when the walk is over: a leaf stopped it, or
+/// nothing the ray can reach is left.
+template <int W, class Registers, class OnLeaf, class Stats, class Line, class AfterPush,
+          class AfterPop>
+[[gnu::always_inline]] inline bool step(const RayNode<W>* nodes, Registers& registers,
+                                        const SlabConstants& k, const Ray<float, 3>& ray,
                                         WideEntry& current, WideStack<W>& stack,
                                         std::uint32_t& size, OnLeaf& on_leaf, Stats& stats,
                                         Line&& line, AfterPush&& after_push, AfterPop&& after_pop) {
@@ -129,9 +158,10 @@ template <int W, class OnLeaf, class Stats, class Line, class AfterPush, class A
         const RayNode<W>& node = nodes[current.child];
         for (std::uint32_t c : node.child)  // boxes measured, as the binary walk counts
             if (c != invalid_index) stats.node();
-        simd::Float<W> entry = tmin;
+        const auto& r = registers.slab();
+        simd::Float<W> entry = registers.entry();
         const simd::Mask<W> hit =
-            clip<W>(node, r.origin, r.inv, r.inv_far, k.near, k.far, entry, tmax);
+            clip<W>(node, r.origin, r.inv, r.inv_far, k.near, k.far, entry, registers.exit());
         const unsigned mask = hit.bits();
         if (mask != 0) {
             push_hits<OnLeaf::any_hit>(entry, hit, mask, node, current, stack, size, line);
@@ -140,7 +170,7 @@ template <int W, class OnLeaf, class Stats, class Line, class AfterPush, class A
         }
     } else {
         if (on_leaf(current.child, current.groups)) return false;
-        tmax = simd::Float<W>(ray.tmax);
+        registers.after_leaf();
     }
     if (!pop(stack, size, ray.tmax, current)) return false;
     after_pop();
@@ -152,17 +182,14 @@ template <int W, class OnLeaf, class Stats, class Line, class AfterPush, class A
 template <int W, class OnLeaf, class Stats>
 void walk(WideRayView<W> tree, Ray<float, 3>& ray, const SlabConstants& k, WideStack<W>& stack,
           OnLeaf& on_leaf, Stats& stats) {
-    const WalkRay<W> r(k);
+    HeldRegisters<W> registers(k, ray);
     const RayNode<W>* nodes = tree.nodes.data();
     const auto* groups = tree.groups.data();
     const auto line = [&](const WideEntry& e) { return entry_address(nodes, groups, e); };
     std::uint32_t size = 0;
     WideEntry current{0, 0, ray.tmin};
-    const simd::Float<W> tmin(ray.tmin);
-    simd::Float<W> tmax(ray.tmax);
     const auto ask = [&] { ask_for_top(stack, size, line); };
-    while (
-        step(nodes, r, k, ray, tmin, tmax, current, stack, size, on_leaf, stats, line, ask, ask)) {
+    while (step(nodes, registers, k, ray, current, stack, size, on_leaf, stats, line, ask, ask)) {
     }
 }
 
