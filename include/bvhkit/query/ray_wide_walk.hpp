@@ -61,7 +61,7 @@ struct ClosestLeaves {
             return h.t;
         };
     }
-    [[gnu::always_inline]] bool operator()(std::uint32_t first, std::uint32_t count) {
+    bool operator()(std::uint32_t first, std::uint32_t count) {
         const WatertightRayLanes<Group::lanes> lanes(prep);
         for (std::uint32_t g = first; g < first + count; ++g) {
             count_lanes(groups[g], stats);
@@ -88,7 +88,7 @@ struct AnyLeaves {
             return h.t;
         };
     }
-    [[gnu::always_inline]] bool operator()(std::uint32_t first, std::uint32_t count) {
+    bool operator()(std::uint32_t first, std::uint32_t count) {
         const WatertightRayLanes<Group::lanes> lanes(prep);
         for (std::uint32_t g = first; g < first + count && !found; ++g) {
             count_lanes(groups[g], stats);
