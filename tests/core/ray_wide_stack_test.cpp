@@ -23,8 +23,10 @@ using namespace bvhkit;
 namespace {
 
 [[gnu::target("avx2")]] void network_sort(const std::int32_t* in, std::int32_t* out) {
-    const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), detail::sort8_descending(v));
+    alignas(32) std::uint32_t v[8];
+    std::copy(in, in + 8, v);
+    detail::sort8_descending(simd::Int<8>::load(v)).store(v);
+    std::copy(v, v + 8, out);
 }
 
 /// Where the pushes ask for lines: anywhere readable (the entries' own addresses are not).
@@ -36,18 +38,18 @@ const char* no_line(const detail::WideEntry&) {
 [[gnu::target("avx2")]] void push_nearest(const float* entry, unsigned mask, const RayNode<8>& node,
                                           detail::WideEntry& current, detail::WideStack8& stack,
                                           std::uint32_t& size) {
-    alignas(32) std::int32_t hit[8];
-    for (int c = 0; c < 8; ++c) hit[c] = (mask >> c) & 1u ? -1 : 0;
-    detail::push_nearest_first8(
-        _mm256_loadu_ps(entry),
-        _mm256_castsi256_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(hit))), mask, node,
-        current, stack, size, no_line);
+    alignas(32) std::uint32_t hit[8];
+    for (int c = 0; c < 8; ++c) hit[c] = (mask >> c) & 1u;
+    detail::push_nearest_first8(simd::Float<8>::load_unaligned(entry),
+                                simd::Int<8>::load(hit) == simd::Int<8>(1), mask, node, current,
+                                stack, size, no_line);
 }
 
 [[gnu::target("avx2")]] void push_lane_order(const float* entry, unsigned mask,
                                              const RayNode<8>& node, detail::WideEntry& current,
                                              detail::WideStack8& stack, std::uint32_t& size) {
-    detail::push_in_lane_order8(_mm256_loadu_ps(entry), mask, node, current, stack, size, no_line);
+    detail::push_in_lane_order8(simd::Float<8>::load_unaligned(entry), mask, node, current, stack,
+                                size, no_line);
 }
 
 void expect_sorted_by_network(std::vector<std::int32_t> keys) {

@@ -437,11 +437,13 @@ TEST(WideRays, RefitWithANonFiniteVertexIsAnError) {
                                         float tmin, float tmax, bool (&got)[8],
                                         TriangleHit<float> (&hit)[8]) {
     const float open = tmax;
-    intersect_watertight8(prep, g, tmin, tmax, [&](int lane, const TriangleHit<float>& h) {
-        got[lane] = true;
-        hit[lane] = h;
-        return open;  // keep the whole range open
-    });
+    const detail::avx2::WatertightRayLanes<8> lanes(prep);
+    detail::avx2::intersect_watertight(lanes, g, tmin, tmax,
+                                       [&](int lane, const TriangleHit<float>& h) {
+                                           got[lane] = true;
+                                           hit[lane] = h;
+                                           return open;  // keep the whole range open
+                                       });
 }
 #endif
 
@@ -481,12 +483,13 @@ TEST(WideRays, FourAbreastTestEqualsTheScalarTest) {
         bool got[4] = {}, want[4] = {};
         TriangleHit<float> got_hit[4], want_hit[4];
         float tmax = ray.tmax;
-        intersect_watertight4(WatertightRay4(prep), group, ray.tmin, tmax,
-                              [&](int lane, const TriangleHit<float>& h) {
-                                  got[lane] = true;
-                                  got_hit[lane] = h;
-                                  return ray.tmax;  // keep the whole range open
-                              });
+        detail::sse2::intersect_watertight(detail::sse2::WatertightRayLanes<4>(prep), group,
+                                           ray.tmin, tmax,
+                                           [&](int lane, const TriangleHit<float>& h) {
+                                               got[lane] = true;
+                                               got_hit[lane] = h;
+                                               return ray.tmax;  // keep the whole range open
+                                           });
         for (int lane = 0; lane < 4; ++lane) {
             if (group.slot[lane] == invalid_index) continue;
             want[lane] = intersect_watertight(prep, tris[lane].p0, tris[lane].p1, tris[lane].p2,

@@ -17,10 +17,7 @@
 
 #include "bvhkit/math/select.hpp"
 #include "bvhkit/primitives/triangle.hpp"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "bvhkit/simd/simd.hpp"
 
 namespace bvhkit {
 
@@ -38,51 +35,17 @@ inline T ratio01(T n, T d) {
     return n > T(0) ? (n < d ? n / d : T(1)) : T(0);
 }
 
-#if defined(__SSE2__)
-/// Four float lanes, so the distance below is written once for SSE and scalars.
-struct F4 {
-    __m128 v;
-    F4() = default;
-    F4(__m128 x) : v(x) {}
-    F4(float s) : v(_mm_set1_ps(s)) {}
-};
-struct Mask4 {
-    __m128 v;
-};
-inline F4 operator+(F4 a, F4 b) {
-    return _mm_add_ps(a.v, b.v);
-}
-inline F4 operator-(F4 a, F4 b) {
-    return _mm_sub_ps(a.v, b.v);
-}
-inline F4 operator*(F4 a, F4 b) {
-    return _mm_mul_ps(a.v, b.v);
-}
-inline F4 operator/(F4 a, F4 b) {
-    return _mm_div_ps(a.v, b.v);
-}
-inline Mask4 operator>(F4 a, F4 b) {
-    return {_mm_cmpgt_ps(a.v, b.v)};
-}
-inline Mask4 operator>=(F4 a, F4 b) {
-    return {_mm_cmpge_ps(a.v, b.v)};
-}
-inline Mask4 operator<=(F4 a, F4 b) {
-    return {_mm_cmple_ps(a.v, b.v)};
-}
-inline Mask4 operator&(Mask4 a, Mask4 b) {
-    return {_mm_and_ps(a.v, b.v)};
-}
+#if BVHKIT_SIMD
+/// Four float lanes, so the distance below is written once for SSE and scalars (the SIMD layer's
+/// operators, compares and select, and these).
+using F4 = simd::Float<4>;
 // As std::min / std::max: (b < a ? b : a), minps giving its first operand when the test holds.
 inline F4 min_of(F4 a, F4 b) {
-    return _mm_min_ps(b.v, a.v);
-}
-inline F4 select(Mask4 m, F4 a, F4 b) {
-    return _mm_or_ps(_mm_and_ps(m.v, a.v), _mm_andnot_ps(m.v, b.v));
+    return min(b, a);
 }
 inline F4 ratio01(F4 n, F4 d) {
     // 0 / 0 is NaN, and maxps gives its second operand (0 here) when the first is NaN.
-    return _mm_min_ps(_mm_max_ps(_mm_div_ps(n.v, d.v), _mm_setzero_ps()), _mm_set1_ps(1.0f));
+    return min(max(n / d, F4::zero()), F4(1.0f));
 }
 #endif
 
@@ -208,24 +171,23 @@ struct alignas(16) TrianglePack4 {
     /// the lanes in exact_lanes).
     unsigned lanes_within(const Vec<T, 3>& p, T bound, T (&d)[4]) const {
         const unsigned used = used_lanes();
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
         if constexpr (std::is_same_v<T, float>) {
             using pack_detail::F4;
             F4 a[3], b[3], q[3];
             pack_detail::TriangleTerms<F4> k;
             for (int i = 0; i < 3; ++i) {
-                a[i] = _mm_load_ps(corner[0][i]), b[i] = _mm_load_ps(corner[1][i]);
+                a[i] = F4::load(corner[0][i]), b[i] = F4::load(corner[1][i]);
                 q[i] = F4(p[i]);
-                k.ab[i] = _mm_load_ps(vector[i]), k.ac[i] = _mm_load_ps(vector[3 + i]);
-                k.bc[i] = _mm_load_ps(vector[6 + i]), k.n[i] = _mm_load_ps(vector[9 + i]);
+                k.ab[i] = F4::load(vector[i]), k.ac[i] = F4::load(vector[3 + i]);
+                k.bc[i] = F4::load(vector[6 + i]), k.n[i] = F4::load(vector[9 + i]);
             }
-            k.aa = _mm_load_ps(scalar[0]), k.cc = _mm_load_ps(scalar[1]);
-            k.ac_ab = _mm_load_ps(scalar[2]), k.bc_bc = _mm_load_ps(scalar[3]);
-            k.det = _mm_load_ps(scalar[4]), k.nn = _mm_load_ps(scalar[5]);
+            k.aa = F4::load(scalar[0]), k.cc = F4::load(scalar[1]);
+            k.ac_ab = F4::load(scalar[2]), k.bc_bc = F4::load(scalar[3]);
+            k.det = F4::load(scalar[4]), k.nn = F4::load(scalar[5]);
             const F4 dist = pack_detail::triangle_distance_squared(a, b, k, q);
-            _mm_storeu_ps(d, dist.v);
-            const unsigned near =
-                unsigned(_mm_movemask_ps(_mm_cmple_ps(dist.v, _mm_set1_ps(bound))));
+            dist.store_unaligned(d);
+            const unsigned near = (dist <= F4(bound)).bits();
             return (near | exact_lanes) & used;
         }
 #endif

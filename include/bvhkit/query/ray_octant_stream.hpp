@@ -11,7 +11,8 @@
 // ray-stream traversal of Tsakok 2009 and Fuetterling et al. 2015, with incoherent rays sorted
 // by octant as Embree's stream calls do).
 //
-// Each ray's clip is clip8's arithmetic, lane for lane, and its leaf tests are walk8's: a ray
+// Each ray's clip is the eight-wide walk's arithmetic (clip_axis), lane for lane, and its leaf
+// tests are the walk's: a ray
 // reaches a leaf here exactly when the one-ray walk, not stopping early, would, so the any-hit
 // answer is the one-ray call's. Design in docs/rays.md ("Occlusion in octant streams"), figures in
 // docs/benchmarks.md.
@@ -93,47 +94,40 @@ template <class Blocked>
     while (true) {
         if (current.groups == 0) {
             const RayNode<8>& node = nodes[current.child];
-            __m256 near_planes[3], far_planes[3];
+            using F = simd::Float<8>;
+            using I = simd::Int<8>;
+            F near_planes[3], far_planes[3];
             for (int a = 0; a < 3; ++a) {
-                near_planes[a] = _mm256_load_ps(node.lo[near[a]]);
-                far_planes[a] = _mm256_load_ps(node.lo[far[a]]);
+                near_planes[a] = F::load(node.lo[near[a]]);
+                far_planes[a] = F::load(node.lo[far[a]]);
             }
             // Lane c: the rays that hit child c.
-            __m256i rays_of = _mm256_setzero_si256();
+            I rays_of = I::zero();
             for (std::uint32_t m = current.rays; m; m &= m - 1) {
                 const int r = __builtin_ctz(m);
-                __m256 t0 = _mm256_set1_ps(s.tmin[r]), t1 = _mm256_set1_ps(s.tmax[r]);
-                for (int a = 0; a < 3; ++a)  // clip8's clip, for this ray
-                    clip_axis8(near_planes[a], far_planes[a], _mm256_set1_ps(s.origin[a][r]),
-                               _mm256_set1_ps(s.inv[a][r]), _mm256_set1_ps(s.inv_far[a][r]), t0,
-                               t1);
-                const __m256i hit = _mm256_castps_si256(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
-                rays_of = _mm256_or_si256(rays_of,
-                                          _mm256_and_si256(hit, _mm256_set1_epi32(int(1u << r))));
+                F t0(s.tmin[r]), t1(s.tmax[r]);
+                for (int a = 0; a < 3; ++a)  // the walk's clip, for this ray
+                    avx2::clip_axis<8>(near_planes[a], far_planes[a], F(s.origin[a][r]),
+                                       F(s.inv[a][r]), F(s.inv_far[a][r]), t0, t1);
+                rays_of = rays_of | (simd::bits_of(t0 <= t1) & I(int(1u << r)));
             }
-            unsigned children = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(
-                                    _mm256_cmpeq_epi32(rays_of, _mm256_setzero_si256())))) ^
-                                0xFFu;
+            unsigned children = (rays_of == I::zero()).bits() ^ 0xFFu;
             if (children != 0) {
                 alignas(32) std::uint32_t mask[8];
-                _mm256_store_si256(reinterpret_cast<__m256i*>(mask), rays_of);
+                rays_of.store(mask);
                 // Any order serves occlusion: the first hit child goes on, the others wait.
                 const int first = __builtin_ctz(children);
                 children &= children - 1;
                 current = Entry{node.child[first], node.groups[first], mask[first]};
-                // The next entry's first three lines, as walk8 asks for them, so that they arrive
-                // while the stream finishes this node.
-                const char* next =
-                    entry_address(nodes, groups, WideEntry{current.child, current.groups, 0});
-                _mm_prefetch(next, _MM_HINT_T0);
-                _mm_prefetch(next + 64, _MM_HINT_T0);
-                _mm_prefetch(next + 128, _MM_HINT_T0);
+                // The next entry's first three lines, as the walk asks for them, so that they
+                // arrive while the stream finishes this node.
+                ask_for_next(WideEntry{current.child, current.groups, 0},
+                             [&](const WideEntry& e) { return entry_address(nodes, groups, e); });
                 for (; children; children &= children - 1) {
                     const int c = __builtin_ctz(children);
                     const Entry e{node.child[c], node.groups[c], mask[c]};
                     stack[size++] = e;
-                    _mm_prefetch(entry_address(nodes, groups, WideEntry{e.child, e.groups, 0}),
-                                 _MM_HINT_T0);
+                    simd::prefetch(entry_address(nodes, groups, WideEntry{e.child, e.groups, 0}));
                 }
                 continue;
             }
@@ -145,11 +139,12 @@ template <class Blocked>
                     found = true;
                     return h.t;
                 };
-                // AnyLeaves::wide8's tests, for this ray.
+                // AnyLeaves' tests, for this ray.
+                const avx2::WatertightRayLanes<8> lanes(s.prep[r]);
                 for (std::uint32_t g = current.child; g < current.child + current.groups && !found;
                      ++g) {
                     float tmax = s.tmax[r];
-                    intersect_watertight8(s.prep[r], groups[g], s.tmin[r], tmax, record);
+                    avx2::intersect_watertight(lanes, groups[g], s.tmin[r], tmax, record);
                 }
                 if (found) live &= ~(1u << r);
             }

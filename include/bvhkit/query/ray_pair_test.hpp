@@ -17,10 +17,7 @@
 // scalar clip) made the walk slower in small files, so only these are forced.
 #include "bvhkit/bvh/sibling_pair.hpp"
 #include "bvhkit/math/ray.hpp"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "bvhkit/simd/simd.hpp"
 
 namespace bvhkit {
 
@@ -52,9 +49,11 @@ class RayPairTest {
     RaySlabData<T, N> slab_;
 };
 
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
 template <>
 class RayPairTest<float, 3> {
+    using F = simd::Float<4>;
+
   public:
     /// For the ray `slab` was made from, whose octant is `Octant` (known at compile time, so
     /// the choice of near and far planes costs nothing per ray either).
@@ -62,53 +61,49 @@ class RayPairTest<float, 3> {
     RayPairTest(const RaySlabData<float, 3>& slab, std::integral_constant<unsigned, Octant>) {
         constexpr float s = 1.0f + 2.0f * rounding_gamma<float>(3);
         for (int i = 0; i < 3; ++i) {
-            origin_[i] = _mm_set1_ps(slab.origin[i]);
+            origin_[i] = F(slab.origin[i]);
             const float inv = slab.inv_direction[i];
             // Lanes hold (L.min, L.max, R.min, R.max) planes; far planes get -s * inv.
             const bool negative = (Octant >> i) & 1u;
             const float on_min = negative ? -s * inv : inv, on_max = negative ? inv : -s * inv;
-            scale_[i] = _mm_setr_ps(on_min, on_max, on_min, on_max);
+            scale_[i] = F::lanes(on_min, on_max, on_min, on_max);
         }
     }
 
     /// (tmin, tmin, -tmax, -tmax): the accumulator's start, never NaN; make it again when tmax
     /// changes.
-    using Interval = __m128;
+    using Interval = simd::Float<4>;
     static Interval interval(float tmin, float tmax) {
-        return _mm_shuffle_ps(_mm_set1_ps(tmin), _mm_set1_ps(-tmax), 0);
+        return simd::shuffle<0, 0, 0, 0>(F(tmin), F(-tmax));
     }
 
     template <unsigned Octant>
     [[gnu::always_inline]] unsigned test(const BvhNode<Aabb3f>* pair, Interval interval,
                                          float entry[2]) const {
         const PairPlanes planes = gather_pair_planes(pair);
-        const __m128 x = planes.axis[0], y = planes.axis[1], z = planes.axis[2];
-        __m128 acc = interval;
-        acc = _mm_max_ps(
-            near_far<(Octant >> 0) & 1u>(_mm_mul_ps(_mm_sub_ps(x, origin_[0]), scale_[0])), acc);
-        acc = _mm_max_ps(
-            near_far<(Octant >> 1) & 1u>(_mm_mul_ps(_mm_sub_ps(y, origin_[1]), scale_[1])), acc);
-        acc = _mm_max_ps(
-            near_far<(Octant >> 2) & 1u>(_mm_mul_ps(_mm_sub_ps(z, origin_[2]), scale_[2])), acc);
-        const __m128 exits =
-            _mm_xor_ps(_mm_shuffle_ps(acc, acc, _MM_SHUFFLE(3, 2, 3, 2)), _mm_set1_ps(-0.0f));
-        entry[0] = _mm_cvtss_f32(acc);
-        entry[1] = _mm_cvtss_f32(_mm_shuffle_ps(acc, acc, _MM_SHUFFLE(1, 1, 1, 1)));
-        return unsigned(_mm_movemask_ps(_mm_cmple_ps(acc, exits))) & 3u;
+        const F x(planes.axis[0]), y(planes.axis[1]), z(planes.axis[2]);
+        F acc = interval;
+        acc = max(near_far<(Octant >> 0) & 1u>((x - origin_[0]) * scale_[0]), acc);
+        acc = max(near_far<(Octant >> 1) & 1u>((y - origin_[1]) * scale_[1]), acc);
+        acc = max(near_far<(Octant >> 2) & 1u>((z - origin_[2]) * scale_[2]), acc);
+        const F exits = -acc.shuffle<2, 3, 2, 3>();
+        entry[0] = acc.first();
+        entry[1] = acc.shuffle<1, 1, 1, 1>().first();
+        return (acc <= exits).bits() & 3u;
     }
 
   private:
     // (L.min, L.max, R.min, R.max) distances -> (L.near, R.near, L.far', R.far').
     template <unsigned Negative>
-    [[gnu::always_inline]] static __m128 near_far(__m128 t) {
+    [[gnu::always_inline]] static F near_far(F t) {
         if constexpr (Negative)
-            return _mm_shuffle_ps(t, t, _MM_SHUFFLE(2, 0, 3, 1));
+            return t.shuffle<1, 3, 0, 2>();
         else
-            return _mm_shuffle_ps(t, t, _MM_SHUFFLE(3, 1, 2, 0));
+            return t.shuffle<0, 2, 1, 3>();
     }
 
-    __m128 origin_[3];
-    __m128 scale_[3];
+    F origin_[3];
+    F scale_[3];
 };
 #endif
 

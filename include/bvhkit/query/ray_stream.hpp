@@ -9,9 +9,10 @@
 // the other seven work (the interleaving of independent pointer chases of Kocberber, Falsafi and
 // Grot 2015, "Asynchronous memory access chaining").
 //
-// Each ray's walk is walk8's, step for step, with the same arithmetic (clip8, the same leaf
-// tests): the answers are the one-by-one calls', bit for bit; only the order in which the rays'
-// steps run is interleaved. Design in docs/rays.md ("Streams"), figures in docs/benchmarks.md.
+// Each ray's walk is the eight-wide walk's, step for step, with the same arithmetic (the walk's
+// clip, push and leaf tests, query/ray_wide_walk.hpp): the answers are the one-by-one calls', bit
+// for bit; only the order in which the rays' steps run is interleaved. Design in docs/rays.md
+// ("Streams"), figures in docs/benchmarks.md.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -56,7 +57,7 @@ struct StreamRay {
 /// the next ray that needs a walk (its index, ray, SlabConstants and WatertightRay) or returns
 /// false when there is none; finish(const StreamRay&) takes a ray whose walk ended (start may
 /// pass it rays it answers without a walk: the slot then holds no hit). AnyHit: stop
-/// at the first hit, children in any order (walk8 with AnyLeaves); else the closest hit
+/// at the first hit, children in any order (the walk with AnyLeaves); else the closest hit
 /// (ClosestLeaves).
 template <bool AnyHit, class Start, class Finish>
 [[gnu::target("avx2")]] void stream8(WideRayView<8> tree, StreamRay* slots, Start&& start,
@@ -70,7 +71,7 @@ template <bool AnyHit, class Start, class Finish>
     const auto ask = [&](const WideEntry& e, std::uint32_t from) {
         const char* p = line(e);
         const std::uint32_t lines = e.groups == 0 ? 4 : std::min<std::uint32_t>(10, 5 * e.groups);
-        for (std::uint32_t q = from; q < lines; ++q) _mm_prefetch(p + 64 * q, _MM_HINT_T0);
+        for (std::uint32_t q = from; q < lines; ++q) simd::prefetch(p + 64 * q);
     };
     const auto begin = [&](StreamRay& s) {
         s.size = 0;
@@ -87,49 +88,23 @@ template <bool AnyHit, class Start, class Finish>
         for (int j = 0; j < stream_width; ++j) {
             StreamRay& s = slots[j];
             if (!s.live) continue;
-            if (s.current.groups == 0) {
-                const RayNode<8>& node = nodes[s.current.child];
-                __m256 origin[3], inv[3], inv_far[3];
-                for (int a = 0; a < 3; ++a) {
-                    origin[a] = _mm256_set1_ps(s.k.origin[a]);
-                    inv[a] = _mm256_set1_ps(s.k.inv[a]);
-                    inv_far[a] = _mm256_set1_ps(s.k.inv_far[a]);
-                }
-                __m256 entry = _mm256_set1_ps(s.ray.tmin);
-                const __m256 hit = clip8(node, origin, inv, inv_far, s.k.near, s.k.far, entry,
-                                         _mm256_set1_ps(s.ray.tmax));
-                const unsigned mask = unsigned(_mm256_movemask_ps(hit));
-                if (mask != 0) {
-                    // The push asks for the next entry's first three lines; the others here.
-                    if constexpr (AnyHit)
-                        push_in_lane_order8(entry, mask, node, s.current, s.stack, s.size, line);
-                    else
-                        push_nearest_first8(entry, hit, mask, node, s.current, s.stack, s.size,
-                                            line);
-                    ask(s.current, 3);
-                    continue;
-                }
+            // The walk's step with the slot's ray; a push asks for the next entry's first three
+            // lines, the rest of them here, and a pop for all of them.
+            avx2::FreshRegisters<8> registers{s.k, s.ray};
+            const auto pushed = [&] { ask(s.current, 3); };
+            const auto popped = [&] { ask(s.current, 0); };
+            bool going;
+            if constexpr (AnyHit) {
+                avx2::AnyLeaves<8, NoStats> leaves{groups, s.prep, s.ray, s.found, stats};
+                going = avx2::step(nodes, registers, s.k, s.ray, s.current, s.stack, s.size, leaves,
+                                   stats, line, pushed, popped);
             } else {
-                bool stop;
-                if constexpr (AnyHit) {
-                    AnyLeaves<TriangleGroup8, NoStats> leaves{groups, s.prep, s.ray, s.found,
-                                                              stats};
-                    stop = leaves.wide8(s.current.child, s.current.groups);
-                } else {
-                    ClosestLeaves<TriangleGroup8, NoStats> leaves{
-                        groups, s.prep, s.ray, s.best, s.hit_group, s.hit_lane, stats};
-                    stop = leaves.wide8(s.current.child, s.current.groups);
-                }
-                if (stop) {
-                    finish(s);
-                    live -= !begin(s);
-                    continue;
-                }
+                avx2::ClosestLeaves<8, NoStats> leaves{groups,      s.prep,     s.ray, s.best,
+                                                       s.hit_group, s.hit_lane, stats};
+                going = avx2::step(nodes, registers, s.k, s.ray, s.current, s.stack, s.size, leaves,
+                                   stats, line, pushed, popped);
             }
-            if (pop8(s.stack, s.size, s.ray.tmax, s.current)) {
-                ask(s.current, 0);
-                continue;
-            }
+            if (going) continue;
             finish(s);
             live -= !begin(s);
         }

@@ -13,13 +13,12 @@
 #include "bvhkit/bvh/wide_bvh.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/primitives/triangle_group.hpp"
+#include "bvhkit/simd/config.hpp"
 #include "bvhkit/tuning.hpp"
 
-#if defined(__SSE2__) && defined(__x86_64__) && defined(__GNUC__)
-#define BVHKIT_RAY_AVX2 1  // the eight-wide walk is compiled, for CPUs that turn out to have AVX2
-#else
-#define BVHKIT_RAY_AVX2 0
-#endif
+// The eight-wide walk is compiled, for CPUs that turn out to have AVX2, where the SIMD layer has
+// eight lanes.
+#define BVHKIT_RAY_AVX2 BVHKIT_SIMD_AVX2
 
 namespace bvhkit {
 

@@ -18,14 +18,11 @@
 
 #include "bvhkit/bvh/bvh.hpp"  // max_bvh_depth
 #include "bvhkit/query/ray_wide_layout.hpp"
-
-#if defined(__SSE2__)
-#include <immintrin.h>
-#endif
+#include "bvhkit/simd/simd.hpp"
 
 namespace bvhkit {
 
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
 namespace detail {
 
 struct WideEntry {
@@ -33,9 +30,17 @@ struct WideEntry {
     float t;
 };
 
+/// The stack of the walk of width W.
+template <int W>
+struct WideStack;
+
 /// The four-wide walk's stack: each level pushes at most three entries, and a wide tree is no
 /// deeper than the binary tree it came from (max_bvh_depth).
-using WideStack4 = WideEntry[3 * max_bvh_depth + 1];
+template <>
+struct WideStack<4> {
+    WideEntry entry[3 * max_bvh_depth + 1];
+};
+using WideStack4 = WideStack<4>;
 
 /// Where entry `e` starts: its node, or its leaf's first group. Both addresses, then a select
 /// without a branch: a branch on the kind of entry was mispredicted at about one push in four.
@@ -54,9 +59,9 @@ template <class Node, class Group>
 template <class Line>
 [[gnu::always_inline]] inline void ask_for_next(const WideEntry& e, Line&& line) {
     const char* next = line(e);
-    _mm_prefetch(next, _MM_HINT_T0);
-    _mm_prefetch(next + 64, _MM_HINT_T0);
-    _mm_prefetch(next + 128, _MM_HINT_T0);
+    simd::prefetch(next);
+    simd::prefetch(next + 64);
+    simd::prefetch(next + 128);
 }
 
 /// After a four-wide node's clip: the nearest hit lane of `mask` becomes `current`, the others are
@@ -78,7 +83,7 @@ template <class Line>
         std::uint32_t i = size++;
         for (; i > base && stack[i - 1].t < e.t; --i) stack[i] = stack[i - 1];
         stack[i] = e;
-        _mm_prefetch(line(e), _MM_HINT_T0);
+        simd::prefetch(line(e));
     }
     ask_for_next(current, line);
 }
@@ -98,24 +103,44 @@ template <class Line>
         const int c = __builtin_ctz(mask);
         const WideEntry e{node.child[c], node.groups[c], entry[c]};
         stack[size++] = e;
-        _mm_prefetch(line(e), _MM_HINT_T0);
+        simd::prefetch(line(e));
     }
     ask_for_next(current, line);
 }
 
+/// What the walk of width four does after a node's clip that hit the lanes of `mask`, whose
+/// entry distances `entry` holds: take_hits, or take_hits_unordered for any hit.
+template <bool AnyHit, class Line>
+[[gnu::always_inline]] inline void push_hits(simd::Float<4> entry, simd::Mask<4>, unsigned mask,
+                                             const RayNode<4>& node, WideEntry& current,
+                                             WideStack<4>& stack, std::uint32_t& size,
+                                             Line&& line) {
+    alignas(16) float t[4];
+    entry.store(t);
+    if constexpr (AnyHit)
+        take_hits_unordered(mask, t, node, current, stack.entry, size, line);
+    else
+        take_hits(mask, t, node, current, stack.entry, size, line);
+}
+
 /// Pops the next entry the ray can still reach; false when none is left.
-[[gnu::always_inline]] inline bool pop(WideEntry* stack, std::uint32_t& size, float tmax,
+[[gnu::always_inline]] inline bool pop(WideStack<4>& stack, std::uint32_t& size, float tmax,
                                        WideEntry& current) {
     do {
         if (size == 0) return false;
-        current = stack[--size];
+        current = stack.entry[--size];
     } while (current.t > tmax);
     return true;
 }
 
-#if BVHKIT_RAY_AVX2
+/// The four-wide walk asks for nothing more after a pop: its pushes asked for every entry.
+template <class Line>
+[[gnu::always_inline]] inline void ask_for_top(const WideStack<4>&, std::uint32_t, Line&&) {}
+
+#if BVHKIT_SIMD_AVX2
 /// The eight-wide walks' stack, one array per field of its entries.
-struct WideStack8 {
+template <>
+struct WideStack<8> {
     // Each level pushes at most seven entries (max_bvh_depth levels), and a push writes eight
     // slots.
     static constexpr std::size_t capacity = 7 * std::size_t(max_bvh_depth) + 8;
@@ -125,13 +150,14 @@ struct WideStack8 {
 
     /// A walk starts with slot 0 set (to the root), so that the slot ask_for_top8 reads is always
     /// one the walk wrote.
-    WideStack8() {
+    WideStack() {
         child[0] = 0;
         groups[0] = 0;
         t[0] = 0.0f;
     }
     WideEntry entry(std::uint32_t i) const { return WideEntry{child[i], groups[i], t[i]}; }
 };
+using WideStack8 = WideStack<8>;
 
 /// Asks for the first line of the entry on top of a stack of `size` entries (slot 0 when it is
 /// empty): the one the walk pops next, whose line then arrives while the walk is still below
@@ -141,27 +167,26 @@ struct WideStack8 {
 template <class Line>
 [[gnu::always_inline]] inline void ask_for_top8(const WideStack8& stack, std::uint32_t size,
                                                 Line&& line) {
-    _mm_prefetch(line(stack.entry(size - (size != 0))), _MM_HINT_T0);
+    simd::prefetch(line(stack.entry(size - (size != 0))));
 }
 
 /// One compare-exchange layer of eight keys: each lane against the `partner` lane a shuffle
 /// brought, keeping the larger key in the lanes set in `Larger`.
 template <int Larger>
-[[gnu::target("avx2"), gnu::always_inline]] inline __m256i compare_exchange8(__m256i v,
-                                                                             __m256i partner) {
-    return _mm256_blend_epi32(_mm256_min_epi32(v, partner), _mm256_max_epi32(v, partner), Larger);
+BVHKIT_SIMD_INLINE_AVX2 simd::Int<8> compare_exchange8(simd::Int<8> v, simd::Int<8> partner) {
+    return simd::blend<Larger>(min(v, partner), max(v, partner));
 }
 
 /// Eight keys in descending order: a bitonic sorting network of six layers, the partners lane ^ 1,
 /// ^ 2 and ^ 4. The first three layers sort blocks of two and four alternately down and up; the
 /// last three merge all eight downwards.
-[[gnu::target("avx2"), gnu::always_inline]] inline __m256i sort8_descending(__m256i v) {
-    v = compare_exchange8<0x99>(v, _mm256_shuffle_epi32(v, 0xB1));
-    v = compare_exchange8<0xC3>(v, _mm256_shuffle_epi32(v, 0x4E));
-    v = compare_exchange8<0xA5>(v, _mm256_shuffle_epi32(v, 0xB1));
-    v = compare_exchange8<0x0F>(v, _mm256_permute4x64_epi64(v, 0x4E));
-    v = compare_exchange8<0x33>(v, _mm256_shuffle_epi32(v, 0x4E));
-    v = compare_exchange8<0x55>(v, _mm256_shuffle_epi32(v, 0xB1));
+BVHKIT_SIMD_INLINE_AVX2 simd::Int<8> sort8_descending(simd::Int<8> v) {
+    v = compare_exchange8<0x99>(v, v.shuffle_in_halves<0xB1>());
+    v = compare_exchange8<0xC3>(v, v.shuffle_in_halves<0x4E>());
+    v = compare_exchange8<0xA5>(v, v.shuffle_in_halves<0xB1>());
+    v = compare_exchange8<0x0F>(v, v.permute_pairs<0x4E>());
+    v = compare_exchange8<0x33>(v, v.shuffle_in_halves<0x4E>());
+    v = compare_exchange8<0x55>(v, v.shuffle_in_halves<0xB1>());
     return v;
 }
 
@@ -176,33 +201,25 @@ inline constexpr std::array<std::uint32_t, 256> set_lanes = [] {
 }();
 
 /// Lane `lane` of `entry`, `lane` in every lane of the index.
-[[gnu::target("avx2"), gnu::always_inline]] inline float lane_of(__m256 entry, __m256i lane) {
-    return _mm256_cvtss_f32(_mm256_permutevar8x32_ps(entry, lane));
+BVHKIT_SIMD_INLINE_AVX2 float lane_of(simd::Float<8> entry, simd::Int<8> lane) {
+    return permute(entry, lane).first();
 }
 
 /// Lane `first` of `node` becomes the walk's next entry, at its distance in `entry`; its first
 /// lines are asked for.
 template <class Line>
-[[gnu::target("avx2"), gnu::always_inline]] inline void go_to_lane8(const RayNode<8>& node,
-                                                                    __m256 entry, int first,
-                                                                    WideEntry& current,
-                                                                    Line&& line) {
-    current =
-        WideEntry{node.child[first], node.groups[first], lane_of(entry, _mm256_set1_epi32(first))};
+BVHKIT_SIMD_INLINE_AVX2 void go_to_lane8(const RayNode<8>& node, simd::Float<8> entry, int first,
+                                         WideEntry& current, Line&& line) {
+    current = WideEntry{node.child[first], node.groups[first], lane_of(entry, simd::Int<8>(first))};
     ask_for_next(current, line);
 }
 
 /// Writes the node's lanes, in the order `order` lists them, to slots [at, at + 8) of `stack`.
-[[gnu::target("avx2"), gnu::always_inline]] inline void put8(WideStack8& stack, std::uint32_t at,
-                                                             __m256i order, const RayNode<8>& node,
-                                                             __m256 entry) {
-    const __m256i child = _mm256_load_si256(reinterpret_cast<const __m256i*>(node.child));
-    const __m256i groups = _mm256_load_si256(reinterpret_cast<const __m256i*>(node.groups));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.child + at),
-                        _mm256_permutevar8x32_epi32(child, order));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.groups + at),
-                        _mm256_permutevar8x32_epi32(groups, order));
-    _mm256_storeu_ps(stack.t + at, _mm256_permutevar8x32_ps(entry, order));
+BVHKIT_SIMD_INLINE_AVX2 void put8(WideStack8& stack, std::uint32_t at, simd::Int<8> order,
+                                  const RayNode<8>& node, simd::Float<8> entry) {
+    permute(simd::Int<8>::load(node.child), order).store_unaligned(stack.child + at);
+    permute(simd::Int<8>::load(node.groups), order).store_unaligned(stack.groups + at);
+    permute(entry, order).store_unaligned(stack.t + at);
 }
 
 /// take_hits for the eight-wide walks: the nearest hit lane becomes `current`, the other hit lanes
@@ -212,9 +229,10 @@ template <class Line>
 /// reversed), with the lane in the lowest three bits: the keys are distinct, and distances that
 /// differ only in those three bits go by lane.
 template <class Line>
-[[gnu::target("avx2"), gnu::always_inline]] inline void push_nearest_first8(
-    __m256 entry, __m256 hit, unsigned mask, const RayNode<8>& node, WideEntry& current,
-    WideStack8& stack, std::uint32_t& size, Line&& line) {
+BVHKIT_SIMD_INLINE_AVX2 void push_nearest_first8(simd::Float<8> entry, simd::Mask<8> hit,
+                                                 unsigned mask, const RayNode<8>& node,
+                                                 WideEntry& current, WideStack8& stack,
+                                                 std::uint32_t& size, Line&& line) {
     if ((mask & (mask - 1)) == 0) {
         // One hit child, nothing to push: a branch that coherent rays predict, and the next node's
         // address sooner than by the reduction below. Without it camera rays ran slower, and
@@ -222,54 +240,72 @@ template <class Line>
         go_to_lane8(node, entry, __builtin_ctz(mask), current, line);
         return;
     }
-    const __m256i seven = _mm256_set1_epi32(7);
-    __m256i bits = _mm256_castps_si256(entry);
-    bits = _mm256_xor_si256(bits, _mm256_srli_epi32(_mm256_srai_epi32(bits, 31), 1));
-    const __m256i key = _mm256_or_si256(_mm256_andnot_si256(seven, bits),
-                                        _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    const __m256i is_hit = _mm256_castps_si256(hit);
+    using Int = simd::Int<8>;
+    const Int seven(7);
+    Int bits = simd::bits_of(entry);
+    bits = bits ^ bits.shift_right_arithmetic<31>().shift_right_logical<1>();
+    const Int key = andnot(seven, bits) | Int::lanes(0, 1, 2, 3, 4, 5, 6, 7);
     constexpr std::int32_t least = std::numeric_limits<std::int32_t>::min();
     constexpr std::int32_t most = std::numeric_limits<std::int32_t>::max();
     // Farthest first, the missed lanes (least keys) after the hits; the nearest lands in slot
     // size + hits - 1, above the new top.
-    const __m256i order = _mm256_and_si256(
-        sort8_descending(_mm256_blendv_epi8(_mm256_set1_epi32(least), key, is_hit)), seven);
+    const Int order = sort8_descending(select(hit, key, Int(least))) & seven;
     put8(stack, size, order, node, entry);
     size += std::uint32_t(__builtin_popcount(mask)) - 1;
     // The nearest lane again, by a reduction that does not wait for the sort: it is the walk's
     // next step.
-    __m256i nearest = _mm256_blendv_epi8(_mm256_set1_epi32(most), key, is_hit);
-    nearest = _mm256_min_epi32(nearest, _mm256_permute4x64_epi64(nearest, 0x4E));
-    nearest = _mm256_min_epi32(nearest, _mm256_shuffle_epi32(nearest, 0x4E));
-    nearest = _mm256_min_epi32(nearest, _mm256_shuffle_epi32(nearest, 0xB1));
-    go_to_lane8(node, entry, _mm256_cvtsi256_si32(nearest) & 7, current, line);
+    Int nearest = select(hit, key, Int(most));
+    nearest = min(nearest, nearest.permute_pairs<0x4E>());
+    nearest = min(nearest, nearest.shuffle_in_halves<0x4E>());
+    nearest = min(nearest, nearest.shuffle_in_halves<0xB1>());
+    go_to_lane8(node, entry, nearest.first() & 7, current, line);
 }
 
 /// take_hits_unordered for the eight-wide walks: the first hit lane becomes `current`, the others
 /// go on the stack in lane order.
 template <class Line>
-[[gnu::target("avx2"), gnu::always_inline]] inline void push_in_lane_order8(
-    __m256 entry, unsigned mask, const RayNode<8>& node, WideEntry& current, WideStack8& stack,
-    std::uint32_t& size, Line&& line) {
+BVHKIT_SIMD_INLINE_AVX2 void push_in_lane_order8(simd::Float<8> entry, unsigned mask,
+                                                 const RayNode<8>& node, WideEntry& current,
+                                                 WideStack8& stack, std::uint32_t& size,
+                                                 Line&& line) {
     const int first = __builtin_ctz(mask);
     const unsigned rest = mask & (mask - 1);
-    const __m256i order =
-        _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(std::int32_t(set_lanes[rest])),
-                                           _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28)),
-                         _mm256_set1_epi32(7));
+    const simd::Int<8> order =
+        shift_right_logical(simd::Int<8>(std::int32_t(set_lanes[rest])),
+                            simd::Int<8>::lanes(0, 4, 8, 12, 16, 20, 24, 28)) &
+        simd::Int<8>(7);
     put8(stack, size, order, node, entry);
     size += std::uint32_t(__builtin_popcount(rest));
     go_to_lane8(node, entry, first, current, line);
 }
 
+/// What the walk of width eight does after a node's clip: push_nearest_first8, or
+/// push_in_lane_order8 for any hit.
+template <bool AnyHit, class Line>
+BVHKIT_SIMD_INLINE_AVX2 void push_hits(simd::Float<8> entry, simd::Mask<8> hit, unsigned mask,
+                                       const RayNode<8>& node, WideEntry& current,
+                                       WideStack8& stack, std::uint32_t& size, Line&& line) {
+    if constexpr (AnyHit)
+        push_in_lane_order8(entry, mask, node, current, stack, size, line);
+    else
+        push_nearest_first8(entry, hit, mask, node, current, stack, size, line);
+}
+
 /// pop for the eight-wide walks' stack.
-[[gnu::always_inline]] inline bool pop8(const WideStack8& stack, std::uint32_t& size, float tmax,
-                                        WideEntry& current) {
+[[gnu::always_inline]] inline bool pop(const WideStack8& stack, std::uint32_t& size, float tmax,
+                                       WideEntry& current) {
     do {
         if (size == 0) return false;
         current = stack.entry(--size);
     } while (current.t > tmax);
     return true;
+}
+
+/// ask_for_top8, the name the walk calls for either width.
+template <class Line>
+[[gnu::always_inline]] inline void ask_for_top(const WideStack8& stack, std::uint32_t size,
+                                               Line&& line) {
+    ask_for_top8(stack, size, line);
 }
 #endif
 

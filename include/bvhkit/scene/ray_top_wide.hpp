@@ -18,14 +18,11 @@
 
 #include "bvhkit/bvh/bvh.hpp"
 #include "bvhkit/math/ray.hpp"
-
-#if defined(__SSE2__)
-#include <immintrin.h>
-#endif
+#include "bvhkit/simd/simd.hpp"
 
 namespace bvhkit::scene_detail {
 
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
 
 class WideTop4 {
   public:
@@ -49,14 +46,15 @@ class WideTop4 {
         if (nodes_.empty()) return;
         constexpr float far_scale = 1.0f + 2.0f * rounding_gamma<float>(3);
         const RaySlabData<float, 3> slab(ray);
-        __m128 origin[3], inv[3];
+        using F = simd::Float<4>;
+        F origin[3], inv[3];
         std::uint32_t near_row[3];
         for (std::size_t a = 0; a < 3; ++a) {
-            origin[a] = _mm_set1_ps(slab.origin[a]);
-            inv[a] = _mm_set1_ps(slab.inv_direction[a]);
+            origin[a] = F(slab.origin[a]);
+            inv[a] = F(slab.inv_direction[a]);
             near_row[a] = (slab.octant >> a) & 1u;  // 1: the near plane is the box's max
         }
-        const __m128 scale = _mm_set1_ps(far_scale);
+        const F scale(far_scale);
         struct Pending {
             std::int32_t child;
             float entry;
@@ -69,21 +67,20 @@ class WideTop4 {
         while (true) {
             if (current >= 0) {
                 const Node& n = nodes_[std::size_t(current)];
-                __m128 t0 = _mm_set1_ps(ray.tmin), t1 = _mm_set1_ps(tmax);
+                F t0(ray.tmin), t1(tmax);
                 for (std::size_t a = 0; a < 3; ++a) {
-                    const __m128 lo = _mm_load_ps(n.bound[near_row[a]][a]);
-                    const __m128 hi = _mm_load_ps(n.bound[1 - near_row[a]][a]);
-                    const __m128 tn = _mm_mul_ps(_mm_sub_ps(lo, origin[a]), inv[a]);
-                    const __m128 tf =
-                        _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(hi, origin[a]), inv[a]), scale);
-                    // SSE's max and min return their second operand when either is NaN: a NaN
+                    const F lo = F::load(n.bound[near_row[a]][a]);
+                    const F hi = F::load(n.bound[1 - near_row[a]][a]);
+                    const F tn = (lo - origin[a]) * inv[a];
+                    const F tf = (hi - origin[a]) * inv[a] * scale;
+                    // max and min return their second operand when either is NaN: a NaN
                     // distance leaves the interval as it was.
-                    t0 = _mm_max_ps(tn, t0);
-                    t1 = _mm_min_ps(tf, t1);
+                    t0 = max(tn, t0);
+                    t1 = min(tf, t1);
                 }
-                unsigned hits = unsigned(_mm_movemask_ps(_mm_cmple_ps(t0, t1))) & n.mask;
+                unsigned hits = (t0 <= t1).bits() & n.mask;
                 alignas(16) float entry[4];
-                _mm_store_ps(entry, t0);
+                t0.store(entry);
                 Pending found[4];
                 int k = 0;
                 for (; hits; hits &= hits - 1) {
