@@ -132,6 +132,11 @@ bool closest_hit_wide(WideRayView<W> tree, const Ray<float, 3>& ray_in,
     if constexpr (W == 8)
         return detail::avx2::closest_hit(tree, ray_in, k, prep, best, hit_group, hit_lane, stats);
     else
+#else
+    // No eight lanes in this build (cpu_has_avx2 is false, so no such tree is walked).
+    if constexpr (W == 8)
+        return false;
+    else
 #endif
         return detail::sse2::closest_hit(tree, ray_in, k, prep, best, hit_group, hit_lane, stats);
 }
@@ -146,6 +151,10 @@ bool any_hit_wide(WideRayView<W> tree, const Ray<float, 3>& ray_in,
 #if BVHKIT_SIMD_AVX2
     if constexpr (W == 8)
         return detail::avx2::any_hit(tree, ray_in, k, prep, stats);
+    else
+#else
+    if constexpr (W == 8)
+        return false;  // as in closest_hit_wide
     else
 #endif
         return detail::sse2::any_hit(tree, ray_in, k, prep, stats);
