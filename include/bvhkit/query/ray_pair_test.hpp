@@ -81,7 +81,7 @@ class RayPairTest<float, 3> {
     [[gnu::always_inline]] unsigned test(const BvhNode<Aabb3f>* pair, Interval interval,
                                          float entry[2]) const {
         const PairPlanes planes = gather_pair_planes(pair);
-        const F x(planes.axis[0]), y(planes.axis[1]), z(planes.axis[2]);
+        const F &x = planes.axis[0], &y = planes.axis[1], &z = planes.axis[2];
         F acc = interval;
         acc = max(near_far<(Octant >> 0) & 1u>((x - origin_[0]) * scale_[0]), acc);
         acc = max(near_far<(Octant >> 1) & 1u>((y - origin_[1]) * scale_[1]), acc);
