@@ -34,6 +34,7 @@
 #include "bvhkit/query/nearest.hpp"
 #include "bvhkit/query/nearest_wide.hpp"
 #include "bvhkit/query/point_order.hpp"
+#include "bvhkit/simd/simd.hpp"
 
 namespace bvhkit {
 
@@ -409,24 +410,25 @@ class ClosestPointMesh {
         return std::max(nearest_detail::round_up_key<T>((r + slack) * (r + slack)),
                         T(4) * std::numeric_limits<T>::min());
     }
-    /// Squared distance from p to the triangle's box. For float on x86 in SSE: each corner is one
-    /// 4-float load (the fourth lane, the next coordinate, masked off), a fraction of the scalar
-    /// form's instructions on a path every N1 query takes often.
+    /// Squared distance from p to the triangle's box. For float on x86 in four lanes: each corner
+    /// is one 4-float load (the fourth lane, the next coordinate, masked off), a fraction of the
+    /// scalar form's instructions on a path every N1 query takes often.
     static T box_distance_squared(const Triangle<T>& t, const Vec<T, 3>& p) {
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
         if constexpr (std::is_same_v<T, float>) {
+            using F = simd::Float<4>;
             static_assert(sizeof(Triangle<float>) == 9 * sizeof(float), "corners are contiguous");
             const float* f = &t.p0[0];
-            const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 3), c = _mm_loadu_ps(f + 6);
-            const __m128 q = _mm_setr_ps(p[0], p[1], p[2], 0.0f);
-            const __m128 lo = _mm_min_ps(a, _mm_min_ps(b, c)), hi = _mm_max_ps(a, _mm_max_ps(b, c));
-            const __m128 xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
-            __m128 g =
-                _mm_max_ps(_mm_max_ps(_mm_sub_ps(lo, q), _mm_sub_ps(q, hi)), _mm_setzero_ps());
-            g = _mm_and_ps(g, xyz);
-            g = _mm_mul_ps(g, g);
-            const __m128 s = _mm_add_ps(g, _mm_movehl_ps(g, g));
-            return _mm_cvtss_f32(_mm_add_ss(s, _mm_shuffle_ps(s, s, _MM_SHUFFLE(1, 1, 1, 1))));
+            const F a = F::load_unaligned(f), b = F::load_unaligned(f + 3),
+                    c = F::load_unaligned(f + 6);
+            const F q = F::lanes(p[0], p[1], p[2], 0.0f);
+            const F lo = min(a, min(b, c)), hi = max(a, max(b, c));
+            const simd::Mask<4> xyz = simd::Mask<4>::lanes(true, true, true, false);
+            F g = max(max(lo - q, q - hi), F::zero());
+            g = where(xyz, g);
+            g = g * g;
+            const F s = g + g.high_half();
+            return add_first(s, s.shuffle<1, 1, 1, 1>()).first();
         }
 #endif
         T d2 = 0;

@@ -10,10 +10,7 @@
 #include "bvhkit/bvh/wide_bvh.hpp"
 #include "bvhkit/math/select.hpp"
 #include "bvhkit/query/nearest.hpp"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "bvhkit/simd/simd.hpp"
 
 namespace bvhkit {
 
@@ -24,19 +21,17 @@ namespace wide_detail {
 template <class T>
 [[gnu::always_inline]] inline unsigned children_within(const WideSlotNode<T>& node,
                                                        const Vec<T, 3>& p, T radius2, T d[4]) {
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
     if constexpr (std::is_same_v<T, float>) {
-        __m128 sum = _mm_setzero_ps();
+        using F = simd::Float<4>;
+        F sum = F::zero();
         for (int a = 0; a < 3; ++a) {
-            const __m128 q = _mm_set1_ps(p[a]);
-            const __m128 gap = _mm_max_ps(_mm_max_ps(_mm_sub_ps(_mm_load_ps(node.lo[a]), q),
-                                                     _mm_sub_ps(q, _mm_load_ps(node.hi[a]))),
-                                          _mm_setzero_ps());
-            sum = _mm_add_ps(sum, _mm_mul_ps(gap, gap));
+            const F q(p[a]);
+            const F gap = max(max(F::load(node.lo[a]) - q, q - F::load(node.hi[a])), F::zero());
+            sum = sum + gap * gap;
         }
-        _mm_storeu_ps(d, sum);
-        return unsigned(_mm_movemask_ps(_mm_cmple_ps(sum, _mm_set1_ps(radius2)))) &
-               ~lanes_equal(node.child, invalid_index);
+        sum.store_unaligned(d);
+        return (sum <= F(radius2)).bits() & ~lanes_equal(node.child, invalid_index);
     }
 #endif
     unsigned within = 0;
