@@ -11,6 +11,7 @@
 // counts are exact in any order, so the split is the same as binned serially.
 #include "bvhkit/build/sah.hpp"
 #include "bvhkit/build/top_down_core.hpp"
+#include "bvhkit/simd/simd.hpp"
 #include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
@@ -103,28 +104,28 @@ class BinnedSahRule {
         Vec<T, N> origin;
         T scale[N];
         std::uint32_t count;
-#if defined(__SSE2__)
-        __m128 origin4, scale4, last4;  // used for 3D float only
+#if BVHKIT_SIMD
+        simd::Float<4> origin4, scale4, last4;  // used for 3D float only
 #endif
         BinMapping(const Vec<T, N>& o, const T* s, std::uint32_t c) : origin(o), count(c) {
             for (std::size_t a = 0; a < N; ++a) scale[a] = s[a];
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
             if constexpr (std::is_same_v<T, float> && N == 3) {
                 origin4 = BoxAccumulator<float, 3>::load(o);
-                scale4 = _mm_setr_ps(s[0], s[1], s[2], 0.0f);
-                last4 = _mm_set1_ps(float(c - 1));
+                scale4 = simd::Float<4>::lanes(s[0], s[1], s[2], 0.0f);
+                last4 = simd::Float<4>(float(c - 1));
             }
 #endif
         }
         void bins(const Vec<T, N>& c, std::uint32_t out[N]) const {
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
             if constexpr (std::is_same_v<T, float> && N == 3) {
-                const __m128 t =
-                    _mm_mul_ps(_mm_sub_ps(BoxAccumulator<float, 3>::load(c), origin4), scale4);
-                const __m128 clamped = _mm_min_ps(_mm_max_ps(t, _mm_setzero_ps()), last4);
-                alignas(16) std::int32_t b[4];
-                _mm_store_si128(reinterpret_cast<__m128i*>(b), _mm_cvttps_epi32(clamped));
-                for (std::size_t a = 0; a < 3; ++a) out[a] = std::uint32_t(b[a]);
+                using F = simd::Float<4>;
+                const F t = (BoxAccumulator<float, 3>::load(c) - origin4) * scale4;
+                const F clamped = min(max(t, F::zero()), last4);
+                alignas(16) std::uint32_t b[4];  // each in [0, count - 1]
+                truncate(clamped).store(b);
+                for (std::size_t a = 0; a < 3; ++a) out[a] = b[a];
                 return;
             }
 #endif

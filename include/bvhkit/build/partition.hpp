@@ -12,6 +12,7 @@
 
 #include "bvhkit/build/box_accumulator.hpp"
 #include "bvhkit/exec/executor.hpp"
+#include "bvhkit/simd/simd.hpp"
 #include "bvhkit/tuning.hpp"
 
 namespace bvhkit {
@@ -50,7 +51,7 @@ struct Split {
 
 /// Bin of a coordinate for binned builders; the same function bins and partitions, so both agree.
 /// Clamped before converting, so that no value (inf, or NaN from 0 * inf) reaches the conversion:
-/// NaN and values <= 0 give bin 0, as the SSE path's max(b, 0) does.
+/// NaN and values <= 0 give bin 0, as the four-lane path's max(b, 0) does.
 template <class T>
 inline std::uint32_t bin_of(T c, T origin, T scale, std::uint32_t bin_count) {
     const T b = (c - origin) * scale;
@@ -92,11 +93,11 @@ template <class T, std::size_t N>
 [[gnu::always_inline]] inline void add_to_side(const BuildInput<T, N>& in, std::uint32_t i,
                                                bool goes_left, RangeBounds<T, N>& left,
                                                RangeBounds<T, N>& right) {
-#if defined(__SSE2__)
+#if BVHKIT_SIMD
     if constexpr (std::is_same_v<T, float> && N == 3) {
-        const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
-        const __m128 to_left = _mm_castsi128_ps(_mm_set1_epi32(-std::int32_t(goes_left)));
-        const __m128 skip_left = _mm_andnot_ps(to_left, inf), skip_right = _mm_and_ps(to_left, inf);
+        const simd::Float<4> inf(std::numeric_limits<float>::infinity());
+        const simd::Mask<4> to_left = simd::Mask<4>::all(goes_left);
+        const simd::Float<4> skip_left = where_not(to_left, inf), skip_right = where(to_left, inf);
         left.boxes.grow(in.boxes[i], skip_left);
         right.boxes.grow(in.boxes[i], skip_right);
         left.centroids.grow_point(in.centroids[i], skip_left);
