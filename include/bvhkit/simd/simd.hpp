@@ -1,9 +1,8 @@
 #pragma once
 // The SIMD layer: Float<W>, Int<W> and Mask<W>, four lanes (SSE2, every x86-64) and eight (AVX2),
-// thin wrappers over the intrinsics, so that a kernel is written once for both widths. The ray
-// kernels name no intrinsic outside this folder; the builders' and the closest-point queries'
-// (build/, query/closest_point_mesh.hpp, query/nearest_wide.hpp, bvh/sibling_pair.hpp,
-// math/select.hpp) still do.
+// thin wrappers over the intrinsics, so that a kernel is written once for both widths. No header
+// outside this folder names an intrinsic except math/select.hpp (scalar minss/maxss and a
+// four-lane compare): math/ is in simd/'s layer, and the layer rule keeps the two apart.
 //
 // The eight-lane functions carry the AVX2 target attribute themselves: the default build targets
 // SSE2, and a kernel for eight lanes is compiled for AVX2 by simd/per_isa.hpp and chosen at run
