@@ -4,8 +4,8 @@
 
 #include <set>
 
-#include "bvhkit/math/random.hpp"
 #include "bvhkit/bvh/min_heap.hpp"
+#include "bvhkit/math/random.hpp"
 
 using namespace bvhkit;
 
