@@ -5,8 +5,8 @@
 #
 # Layers, lowest first. Two folders of one layer may not include each other (bvh and bsp, dynamic and
 # query); the only allowed crossings are listed in `allowed` below.
-#   0 error.hpp version.hpp tuning.hpp
-#   1 math exec simd
+#   0 error.hpp version.hpp tuning.hpp simd
+#   1 math exec
 #   2 primitives
 #   3 volumes
 #   4 bvh bsp convex
@@ -21,7 +21,7 @@ set(rank_version.hpp 0)
 set(rank_tuning.hpp 0)
 set(rank_math 1)
 set(rank_exec 1)
-set(rank_simd 1)
+set(rank_simd 0)
 set(rank_primitives 2)
 set(rank_volumes 3)
 set(rank_bvh 4)
