@@ -197,18 +197,23 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     template <class OnHit, class Stats = NoStats>
     void all_hits(const Ray<T, 3>& ray, OnHit&& on_hit, Stats&& stats = {}) const {
         const Reading reading(exclusion_);
+        // The walk rays take (the wide layout's gives the binary walk's hits, the same test).
+        const auto walk = [&](auto&& report) {
+#if defined(__SSE2__)
+            if constexpr (std::is_same_v<T, float>)
+                if (traces_wide()) return wide_rays().all_hits(ray, report, stats);
+#endif
+            binary_rays().all_hits(ray, report, stats);
+        };
         if (!split_references_) {
-            binary_rays().all_hits(ray, on_hit, stats);
+            walk(on_hit);
             return;
         }
         // A triangle split by the build can be met in several leaves: reported the first time.
         std::unordered_set<std::uint32_t> seen;
-        binary_rays().all_hits(
-            ray,
-            [&](const Hit<T>& h) {
-                return seen.insert(h.primitive).second ? bool(on_hit(h)) : true;
-            },
-            stats);
+        walk([&](const Hit<T>& h) {
+            return seen.insert(h.primitive).second ? bool(on_hit(h)) : true;
+        });
     }
 
     // Batches: trace() and occluded(), from RayBatches (query/triangle_rays.hpp), which run these

@@ -3,8 +3,14 @@
 // tests) the shared meshes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
+#include <utility>
+#include <vector>
+
 #include "brute_force.hpp"
 #include "bvhkit/bvh/validate.hpp"
+#include "bvhkit/mesh/procedural.hpp"
 #include "bvhkit/primitives/segment.hpp"
 #include "bvhkit/triangle_bvh.hpp"
 #include "random_geometry.hpp"
@@ -216,6 +222,75 @@ TEST(RayQueries2d, SegmentsMatchBruteForce) {
                 ASSERT_EQ(got.t, best);
                 ASSERT_EQ(any_hit(bvh, ray, test_segment), true);
             }
+        }
+    }
+}
+
+// all_hits on a float tree walks the wide layout (query/ray_wide_walk.hpp's AllLeaves): the same
+// hits as the binary walk's, bit for bit (t, u, v, normal), each once. Hard sets: far from the
+// origin, tiny, needles, and coplanar overlapping squares whose shared edges and corners the
+// vertical rays meet exactly (where both triangles of an edge report it).
+TEST(AllHits, TheWideLayoutsGiveTheBinaryWalksHits) {
+    std::vector<Triangle<float>> coplanar;
+    for (int layer = 0; layer < 2; ++layer)
+        for (int i = 0; i < 24; ++i)
+            for (int j = 0; j < 24; ++j) {
+                const float x = i + 0.5f * layer, y = j + 0.5f * layer, z = float(i % 3);
+                coplanar.push_back({{x, y, z}, {x + 1, y, z}, {x, y + 1, z}});
+                coplanar.push_back({{x + 1, y, z}, {x + 1, y + 1, z}, {x, y + 1, z}});
+            }
+    const std::vector<std::pair<std::string, std::vector<Triangle<float>>>> meshes{
+        {"far sphere", test::placed<float>(make_sphere(4), 1, 1e5)},
+        {"tiny torus", test::placed<float>(make_torus(64, 32), 1e-6, 0)},
+        {"needles", test::random_needles(3000, 41)},
+        {"coplanar", coplanar}};
+    struct Seen {
+        std::uint32_t primitive;
+        float t, u, v;
+        Vec<float, 3> normal;
+    };
+    const auto hits_of = [](const TriangleBvh<float>& bvh, const Ray<float, 3>& ray) {
+        std::vector<Seen> out;
+        bvh.all_hits(ray, [&](const Hit<float>& h) {
+            out.push_back({h.primitive, h.t, h.u, h.v, h.normal});
+            return true;
+        });
+        std::sort(out.begin(), out.end(),
+                  [](const Seen& a, const Seen& b) { return a.primitive < b.primitive; });
+        return out;
+    };
+    for (const auto& [name, tris] : meshes) {
+        SCOPED_TRACE(name);
+        TriangleBvhOptions binary, wide4;
+        binary.ray_layout = RayLayout::Binary;
+        wide4.ray_layout = RayLayout::Wide4;
+        const TriangleBvh<float> reference(tris, binary);
+        ASSERT_EQ(reference.ray_width(), 2);
+        std::vector<Ray<float, 3>> rays = test::rays_through_box(tris, test::scaled(3000, 3), 43);
+        if (name == "coplanar")  // straight down through grid corners, edges and cell centres
+            for (int i = 0; i < 200; ++i)
+                rays.push_back(
+                    Ray<float, 3>({0.25f * float(i % 97), 0.5f * float(i / 7), 5}, {0, 0, -1}));
+        for (std::size_t i = 7; i < rays.size(); i += 13) rays[i].tmax *= 0.5f;  // cut short
+        for (const TriangleBvhOptions& options : {TriangleBvhOptions{}, wide4}) {
+            const TriangleBvh<float> bvh(tris, options);
+            SCOPED_TRACE(bvh.ray_width());
+            std::size_t total = 0;
+            for (std::size_t r = 0; r < rays.size(); ++r) {
+                const std::vector<Seen> want = hits_of(reference, rays[r]);
+                const std::vector<Seen> got = hits_of(bvh, rays[r]);
+                ASSERT_EQ(got.size(), want.size()) << r;
+                for (std::size_t k = 0; k < got.size(); ++k) {
+                    ASSERT_EQ(got[k].primitive, want[k].primitive) << r;
+                    ASSERT_TRUE(test::same_bits(got[k].t, want[k].t) &&
+                                test::same_bits(got[k].u, want[k].u) &&
+                                test::same_bits(got[k].v, want[k].v))
+                        << r;
+                    ASSERT_EQ(got[k].normal, want[k].normal) << r;
+                }
+                total += got.size();
+            }
+            EXPECT_GT(total, rays.size() / 10);  // the rays do cross the meshes
         }
     }
 }

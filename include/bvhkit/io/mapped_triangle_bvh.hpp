@@ -75,6 +75,10 @@ class MappedTriangleBvh : public RayBatches<MappedTriangleBvh<T>, T> {
     /// on_hit(const Hit<T>&) -> bool (true to go on); hits come in no particular order.
     template <class OnHit, class Stats = NoStats>
     void all_hits(const Ray<T, 3>& ray, OnHit&& on_hit, Stats&& stats = {}) const {
+#if defined(__SSE2__)
+        if constexpr (std::is_same_v<T, float>)
+            if (ray_width() > 2) return wide_rays().all_hits(ray, on_hit, stats);
+#endif
         rays_.all_hits(ray, on_hit, stats);
     }
 

@@ -159,6 +159,23 @@ bool any_hit_wide(WideRayView<W> tree, const Ray<float, 3>& ray_in,
 #endif
         return detail::sse2::any_hit(tree, ray_in, k, prep, stats);
 }
+
+/// Every hit through a wide tree in the ray's range, in no particular order: on_hit(group, lane,
+/// hit) -> bool (false ends the walk), the triangle as in closest_hit_wide (same conditions).
+template <int W, class OnHit, class Stats = NoStats>
+void all_hits_wide(WideRayView<W> tree, const Ray<float, 3>& ray_in, const detail::SlabConstants& k,
+                   const WatertightRay<float>& prep, OnHit&& on_hit, Stats&& stats = {}) {
+#if BVHKIT_SIMD_AVX2
+    if constexpr (W == 8)
+        detail::avx2::all_hits(tree, ray_in, k, prep, on_hit, stats);
+    else
+#else
+    if constexpr (W == 8)
+        return;  // as in closest_hit_wide
+    else
+#endif
+        detail::sse2::all_hits(tree, ray_in, k, prep, on_hit, stats);
+}
 #endif
 
 /// Whether the wide walk serves `ray`: traceable, and no direction component subnormal (whose

@@ -99,6 +99,32 @@ struct AnyLeaves {
     }
 };
 
+template <int W, class OnHit, class Stats>
+struct AllLeaves {
+    using Group = typename WideRayView<W>::Group;
+    static constexpr bool any_hit = true;  // every hit is wanted: the order of the children is free
+    const Group* groups;
+    const WatertightRay<float>& prep;
+    const Ray<float, 3>& ray;
+    OnHit& on_hit;  // on_hit(group, lane, hit) -> bool, false to stop
+    bool stopped = false;
+    Stats& stats;
+
+    bool operator()(std::uint32_t first, std::uint32_t count) {
+        const WatertightRayLanes<Group::lanes> lanes(prep);
+        for (std::uint32_t g = first; g < first + count && !stopped; ++g) {
+            count_lanes(groups[g], stats);
+            float tmax = ray.tmax;  // never narrowed: each hit in the ray's range is reported
+            intersect_watertight(lanes, groups[g], ray.tmin, tmax,
+                                 [&](int lane, const TriangleHit<float>& h) {
+                                     if (!stopped && !on_hit(groups[g], lane, h)) stopped = true;
+                                     return ray.tmax;
+                                 });
+        }
+        return stopped;
+    }
+};
+
 /// A ray's slab constants in every lane: made once for a one-ray walk, once a step in a stream.
 template <int W>
 struct WalkRay {
@@ -217,6 +243,16 @@ bool any_hit(WideRayView<W> tree, const Ray<float, 3>& ray_in, const SlabConstan
     WideStack<W> stack;
     walk(tree, ray, k, stack, leaves, stats);
     return found;
+}
+
+/// all_hits_wide's walk.
+template <int W, class OnHit, class Stats>
+void all_hits(WideRayView<W> tree, const Ray<float, 3>& ray_in, const SlabConstants& k,
+              const WatertightRay<float>& prep, OnHit& on_hit, Stats& stats) {
+    Ray<float, 3> ray = ray_in;
+    AllLeaves<W, OnHit, Stats> leaves{tree.groups.data(), prep, ray, on_hit, false, stats};
+    WideStack<W> stack;
+    walk(tree, ray, k, stack, leaves, stats);
 }
 
 }  // namespace bvhkit::detail::BVHKIT_SIMD_ISA

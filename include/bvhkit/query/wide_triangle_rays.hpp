@@ -97,6 +97,32 @@ class WideTriangleRays {
                               : any_hit_wide(wide8_, ray, prep, stats);
     }
 
+    /// on_hit(const Hit<float>&) -> bool (true to go on) for every hit in the ray's range, in no
+    /// particular order; the hits of the binary walk's all_hits (the same watertight test).
+    template <class OnHit, class Stats>
+    void all_hits(const Ray<float, 3>& ray, OnHit&& on_hit, Stats&& stats) const {
+        detail::SlabConstants k;
+        const Route route = width() > 2 ? route_wide(ray, k) : Route::Binary;
+        if (route == Route::Miss) return;
+        if (route == Route::Binary) {
+            binary_.all_hits(ray, on_hit, stats);
+            return;
+        }
+        const WatertightRay<float> prep(ray, WatertightRay<float>::KnownValid{});
+        const auto walk = [&](auto wide) {
+            all_hits_wide(
+                wide, ray, k, prep,
+                [&](const auto& group, int lane, const TriangleHit<float>& h) {
+                    return bool(on_hit(wide_hit(h, group, lane)));
+                },
+                stats);
+        };
+        if (wide8_.empty())
+            walk(wide4_);
+        else
+            walk(wide8_);
+    }
+
     /// hits[i] = closest_hit(rays[i]); the spans are of one length.
     void trace_on_calling_thread(std::span<const Ray<float, 3>> rays,
                                  std::span<Hit<float>> hits) const {
