@@ -75,9 +75,8 @@ bool is_closed_surface(const M& mesh, const std::vector<std::uint32_t>& weld,
 }
 
 /// The winding number at p of a closed oriented surface traced by `rays` (an object with
-/// any_hit(ray) and all_hits(ray, on_hit) that give the same hits, whose ray test is watertight
-/// and whose hits carry the geometric normal),
-/// or nothing where one ray's hits cannot decide it (see above). p with a NaN or infinite
+/// all_hits(ray, on_hit), whose ray test is watertight and whose hits carry the geometric
+/// normal), or nothing where one ray's hits cannot decide it (see above). p with a NaN or infinite
 /// coordinate gives nothing too.
 template <class T, class Rays>
 std::optional<int> crossing_winding_number(const Rays& rays, const Vec<T, 3>& p) {
@@ -87,8 +86,9 @@ std::optional<int> crossing_winding_number(const Rays& rays, const Vec<T, 3>& p)
     // Barycentrics within a few roundings of 0 may be an exact edge or vertex hit: u and v are
     // exactly 0 there, 1 - u - v only within the roundings of u and v.
     const T edge = T(16) * std::numeric_limits<T>::epsilon();
-    // Most rays from points outside meet nothing: the occlusion walk, the fastest, says so.
-    if (!rays.any_hit(ray)) return 0;
+    // No occlusion query first for the rays that meet nothing: on the wide layout an all-hits
+    // walk that finds nothing visits what the occlusion walk would, and a ray that meets the
+    // surface would be walked twice.
     int winding = 0;
     bool decided = true;
     rays.all_hits(ray, [&](const Hit<T>& h) {
