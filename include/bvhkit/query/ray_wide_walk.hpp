@@ -52,9 +52,13 @@ struct ClosestLeaves {
     int& hit_lane;
     Stats& stats;
 
-    /// A hit in group g becomes the closest so far, and the range shrinks to it.
+    /// A hit in group g becomes the closest so far, and the range shrinks to it; at the closest
+    /// so far's own t the lower triangle index is kept (closer_hit).
     auto record(std::uint32_t g) {
         return [this, g](int lane, const TriangleHit<float>& h) {
+            if (hit_group != nullptr &&
+                !closer_hit(h.t, groups[g].slot[lane], best.t, hit_group->slot[hit_lane]))
+                return best.t;
             best = h;
             hit_group = groups + g;
             hit_lane = lane;

@@ -1,0 +1,60 @@
+#pragma once
+// Whether a run of rays is coherent enough to walk as one packet (query/ray_octant_stream.hpp):
+// the test by which trace batches choose the packet walk for a run, without being told. A packet
+// pays when its rays meet mostly the same boxes: then a node's loads, its push and its pop serve
+// all of them. Rays that share a direction octant, with close directions and origins (camera
+// rays of a row or a tile; shadow rays from nearby points towards one light) do; random rays do
+// not, and go as before. The test reads each ray once (a square root and a few compares), well
+// below the cost of one ray's walk.
+#include <cmath>
+#include <cstddef>
+#include <span>
+
+#include "bvhkit/math/aabb.hpp"
+#include "bvhkit/math/ray.hpp"
+#include "bvhkit/tuning.hpp"
+
+namespace bvhkit {
+
+/// Whether `rays` (a run of a batch) share a direction octant (by sign bit, -0 negative as the
+/// walks read it), their unit directions lie in a box tuning::packet_direction_spread wide on
+/// each axis, and their origins in a box tuning::packet_origin_spread of `bounds`' largest
+/// extent. False for an empty run, or one with a ray whose origin or direction is not finite or
+/// whose direction is zero (those take the one-ray calls' own routes).
+inline bool coherent_rays(std::span<const Ray<float, 3>> rays, const Aabb<float, 3>& bounds) {
+    if (rays.empty()) return false;
+    float dlo[3], dhi[3], olo[3], ohi[3];
+    bool sign[3];
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const Ray<float, 3>& r = rays[i];
+        const float length =
+            std::sqrt(r.direction[0] * r.direction[0] + r.direction[1] * r.direction[1] +
+                      r.direction[2] * r.direction[2]);
+        if (!(length > 0.0f) || !std::isfinite(length)) return false;
+        for (int a = 0; a < 3; ++a) {
+            const float d = r.direction[a] / length, o = r.origin[a];
+            if (!std::isfinite(o)) return false;
+            if (i == 0) {
+                sign[a] = std::signbit(r.direction[a]);
+                dlo[a] = dhi[a] = d;
+                olo[a] = ohi[a] = o;
+                continue;
+            }
+            if (std::signbit(r.direction[a]) != sign[a]) return false;
+            dlo[a] = std::fmin(dlo[a], d);
+            dhi[a] = std::fmax(dhi[a], d);
+            olo[a] = std::fmin(olo[a], o);
+            ohi[a] = std::fmax(ohi[a], o);
+        }
+    }
+    float extent = 0.0f;
+    for (int a = 0; a < 3; ++a) extent = std::fmax(extent, bounds.max[a] - bounds.min[a]);
+    const float origin_limit = tuning::packet_origin_spread * extent;
+    for (int a = 0; a < 3; ++a)
+        if (!(dhi[a] - dlo[a] <= tuning::packet_direction_spread) ||
+            !(ohi[a] - olo[a] <= origin_limit))
+            return false;
+    return true;
+}
+
+}  // namespace bvhkit
