@@ -126,23 +126,9 @@ class WideTriangleRays {
     void trace_on_calling_thread(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits,
                                  bool packets = false) const {
 #if BVHKIT_RAY_AVX2
-        if (!wide8_.empty() && (packets || path_ == RayBatchPath::Packets)) {
-            trace_in_packets(rays, hits);
-            return;
-        }
-        if (!wide8_.empty() && path_ == RayBatchPath::Auto) {
-            // Runs of incoherent rays go on as below; coherent ones as packets.
-            const Aabb<float, 3>& bounds = binary_.bvh().nodes[0].bounds;
-            const std::size_t n = detail::octant_stream_size;
-            std::size_t run = 0;  // the start of the rays not yet traced
-            for (std::size_t i = 0; i < rays.size(); i += n) {
-                const std::size_t count = std::min(n, rays.size() - i);
-                if (!coherent_rays(rays.subspan(i, count), bounds)) continue;
-                trace_one_way(rays.subspan(run, i - run), hits.subspan(run, i - run));
-                trace_in_packets(rays.subspan(i, count), hits.subspan(i, count));
-                run = i + count;
-            }
-            trace_one_way(rays.subspan(run), hits.subspan(run));
+        if (!wide8_.empty() &&
+            (packets || path_ == RayBatchPath::Packets || path_ == RayBatchPath::Auto)) {
+            trace_in_packets(rays, hits, packets || path_ == RayBatchPath::Packets);
             return;
         }
 #endif
@@ -238,23 +224,35 @@ class WideTriangleRays {
         detail::stream8<AnyHit>(wide8_, slots, start, finish);
     }
 
-    // Closest hits in packets of one octant (query/ray_octant_stream.hpp); the rays the wide walk
-    // does not take go one by one.
-    void trace_in_packets(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits) const {
+    // Closest hits in packets of one octant (query/ray_octant_stream.hpp), a run of
+    // octant_stream_size rays at a time: every run (`every_run`), or those coherent_rays accepts,
+    // the others as trace_one_way. The rays the wide walk does not take go one by one.
+    void trace_in_packets(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits,
+                          bool every_run) const {
         const auto done = [&](const detail::OctantStream& s, int r, bool found) {
             hits[s.index[r]] =
                 found ? wide_hit(s.best[r], *s.hit_group[r], s.hit_lane[r]) : Hit<float>{};
         };
         detail::OctantStreams<false> streams;
         detail::SlabConstants k;
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            const Ray<float, 3>& ray = rays[i];
-            const Route route = route_wide(ray, k);
-            if (route == Route::Walk)
-                streams.add(wide8_, ray, k, i, done);
-            else
-                hits[i] = route == Route::Binary ? binary_.closest_hit(ray) : Hit<float>{};
+        const Aabb<float, 3>& bounds = binary_.bvh().nodes[0].bounds;
+        const std::size_t n = detail::octant_stream_size;
+        std::size_t rest = 0;  // the first ray neither in a packet nor traced
+        for (std::size_t b = 0; b < rays.size(); b += n) {
+            const std::size_t count = std::min(n, rays.size() - b);
+            if (!every_run && !coherent_rays(rays.subspan(b, count), bounds)) continue;
+            trace_one_way(rays.subspan(rest, b - rest), hits.subspan(rest, b - rest));
+            rest = b + count;
+            for (std::size_t i = b; i < b + count; ++i) {
+                const Ray<float, 3>& ray = rays[i];
+                const Route route = route_wide(ray, k);
+                if (route == Route::Walk)
+                    streams.add(wide8_, ray, k, i, done);
+                else
+                    hits[i] = route == Route::Binary ? binary_.closest_hit(ray) : Hit<float>{};
+            }
         }
+        trace_one_way(rays.subspan(rest), hits.subspan(rest));
         streams.finish(wide8_, done);
     }
 
