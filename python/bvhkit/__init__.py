@@ -221,6 +221,30 @@ class TriangleMesh:
         self._impl.intersect(o, d, t0, t1, t, face, bary, n)
         return RayHits(t, face, bary)
 
+    def intersect_packets(
+        self,
+        origins: _npt.ArrayLike,
+        directions: _npt.ArrayLike,
+        tmin: _npt.ArrayLike = 0.0,
+        tmax: _typing.Optional[_npt.ArrayLike] = _np.inf,
+        threads: int = 0,
+    ) -> RayHits:
+        """:meth:`intersect` for rays the caller knows to be coherent (camera rays, shadow rays
+        towards one light): every 32 consecutive rays walk the tree together as one packet.
+
+        The answers are :meth:`intersect`'s, bit for bit; only the speed depends on the order.
+        Give camera rays in tiles: 32 consecutive rays an 8x4 block of pixels (or two rows of a
+        16x16 tile, or 32 pixels of one row). :meth:`intersect` already walks the runs of 32 rays
+        it finds coherent as packets; this call skips that test and walks every run so.
+        """
+        o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
+        k = len(o)
+        t = _np.empty(k, self.dtype)
+        face = _np.empty(k, _np.int64)
+        bary = _np.empty((k, 3), self.dtype)
+        self._impl.intersect_packets(o, d, t0, t1, t, face, bary, n)
+        return RayHits(t, face, bary)
+
     def occluded(
         self,
         origins: _npt.ArrayLike,

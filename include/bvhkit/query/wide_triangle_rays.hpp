@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -30,8 +31,9 @@ namespace bvhkit {
 /// layout. Every choice answers as the one-ray calls do, bit for bit; the choice is for tests,
 /// which must run every path whatever the mesh's size, and for measuring.
 enum class RayBatchPath {
-    Auto,           // trace batches: each run of 32 rays that coherent_rays accepts as a packet,
-                    // the others in streams from 2 MB of layout on (tuning.hpp); occlusion
+    Auto,           // trace batches: each run of 32 rays (8 or more at a batch's end) that
+                    // coherent_rays accepts as a packet, the others one by one, or in streams
+                    // from 2 MB of layout on (tuning.hpp); occlusion
                     // batches in octant streams below 8 MB and in streams above
     OneByOne,       // each ray walks alone, as closest_hit / any_hit
     Streams,        // eight rays in flight (query/ray_stream.hpp); needs the eight-wide layout
@@ -233,27 +235,31 @@ class WideTriangleRays {
             hits[s.index[r]] =
                 found ? wide_hit(s.best[r], *s.hit_group[r], s.hit_lane[r]) : Hit<float>{};
         };
-        detail::OctantStreams<false> streams;
+        // Made at the first packet: a batch of a few rays, or of incoherent ones, makes none.
+        std::optional<detail::OctantStreams<false>> streams;
         detail::SlabConstants k;
         const Aabb<float, 3>& bounds = binary_.bvh().nodes[0].bounds;
         const std::size_t n = detail::octant_stream_size;
         std::size_t rest = 0;  // the first ray neither in a packet nor traced
         for (std::size_t b = 0; b < rays.size(); b += n) {
             const std::size_t count = std::min(n, rays.size() - b);
-            if (!every_run && !coherent_rays(rays.subspan(b, count), bounds)) continue;
+            // A run of a few rays (a batch's tail, a batch of one) shares too little to pay.
+            if (!every_run && (count < n / 4 || !coherent_rays(rays.subspan(b, count), bounds)))
+                continue;
             trace_one_way(rays.subspan(rest, b - rest), hits.subspan(rest, b - rest));
             rest = b + count;
+            if (!streams) streams.emplace();
             for (std::size_t i = b; i < b + count; ++i) {
                 const Ray<float, 3>& ray = rays[i];
                 const Route route = route_wide(ray, k);
                 if (route == Route::Walk)
-                    streams.add(wide8_, ray, k, i, done);
+                    streams->add(wide8_, ray, k, i, done);
                 else
                     hits[i] = route == Route::Binary ? binary_.closest_hit(ray) : Hit<float>{};
             }
         }
         trace_one_way(rays.subspan(rest), hits.subspan(rest));
-        streams.finish(wide8_, done);
+        if (streams) streams->finish(wide8_, done);
     }
 
     // Occlusion rays in octant streams (query/ray_octant_stream.hpp); those the wide walk does not
