@@ -34,8 +34,9 @@ inline bool coherent_rays(std::span<const Ray<float, 3>> rays, const Aabb<float,
             std::sqrt(r.direction[0] * r.direction[0] + r.direction[1] * r.direction[1] +
                       r.direction[2] * r.direction[2]);
         if (!(length > 0.0f) || !std::isfinite(length)) return false;
+        const float inverse = 1.0f / length;
         for (int a = 0; a < 3; ++a) {
-            const float d = r.direction[a] / length, o = r.origin[a];
+            const float d = r.direction[a] * inverse, o = r.origin[a];
             if (!std::isfinite(o)) return false;
             if (i == 0) {
                 sign[a] = std::signbit(r.direction[a]);
