@@ -213,13 +213,7 @@ class TriangleMesh:
             bary = _np.empty((k, 3), dtype)
             self._impl.intersect_shared(origins, directions, tmin, tmax, t, face, bary, threads)
             return RayHits(t, face, bary)
-        o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
-        k = len(o)
-        t = _np.empty(k, self.dtype)
-        face = _np.empty(k, _np.int64)
-        bary = _np.empty((k, 3), self.dtype)
-        self._impl.intersect(o, d, t0, t1, t, face, bary, n)
-        return RayHits(t, face, bary)
+        return self._hits(self._impl.intersect, origins, directions, tmin, tmax, threads)
 
     def intersect_packets(
         self,
@@ -237,12 +231,17 @@ class TriangleMesh:
         16x16 tile, or 32 pixels of one row). :meth:`intersect` already walks the runs of 32 rays
         it finds coherent as packets; this call skips that test and walks every run so.
         """
+        return self._hits(self._impl.intersect_packets, origins, directions, tmin, tmax, threads)
+
+    def _hits(self, call: object, origins: object, directions: object, tmin: object,
+              tmax: object, threads: object) -> RayHits:
+        """call(...) of the binding (intersect or intersect_packets) on checked arguments."""
         o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
         k = len(o)
         t = _np.empty(k, self.dtype)
         face = _np.empty(k, _np.int64)
         bary = _np.empty((k, 3), self.dtype)
-        self._impl.intersect_packets(o, d, t0, t1, t, face, bary, n)
+        call(o, d, t0, t1, t, face, bary, n)
         return RayHits(t, face, bary)
 
     def occluded(
