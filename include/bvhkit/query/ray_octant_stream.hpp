@@ -48,7 +48,8 @@ struct OctantStream {
     alignas(32) float inv[3][octant_stream_size];
     alignas(32) float inv_far[3][octant_stream_size];
     alignas(32) float tmin[octant_stream_size];
-    alignas(32) float tmax[octant_stream_size] = {};  // a closest hit's shrinks as it hits
+    // A closest hit's shrinks as it hits; whole blocks of eight for rays_reaching.
+    alignas(32) float tmax[(octant_stream_size + 7) / 8 * 8];
     WatertightRay<float> prep[octant_stream_size];
     std::size_t index[octant_stream_size];  // the ray's place in the batch
     // A closest hit's answer: the hit, and where its triangle lies (hit_group null on none).
@@ -80,12 +81,13 @@ inline int direction_octant(const SlabConstants& k) {
     return int(k.near[0] >= 3) | int(k.near[1] >= 3) << 1 | int(k.near[2] >= 3) << 2;
 }
 
-/// The rays of `mask` whose range still reaches t: tmax[r] >= t.
+/// The rays of `mask` (of the stream's) whose range still reaches t: tmax[r] >= t. Reads tmax
+/// in blocks of eight up to the count's: the walk sets the last block's unused slots.
 [[gnu::target("avx2")]] inline std::uint32_t rays_reaching(const OctantStream& s, float t,
                                                            std::uint32_t mask) {
     using F = simd::Float<8>;
     std::uint32_t reach = 0;
-    for (int q = 0; q < octant_stream_size / 8; ++q)
+    for (int q = 0; q < (s.count + 7) / 8; ++q)
         reach |= (F(t) <= F::load(s.tmax + 8 * q)).bits() << (8 * q);
     return mask & reach;
 }
@@ -116,7 +118,8 @@ template <bool AnyHit, class Done>
         far[a] = std::uint32_t(a + (negative ? 0 : 3));
     }
     const std::uint32_t all = s.count == 32 ? ~0u : (1u << s.count) - 1;
-    std::uint32_t live = all;  // any hit: rays not yet blocked
+    for (int r = s.count; r % 8 != 0; ++r) s.tmax[r] = 0.0f;  // read by rays_reaching, unused
+    std::uint32_t live = all;                                 // any hit: rays not yet blocked
     Entry stack[(8 - 1) * max_bvh_depth + 1];
     std::uint32_t size = 0;
     Entry current{0, 0, all, 0.0f};

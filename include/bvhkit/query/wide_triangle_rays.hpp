@@ -14,7 +14,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <span>
 #include <string>
 
@@ -227,39 +226,58 @@ class WideTriangleRays {
     }
 
     // Closest hits in packets of one octant (query/ray_octant_stream.hpp), a run of
-    // octant_stream_size rays at a time: every run (`every_run`), or those coherent_rays accepts,
+    // octant_stream_size rays at a time: every run (`every_run`), or those packet_run accepts,
     // the others as trace_one_way. The rays the wide walk does not take go one by one.
     void trace_in_packets(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits,
                           bool every_run) const {
+        // The streams are made at the first packet: a batch of a few rays, or of incoherent
+        // ones, makes none.
+        for (std::size_t b = 0; b < rays.size(); b += detail::octant_stream_size)
+            if (every_run || packet_run(rays, b)) {
+                trace_one_way(rays.first(b), hits.first(b));
+                trace_packets_from(rays, hits, b, every_run);
+                return;
+            }
+        trace_one_way(rays, hits);
+    }
+
+    /// Whether the run of rays from b walks as a packet when the batch path chooses: 8 rays or
+    /// more (a batch's tail, or a batch of one, shares too little to pay) that coherent_rays
+    /// accepts.
+    bool packet_run(std::span<const Ray<float, 3>> rays, std::size_t b) const {
+        const std::size_t n = detail::octant_stream_size;
+        const std::size_t count = std::min(n, rays.size() - b);
+        return count >= n / 4 &&
+               coherent_rays(rays.subspan(b, count), binary_.bvh().nodes[0].bounds);
+    }
+
+    /// trace_in_packets from `first`, the start of a run that walks as a packet.
+    void trace_packets_from(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits,
+                            std::size_t first, bool every_run) const {
         const auto done = [&](const detail::OctantStream& s, int r, bool found) {
             hits[s.index[r]] =
                 found ? wide_hit(s.best[r], *s.hit_group[r], s.hit_lane[r]) : Hit<float>{};
         };
-        // Made at the first packet: a batch of a few rays, or of incoherent ones, makes none.
-        std::optional<detail::OctantStreams<false>> streams;
+        detail::OctantStreams<false> streams;
         detail::SlabConstants k;
-        const Aabb<float, 3>& bounds = binary_.bvh().nodes[0].bounds;
         const std::size_t n = detail::octant_stream_size;
-        std::size_t rest = 0;  // the first ray neither in a packet nor traced
-        for (std::size_t b = 0; b < rays.size(); b += n) {
-            const std::size_t count = std::min(n, rays.size() - b);
-            // A run of a few rays (a batch's tail, a batch of one) shares too little to pay.
-            if (!every_run && (count < n / 4 || !coherent_rays(rays.subspan(b, count), bounds)))
-                continue;
+        std::size_t rest = first;  // the first ray neither in a packet nor traced
+        for (std::size_t b = first; b < rays.size(); b += n) {
+            if (b != first && !every_run && !packet_run(rays, b)) continue;
             trace_one_way(rays.subspan(rest, b - rest), hits.subspan(rest, b - rest));
+            const std::size_t count = std::min(n, rays.size() - b);
             rest = b + count;
-            if (!streams) streams.emplace();
             for (std::size_t i = b; i < b + count; ++i) {
                 const Ray<float, 3>& ray = rays[i];
                 const Route route = route_wide(ray, k);
                 if (route == Route::Walk)
-                    streams->add(wide8_, ray, k, i, done);
+                    streams.add(wide8_, ray, k, i, done);
                 else
                     hits[i] = route == Route::Binary ? binary_.closest_hit(ray) : Hit<float>{};
             }
         }
         trace_one_way(rays.subspan(rest), hits.subspan(rest));
-        if (streams) streams->finish(wide8_, done);
+        streams.finish(wide8_, done);
     }
 
     // Occlusion rays in octant streams (query/ray_octant_stream.hpp); those the wide walk does not
