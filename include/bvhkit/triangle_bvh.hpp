@@ -11,7 +11,8 @@
 // Batches of rays: trace() and occluded() over spans, on every core with oneTBB;
 // trace_on_calling_thread() and occluded_stream() on the calling thread. On the eight-wide layout a
 // batch walks several rays at once (query/ray_stream.hpp; occlusion rays below 8 MB in octant
-// streams, query/ray_octant_stream.hpp), or as RayBatchPath forces: the one-by-one calls' answers,
+// streams, query/ray_octant_stream.hpp; runs of coherent rays as packets, query/ray_coherence.hpp,
+// and every run with trace_packets()), or as RayBatchPath forces: the one-by-one calls' answers,
 // bit for bit. The float paths are query/wide_triangle_rays.hpp's, shared with MappedTriangleBvh.
 //
 // The triangle test is TriangleBvhOptions::triangle_test: watertight by default (no ray slips
