@@ -110,6 +110,14 @@ inline constexpr int octant_stream_size = 32;
 /// walks above: there a node's rays are few and the walk waits for memory, which interleaving
 /// hides better. `bvhkit-bench rays MESH` (R3-mt).
 inline constexpr std::size_t octant_streams_below_layout_bytes = std::size_t(8) << 20;
+/// A run of octant_stream_size consecutive rays of a trace batch walks as one packet
+/// (query/ray_coherence.hpp) when its rays share a direction octant, their directions lie within
+/// an angle of sine packet_direction_spread of the first one's, and their origins within this
+/// fraction of the tree's extent of the first one's on every axis: camera rays of a row or tile,
+/// and shadow rays from near points towards one light, do. Measured by R1 (camera rays) batched
+/// against one by one, docs/benchmarks.md ("Packets of coherent rays").
+inline constexpr float packet_direction_spread = 0.125f;
+inline constexpr float packet_origin_spread = 0.125f;
 /// Rays per task of the batch calls: large enough to pay for a task, small enough to balance
 /// incoherent rays over the cores. `bvhkit-bench rays MESH` (R2-mt, R3-mt).
 inline constexpr std::size_t ray_batch_grain = 256;

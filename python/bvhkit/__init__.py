@@ -213,12 +213,35 @@ class TriangleMesh:
             bary = _np.empty((k, 3), dtype)
             self._impl.intersect_shared(origins, directions, tmin, tmax, t, face, bary, threads)
             return RayHits(t, face, bary)
+        return self._hits(self._impl.intersect, origins, directions, tmin, tmax, threads)
+
+    def intersect_packets(
+        self,
+        origins: _npt.ArrayLike,
+        directions: _npt.ArrayLike,
+        tmin: _npt.ArrayLike = 0.0,
+        tmax: _typing.Optional[_npt.ArrayLike] = _np.inf,
+        threads: int = 0,
+    ) -> RayHits:
+        """:meth:`intersect` for rays the caller knows to be coherent (camera rays, shadow rays
+        towards one light): every 32 consecutive rays walk the tree together as one packet.
+
+        The answers are :meth:`intersect`'s, bit for bit; only the speed depends on the order.
+        Give camera rays in tiles: 32 consecutive rays an 8x4 block of pixels (or two rows of a
+        16x16 tile, or 32 pixels of one row). :meth:`intersect` already walks the runs of 32 rays
+        it finds coherent as packets; this call skips that test and walks every run so.
+        """
+        return self._hits(self._impl.intersect_packets, origins, directions, tmin, tmax, threads)
+
+    def _hits(self, call: object, origins: object, directions: object, tmin: object,
+              tmax: object, threads: object) -> RayHits:
+        """call(...) of the binding (intersect or intersect_packets) on checked arguments."""
         o, d, t0, t1, n = self._rays(origins, directions, tmin, tmax, threads)
         k = len(o)
         t = _np.empty(k, self.dtype)
         face = _np.empty(k, _np.int64)
         bary = _np.empty((k, 3), self.dtype)
-        self._impl.intersect(o, d, t0, t1, t, face, bary, n)
+        call(o, d, t0, t1, t, face, bary, n)
         return RayHits(t, face, bary)
 
     def occluded(

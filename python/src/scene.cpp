@@ -152,6 +152,17 @@ class Scene {
         intersect_within(origins, directions, PerRayLimits{tmin.data(), tmax.data()}, t, face,
                          barycentric, threads);
     }
+    /// intersect for rays their caller knows to be coherent: every 32 consecutive rays walk as
+    /// one packet (TriangleBvh::trace_packets); the same answers.
+    void intersect_packets(const Rows<T, 3>& origins, const Rows<T, 3>& directions,
+                           const Column<T>& tmin, const Column<T>& tmax, OutColumn<T> t,
+                           OutColumn<std::int64_t> face, OutRows<T, 3> barycentric,
+                           unsigned threads) const {
+        expect_rows(tmin, origins.shape(0), "tmin");
+        expect_rows(tmax, origins.shape(0), "tmax");
+        intersect_within(origins, directions, PerRayLimits{tmin.data(), tmax.data()}, t, face,
+                         barycentric, threads, true);
+    }
     /// intersect with one [tmin, tmax] for every ray.
     void intersect_shared(const Rows<T, 3>& origins, const Rows<T, 3>& directions, T tmin, T tmax,
                           OutColumn<T> t, OutColumn<std::int64_t> face, OutRows<T, 3> barycentric,
@@ -162,7 +173,7 @@ class Scene {
     template <class Limits>
     void intersect_within(const Rows<T, 3>& origins, const Rows<T, 3>& directions,
                           const Limits& limits, OutColumn<T> t, OutColumn<std::int64_t> face,
-                          OutRows<T, 3> barycentric, unsigned threads) const {
+                          OutRows<T, 3> barycentric, unsigned threads, bool packets = false) const {
         expect_rows(t, origins.shape(0), "t");
         expect_rows(face, origins.shape(0), "face");
         expect_rows(barycentric, origins.shape(0), "barycentric");
@@ -171,7 +182,11 @@ class Scene {
         ray_chunks(origins, directions, limits, threads,
                    [&](std::size_t first, std::span<const Ray3> chunk) {
                        Hit<T> hits[ray_chunk];
-                       rays_.trace_on_calling_thread(chunk, std::span<Hit<T>>(hits, chunk.size()));
+                       const std::span<Hit<T>> out(hits, chunk.size());
+                       if (packets)
+                           rays_.trace_packets(chunk, out, 1u);
+                       else
+                           rays_.trace_on_calling_thread(chunk, out);
                        for (std::size_t j = 0; j < chunk.size(); ++j) {
                            const Hit<T>& h = hits[j];
                            const std::size_t i = first + j;
@@ -520,6 +535,10 @@ void bind_scene_type(nb::module_& m, const char* name) {
              nb::arg("tmin"), nb::arg("tmax"), nb::arg("t"), nb::arg("face"),
              nb::arg("barycentric"), nb::arg("threads"),
              "intersect with one [tmin, tmax] for every ray.")
+        .def("intersect_packets", &S::intersect_packets, nb::arg("origins"), nb::arg("directions"),
+             nb::arg("tmin"), nb::arg("tmax"), nb::arg("t"), nb::arg("face"),
+             nb::arg("barycentric"), nb::arg("threads"),
+             "intersect for coherent rays, 32 consecutive rays a packet.")
         .def("occluded", &S::occluded, nb::arg("origins"), nb::arg("directions"), nb::arg("tmin"),
              nb::arg("tmax"), nb::arg("out"), nb::arg("threads"),
              "Whether each ray hits anything within [tmin, tmax].")

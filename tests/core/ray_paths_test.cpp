@@ -1,8 +1,9 @@
 // Every path a float ray can take through a TriangleBvh, forced, on every shared mesh and on the
 // hard-geometry sets, against the one-ray binary walk with the watertight test: the binary walk
-// (watertight and fast), the four- and eight-wide walks, and the batches' streams and octant
-// streams (RayBatchPath). No path is left to a size threshold (tuning.hpp), so none turns into a
-// skip when one is retuned; only the eight-wide paths skip, naming AVX2, on a CPU without it.
+// (watertight and fast), the four- and eight-wide walks, and the batches' streams, octant
+// streams and packets (RayBatchPath). No path is left to a size threshold (tuning.hpp), so none
+// turns into a skip when one is retuned; only the eight-wide paths skip, naming AVX2, on a CPU
+// without it.
 //
 // The wide walks open boxes in another order than the binary walk, so where a ray meets two
 // triangles at the same t either may be reported: then the t must equal the reference's (a zero
@@ -150,6 +151,8 @@ void check_every_path(const std::vector<Triangle<float>>& tris, std::size_t ray_
          RayBatchPath::Streams},
         {"octant streams", RayLayout::Auto, TriangleTest::Watertight, empty ? 2 : 8,
          RayBatchPath::OctantStreams},
+        {"packets", RayLayout::Auto, TriangleTest::Watertight, empty ? 2 : 8,
+         RayBatchPath::Packets},
     };
     std::vector<std::string> skipped;
     for (const Path& p : paths) {
@@ -167,8 +170,9 @@ void check_every_path(const std::vector<Triangle<float>>& tris, std::size_t ray_
         if (p.width < 8) {
             EXPECT_THROW(tree.set_batch_path(RayBatchPath::Streams), Error);
             EXPECT_THROW(tree.set_batch_path(RayBatchPath::OctantStreams), Error);
+            EXPECT_THROW(tree.set_batch_path(RayBatchPath::Packets), Error);
             EXPECT_FALSE(tree.streams_rays());
-        } else if (p.batches != RayBatchPath::OctantStreams) {
+        } else if (p.batches == RayBatchPath::OneByOne || p.batches == RayBatchPath::Streams) {
             EXPECT_EQ(tree.streams_rays(), p.batches == RayBatchPath::Streams);
         }
         std::vector<std::vector<Hit<float>>> hits;

@@ -107,6 +107,17 @@ struct alignas(16) SlabConstants {
     }
 };
 
+/// Whether a hit at t on triangle `slot` replaces the closest hit so far (best_t on triangle
+/// best_slot), for a hit the test found within the range, so t <= best_t. At an equal t the lower
+/// triangle index wins: the closest hit is then the least (t, index) of the triangles the ray
+/// meets, whatever order the leaves are tested in, so a walk that visits them in another order
+/// (the packets of query/ray_octant_stream.hpp) answers as the one-ray walk does. Both visit
+/// every leaf whose box the ray meets at or before the closest t (their pops drop only entries
+/// strictly beyond it), so both test the winner.
+inline bool closer_hit(float t, std::uint32_t slot, float best_t, std::uint32_t best_slot) {
+    return t < best_t || slot < best_slot;
+}
+
 }  // namespace detail
 #endif
 }  // namespace bvhkit

@@ -52,16 +52,23 @@ struct ClosestLeaves {
     int& hit_lane;
     Stats& stats;
 
-    /// A hit in group g becomes the closest so far, and the range shrinks to it.
+    /// A hit in group g becomes the closest so far, and the range shrinks to it; at the closest
+    /// so far's own t the lower triangle index is kept (closer_hit).
     auto record(std::uint32_t g) {
         return [this, g](int lane, const TriangleHit<float>& h) {
+            if (hit_group != nullptr && h.t == best.t &&
+                !closer_hit(h.t, groups[g].slot[lane], best.t, hit_group->slot[hit_lane]))
+                [[unlikely]]
+                return best.t;
             best = h;
             hit_group = groups + g;
             hit_lane = lane;
             return h.t;
         };
     }
-    bool operator()(std::uint32_t first, std::uint32_t count) {
+    // Inlined into the walk: the tie rule in record() takes it past GCC's inlining budget, and a
+    // call per leaf costs more than the rule.
+    [[gnu::always_inline]] bool operator()(std::uint32_t first, std::uint32_t count) {
         const WatertightRayLanes<Group::lanes> lanes(prep);
         for (std::uint32_t g = first; g < first + count; ++g) {
             count_lanes(groups[g], stats);

@@ -143,9 +143,6 @@ class RayBatches {
                         std::to_string(rays) + " rays");
     }
 
-  private:
-    const Tree& tree() const { return static_cast<const Tree&>(*this); }
-
     /// Runs chunk(rays, out) over chunks of batch_grain on the executor's threads.
     template <class Out, class Chunk>
     static void for_each(std::span<const Ray<T, 3>> rays, std::span<Out> out, const Executor& exec,
@@ -155,6 +152,9 @@ class RayBatches {
             chunk(rays.subspan(b, e - b), out.subspan(b, e - b));
         });
     }
+
+  private:
+    const Tree& tree() const { return static_cast<const Tree&>(*this); }
 };
 
 }  // namespace bvhkit

@@ -7,15 +7,18 @@
 // The paths: a ray the wide walk does not serve (query/ray_wide.hpp, wide_ray_usable) takes the
 // binary tree; one that misses the tree's bounds is a miss without a walk; the others walk the
 // wide layout, four or eight wide. Batches on the eight-wide layout may walk several rays at once
-// (streams, query/ray_stream.hpp; octant streams for occlusion, query/ray_octant_stream.hpp),
-// chosen by the layout's size (tuning.hpp) or forced by RayBatchPath. Every path gives the
-// one-ray calls' answers, bit for bit.
+// (streams, query/ray_stream.hpp; octant streams for occlusion and packets of coherent rays for
+// closest hits, query/ray_octant_stream.hpp), chosen by the layout's size (tuning.hpp) and, for
+// packets, by the rays themselves (query/ray_coherence.hpp), or forced by RayBatchPath. Every
+// path gives the one-ray calls' answers, bit for bit.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
 
 #include "bvhkit/error.hpp"
+#include "bvhkit/query/ray_coherence.hpp"
 #include "bvhkit/query/ray_octant_stream.hpp"
 #include "bvhkit/query/ray_stream.hpp"
 #include "bvhkit/query/ray_wide.hpp"
@@ -27,20 +30,40 @@ namespace bvhkit {
 /// layout. Every choice answers as the one-ray calls do, bit for bit; the choice is for tests,
 /// which must run every path whatever the mesh's size, and for measuring.
 enum class RayBatchPath {
-    Auto,           // by the layout's size (tuning.hpp): trace batches in streams from 2 MB on,
-                    // occlusion batches in octant streams below 8 MB and in streams above
+    Auto,           // trace batches: each run of 32 rays (8 or more at a batch's end) that
+                    // coherent_rays accepts as a packet, the others one by one, or in streams
+                    // from 2 MB of layout on (tuning.hpp); occlusion
+                    // batches in octant streams below 8 MB and in streams above
     OneByOne,       // each ray walks alone, as closest_hit / any_hit
     Streams,        // eight rays in flight (query/ray_stream.hpp); needs the eight-wide layout
     OctantStreams,  // occlusion batches in octant streams (query/ray_octant_stream.hpp), trace
                     // batches as Auto; needs the eight-wide layout
+    Packets,        // trace and occlusion batches in octant streams, whatever the rays (for
+                    // coherent rays: query/ray_octant_stream.hpp); needs the eight-wide layout
 };
+
+/// The name of a RayBatchPath, for messages.
+inline const char* batch_path_name(RayBatchPath path) {
+    switch (path) {
+        case RayBatchPath::Auto:
+            return "Auto";
+        case RayBatchPath::OneByOne:
+            return "OneByOne";
+        case RayBatchPath::Streams:
+            return "Streams";
+        case RayBatchPath::OctantStreams:
+            return "OctantStreams";
+        case RayBatchPath::Packets:
+            return "Packets";
+    }
+    return "?";
+}
 
 /// An Error unless a tree whose rays walk `ray_width` wide can take `path`: the streams need the
 /// eight-wide layout (RayLayout Auto or Wide8 on a CPU with AVX2).
 inline void check_batch_path(RayBatchPath path, int ray_width, const char* what) {
-    if ((path == RayBatchPath::Streams || path == RayBatchPath::OctantStreams) && ray_width != 8)
-        throw Error(std::string(what) + ": RayBatchPath::" +
-                    (path == RayBatchPath::Streams ? "Streams" : "OctantStreams") +
+    if (path != RayBatchPath::Auto && path != RayBatchPath::OneByOne && ray_width != 8)
+        throw Error(std::string(what) + ": RayBatchPath::" + batch_path_name(path) +
                     " needs the eight-wide ray layout, and this tree's rays walk " +
                     std::to_string(ray_width) +
                     " wide (the eight-wide walk needs a CPU with AVX2, the watertight test and "
@@ -123,22 +146,20 @@ class WideTriangleRays {
             walk(wide8_);
     }
 
-    /// hits[i] = closest_hit(rays[i]); the spans are of one length.
-    void trace_on_calling_thread(std::span<const Ray<float, 3>> rays,
-                                 std::span<Hit<float>> hits) const {
+    /// hits[i] = closest_hit(rays[i]); the spans are of one length. On the eight-wide layout,
+    /// Auto walks each run of octant_stream_size rays that coherent_rays accepts as a packet
+    /// (query/ray_octant_stream.hpp), the others as before; `packets` (or RayBatchPath::Packets)
+    /// walks every run as packets.
+    void trace_on_calling_thread(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits,
+                                 bool packets = false) const {
 #if BVHKIT_RAY_AVX2
-        if (streams_traces()) {
-            stream<false>(
-                rays,
-                [&](const detail::StreamRay& s) {
-                    hits[s.index] =
-                        s.hit_group ? wide_hit(s.best, *s.hit_group, s.hit_lane) : Hit<float>{};
-                },
-                [&](std::size_t i) { hits[i] = closest_hit(rays[i], NoStats{}); });
+        if (!wide8_.empty() &&
+            (packets || path_ == RayBatchPath::Packets || path_ == RayBatchPath::Auto)) {
+            trace_in_packets(rays, hits, packets || path_ == RayBatchPath::Packets);
             return;
         }
 #endif
-        for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], NoStats{});
+        trace_one_way(rays, hits);
     }
 
     /// occluded[i] = any_hit(rays[i]) (1 or 0); the spans are of one length.
@@ -147,7 +168,7 @@ class WideTriangleRays {
 #if BVHKIT_RAY_AVX2
         if (!wide8_.empty() && path_ != RayBatchPath::OneByOne) {
             const bool octants =
-                path_ == RayBatchPath::OctantStreams ||
+                path_ == RayBatchPath::OctantStreams || path_ == RayBatchPath::Packets ||
                 (path_ == RayBatchPath::Auto && detail::octant_streams_pay(wide8_));
             if (octants)
                 occlude_in_octants(rays, occluded);
@@ -163,6 +184,24 @@ class WideTriangleRays {
     }
 
   private:
+    /// The trace batch's rays in streams (when streams_traces()) or one by one.
+    void trace_one_way(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits) const {
+        if (rays.empty()) return;
+#if BVHKIT_RAY_AVX2
+        if (streams_traces()) {
+            stream<false>(
+                rays,
+                [&](const detail::StreamRay& s) {
+                    hits[s.index] =
+                        s.hit_group ? wide_hit(s.best, *s.hit_group, s.hit_lane) : Hit<float>{};
+                },
+                [&](std::size_t i) { hits[i] = closest_hit(rays[i], NoStats{}); });
+            return;
+        }
+#endif
+        for (std::size_t i = 0; i < rays.size(); ++i) hits[i] = closest_hit(rays[i], NoStats{});
+    }
+
     /// A wide walk's hit as a Hit: the group holds the triangle's index and a copy of its corners
     /// (the same normal as the binary walk's, from the line just tested).
     template <class Group>
@@ -212,12 +251,69 @@ class WideTriangleRays {
         detail::stream8<AnyHit>(wide8_, slots, start, finish);
     }
 
+    // Closest hits in packets of one octant (query/ray_octant_stream.hpp), a run of
+    // octant_stream_size rays at a time: every run (`every_run`), or those packet_run accepts,
+    // the others as trace_one_way. The rays the wide walk does not take go one by one.
+    void trace_in_packets(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits,
+                          bool every_run) const {
+        // The streams are made at the first packet: a batch of a few rays, or of incoherent
+        // ones, makes none.
+        for (std::size_t b = 0; b < rays.size(); b += detail::octant_stream_size)
+            if (every_run || packet_run(rays, b)) {
+                trace_one_way(rays.first(b), hits.first(b));
+                trace_packets_from(rays, hits, b, every_run);
+                return;
+            }
+        trace_one_way(rays, hits);
+    }
+
+    /// Whether the run of rays from b walks as a packet when the batch path chooses: 8 rays or
+    /// more (a batch's tail, or a batch of one, shares too little to pay) that coherent_rays
+    /// accepts.
+    bool packet_run(std::span<const Ray<float, 3>> rays, std::size_t b) const {
+        const std::size_t n = detail::octant_stream_size;
+        const std::size_t count = std::min(n, rays.size() - b);
+        return count >= n / 4 &&
+               coherent_rays(rays.subspan(b, count), binary_.bvh().nodes[0].bounds);
+    }
+
+    /// trace_in_packets from `first`, the start of a run that walks as a packet.
+    void trace_packets_from(std::span<const Ray<float, 3>> rays, std::span<Hit<float>> hits,
+                            std::size_t first, bool every_run) const {
+        const auto done = [&](const detail::OctantStream& s, int r, bool found) {
+            hits[s.index[r]] =
+                found ? wide_hit(s.best[r], *s.hit_group[r], s.hit_lane[r]) : Hit<float>{};
+        };
+        detail::OctantStreams<false> streams;
+        detail::SlabConstants k;
+        const std::size_t n = detail::octant_stream_size;
+        std::size_t rest = first;  // the first ray neither in a packet nor traced
+        for (std::size_t b = first; b < rays.size(); b += n) {
+            if (b != first && !every_run && !packet_run(rays, b)) continue;
+            trace_one_way(rays.subspan(rest, b - rest), hits.subspan(rest, b - rest));
+            const std::size_t count = std::min(n, rays.size() - b);
+            rest = b + count;
+            for (std::size_t i = b; i < b + count; ++i) {
+                const Ray<float, 3>& ray = rays[i];
+                const Route route = route_wide(ray, k);
+                if (route == Route::Walk)
+                    streams.add(wide8_, ray, k, i, done);
+                else
+                    hits[i] = route == Route::Binary ? binary_.closest_hit(ray) : Hit<float>{};
+            }
+        }
+        trace_one_way(rays.subspan(rest), hits.subspan(rest));
+        streams.finish(wide8_, done);
+    }
+
     // Occlusion rays in octant streams (query/ray_octant_stream.hpp); those the wide walk does not
     // take go one by one.
     void occlude_in_octants(std::span<const Ray<float, 3>> rays,
                             std::span<std::uint8_t> occluded) const {
-        const auto blocked = [&](std::size_t i, bool b) { occluded[i] = b ? 1 : 0; };
-        detail::OctantStreams streams;
+        const auto blocked = [&](const detail::OctantStream& s, int r, bool b) {
+            occluded[s.index[r]] = b ? 1 : 0;
+        };
+        detail::OctantStreams<true> streams;
         detail::SlabConstants k;
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray<float, 3>& ray = rays[i];
