@@ -4,8 +4,8 @@
 
 #include <set>
 
-#include "bvhkit/bvh/min_heap.hpp"
 #include "bvhkit/math/random.hpp"
+#include "bvhkit/walk/min_heap.hpp"
 
 using namespace bvhkit;
 

@@ -1,7 +1,7 @@
 #pragma once
 // The dynamic tree's queries, written against a read-only view of its arrays: box overlap, point,
 // ray cast, box cast and tree against tree. None recurses: box and point queries walk on
-// walk_depth_first and tree against tree on walk_pairs (bvh/walks.hpp), with a SmallStack (on the
+// walk_depth_first and tree against tree on walk_pairs (walk/walks.hpp), with a SmallStack (on the
 // caller's frame); the casts keep their own loop, whose stack entries carry the entry fraction
 // that lets a shortened segment drop them. Leaves are reported when the proxy's own (tight) box
 // passes the test; the fat boxes in the nodes only steer the descent.
@@ -12,10 +12,10 @@
 #include <type_traits>
 #include <utility>
 
-#include "bvhkit/bvh/walks.hpp"
 #include "bvhkit/dynamic/small_stack.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
 #include "bvhkit/math/ray.hpp"
+#include "bvhkit/walk/walks.hpp"
 
 namespace bvhkit::dynamic_detail {
 
@@ -26,7 +26,7 @@ struct TreeView {
     std::int32_t root;
 };
 
-/// The tree's shape as a NodeView (bvh/walks.hpp), for the walk skeletons. Its depth has no bound,
+/// The tree's shape as a NodeView (walk/walks.hpp), for the walk skeletons. Its depth has no bound,
 /// so the walks run on a SmallStack, which grows past its inline entries.
 template <class T, std::size_t N>
 struct DynamicNodes {
