@@ -96,15 +96,6 @@ struct RayRef {
     T t0, t1;
 };
 
-template <class T, std::size_t N>
-struct RayNodes {
-    using Ref = RayRef<T>;
-    const BspNode<T, N>* nodes;
-    Ref root_ref;
-    Ref root() const { return root_ref; }
-    bool is_leaf(const Ref& r) const { return nodes[r.node].is_leaf(); }
-};
-
 }  // namespace bsp_detail
 
 /// The closest polygon the ray meets in [ray.tmin, ray.tmax]; a miss for a ray that is not
@@ -183,8 +174,8 @@ BspHit<T> closest_hit(const BspTree<T, N>& tree, const Ray<T, N>& ray,
         return true;
     };
     bsp_detail::BspTraversalStack<Ref> stack(tree.statistics().depth + 2);
-    walk_depth_first(bsp_detail::RayNodes<T, N>{nodes.data(), {0, ray.tmin, ray.tmax}}, stack,
-                     enter, on_leaf, open);
+    walk_depth_first(CarryingNodes<BspNode<T, N>, Ref>{nodes.data(), {0, ray.tmin, ray.tmax}},
+                     stack, enter, on_leaf, open);
     if (stats) {
         stats->nodes_visited += visited;
         stats->polygons_tested += tested;

@@ -117,17 +117,6 @@ struct CastRef {
     T entry;
 };
 
-/// The tree's shape as a NodeView whose handles carry their entry fraction: a cast opens the nodes
-/// itself (it clips both children before choosing).
-template <class T, std::size_t N>
-struct CastNodes {
-    using Ref = CastRef<T>;
-    const Node<T, N>* nodes;
-    Ref root_ref;
-    Ref root() const { return root_ref; }
-    bool is_leaf(const Ref& r) const { return nodes[r.node].is_leaf(); }
-};
-
 /// Ray (or box) cast of `in` (every box grown by in.half_extent: zero for a ray, the cast box's
 /// half extents for a box cast) along `seg`, its slab form. The callback is either
 /// callback(ProxyId, T max_fraction) or callback(const CastInput&, ProxyId), returning T, as games
@@ -192,7 +181,8 @@ void cast(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, CastInput<T,
         return true;
     };
     SmallStack<CastRef<T>> stack;
-    walk_depth_first(CastNodes<T, N>{t.nodes, {t.root, root_entry}}, stack, enter, on_leaf, open);
+    walk_depth_first(CarryingNodes<Node<T, N>, CastRef<T>>{t.nodes, {t.root, root_entry}}, stack,
+                     enter, on_leaf, open);
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
 }
 

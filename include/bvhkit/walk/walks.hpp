@@ -62,6 +62,18 @@ concept BinaryNodeView = NodeView<V> && requires(const V& v, typename V::Ref r) 
     { v.child(r, 0) } -> std::same_as<typename V::Ref>;
 };
 
+/// A NodeView over one array of nodes whose handles carry what the walk knows of each node: Ref has
+/// a member `node` (the index into `nodes`, whose elements have is_leaf()), and the walk starts at
+/// `start`. For walks that open nodes themselves (an opener, below).
+template <class Node, class R>
+struct CarryingNodes {
+    using Ref = R;
+    const Node* nodes;
+    Ref start;
+    constexpr Ref root() const { return start; }
+    constexpr bool is_leaf(const Ref& r) const { return nodes[r.node].is_leaf(); }
+};
+
 enum class FirstChild { Left, Right };
 
 /// When a depth-first walk asks enter(): as it reaches a node (OnEntry), or for both children of
