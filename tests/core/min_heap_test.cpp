@@ -1,4 +1,4 @@
-// MinHeap4 (query/min_heap.hpp) against a sorted multiset: random interleavings of pushes and pops,
+// MinHeap4 (walk/min_heap.hpp) against a sorted multiset: random interleavings of pushes and pops,
 // with many equal keys, always pop the least key, and every pushed entry comes out exactly once.
 #include <gtest/gtest.h>
 
