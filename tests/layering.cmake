@@ -8,7 +8,7 @@
 #   0 error.hpp version.hpp tuning.hpp simd
 #   1 math exec
 #   2 primitives
-#   3 volumes
+#   3 volumes walk
 #   4 bvh bsp convex
 #   5 build
 #   6 dynamic query
@@ -24,6 +24,7 @@ set(rank_exec 1)
 set(rank_simd 0)
 set(rank_primitives 2)
 set(rank_volumes 3)
+set(rank_walk 3)
 set(rank_bvh 4)
 set(rank_bsp 4)
 set(rank_convex 4)

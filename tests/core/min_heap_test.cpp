@@ -1,11 +1,11 @@
-// MinHeap4 (query/min_heap.hpp) against a sorted multiset: random interleavings of pushes and pops,
+// MinHeap4 (walk/min_heap.hpp) against a sorted multiset: random interleavings of pushes and pops,
 // with many equal keys, always pop the least key, and every pushed entry comes out exactly once.
 #include <gtest/gtest.h>
 
 #include <set>
 
-#include "bvhkit/bvh/min_heap.hpp"
 #include "bvhkit/math/random.hpp"
+#include "bvhkit/walk/min_heap.hpp"
 
 using namespace bvhkit;
 

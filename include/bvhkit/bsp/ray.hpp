@@ -2,7 +2,8 @@
 // The closest hit of a ray among a BSP's polygons: front-to-back along the ray. At a node the
 // segment [t0, t1] is cut into the parts on each side of the thick splitter plane; the side holding
 // the ray's start is visited first, and the far side is skipped once a hit lies before the point
-// where the ray enters it (polygons there lie wholly on that side of the thick plane).
+// where the ray enters it (polygons there lie wholly on that side of the thick plane). The walk is
+// walk_depth_first (walk/walks.hpp) over nodes that carry their part of the segment.
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -13,6 +14,7 @@
 #include "bvhkit/bsp/stack.hpp"
 #include "bvhkit/math/ray.hpp"
 #include "bvhkit/primitives/hit.hpp"
+#include "bvhkit/walk/walks.hpp"
 
 namespace bvhkit {
 
@@ -85,6 +87,17 @@ bool intersect_polygon(const Ray<T, 2>& ray, std::span<const Vec<T, 2>> v, const
     return true;
 }
 
+namespace bsp_detail {
+
+/// A node of the ray walk and the part [t0, t1] of the segment in its cell.
+template <class T>
+struct RayRef {
+    std::uint32_t node;
+    T t0, t1;
+};
+
+}  // namespace bsp_detail
+
 /// The closest polygon the ray meets in [ray.tmin, ray.tmax]; a miss for a ray that is not
 /// traceable (math/ray.hpp). Ties go to the polygon found first.
 template <class T, std::size_t N>
@@ -92,16 +105,10 @@ BspHit<T> closest_hit(const BspTree<T, N>& tree, const Ray<T, N>& ray,
                       BspRayStats* stats = nullptr) {
     BspHit<T> best;
     if (!is_traceable(ray)) return best;
-    struct Entry {
-        std::uint32_t node;
-        T t0, t1;
-    };
     const auto& nodes = tree.nodes();
     const auto& pool = tree.polygons();
     // Twice the build's thickness: the traversal's distances round differently from the build's.
     const T eps = T(2) * tree.epsilon();
-    bsp_detail::BspTraversalStack<Entry> stack(tree.statistics().depth + 2);
-    stack.push({0, ray.tmin, ray.tmax});
     std::size_t visited = 0, tested = 0;
     // tmax is inclusive in the caller's ray: test up to just past it, then drop a hit beyond.
     const T limit = std::nextafter(ray.tmax, std::numeric_limits<T>::infinity());
@@ -118,19 +125,23 @@ BspHit<T> closest_hit(const BspTree<T, N>& tree, const Ray<T, N>& ray,
             }
         }
     };
-    while (!stack.empty()) {
-        const Entry e = stack.pop();
-        if (e.t0 > best_t) continue;
+    using Ref = bsp_detail::RayRef<T>;
+    // A part that starts beyond the closest hit so far holds nothing nearer.
+    const auto enter = [&](const Ref& r) {
+        if (r.t0 > best_t) return false;
         ++visited;
-        const BspNode<T, N>& n = nodes[e.node];
-        if (n.is_leaf()) {
-            test_range(n.first, n.count);
-            continue;
-        }
+        return true;
+    };
+    const auto on_leaf = [&](const Ref& r) {
+        test_range(nodes[r.node].first, nodes[r.node].count);
+        return true;
+    };
+    const auto open = [&](Ref& r, bsp_detail::BspTraversalStack<Ref>& stack) -> bool {
+        const BspNode<T, N>& n = nodes[r.node];
         const T d0 = n.plane.distance(ray.origin);
         const T dn = dot(n.plane.normal, ray.direction);
         // The parts of [t0, t1] where the ray is in front (d >= -eps) and behind (d <= eps).
-        T f0 = e.t0, f1 = e.t1, b0 = e.t0, b1 = e.t1;
+        T f0 = r.t0, f1 = r.t1, b0 = r.t0, b1 = r.t1;
         if (dn == T(0)) {
             if (d0 < -eps) f1 = -std::numeric_limits<T>::infinity();
             if (d0 > eps) b1 = -std::numeric_limits<T>::infinity();
@@ -148,17 +159,23 @@ BspHit<T> closest_hit(const BspTree<T, N>& tree, const Ray<T, N>& ray,
         // The node's polygons lie where both parts meet (the slab |d| <= eps).
         if (n.count && front_ok && back_ok && std::max(f0, b0) <= std::min(f1, b1))
             test_range(n.first, n.count);
-        // The side the segment is in first goes on top (the one the ray leaves on ties).
+        // The side the segment is in first is gone on with (the one the ray leaves on ties).
         const bool front_first = f0 < b0 || (f0 == b0 && dn < T(0));
-        const Entry front{n.front, f0, f1}, back{n.back, b0, b1};
-        if (front_first) {
-            if (back_ok) stack.push(back);
-            if (front_ok) stack.push(front);
-        } else {
-            if (front_ok) stack.push(front);
-            if (back_ok) stack.push(back);
+        const Ref front{n.front, f0, f1}, back{n.back, b0, b1};
+        const bool first_ok = front_first ? front_ok : back_ok;
+        const bool second_ok = front_first ? back_ok : front_ok;
+        if (first_ok) {
+            if (second_ok) stack.push(front_first ? back : front);
+            r = front_first ? front : back;
+            return true;
         }
-    }
+        if (!second_ok) return false;
+        r = front_first ? back : front;
+        return true;
+    };
+    bsp_detail::BspTraversalStack<Ref> stack(tree.statistics().depth + 2);
+    walk_depth_first(CarryingNodes<BspNode<T, N>, Ref>{nodes.data(), {0, ray.tmin, ray.tmax}},
+                     stack, enter, on_leaf, open);
     if (stats) {
         stats->nodes_visited += visited;
         stats->polygons_tested += tested;

@@ -23,6 +23,7 @@ class BspTraversalStack {
     void push(const E& e) { data_[size_++] = e; }
     E pop() { return data_[--size_]; }
     bool empty() const { return size_ == 0; }
+    void clear() { size_ = 0; }
 
   private:
     E inline_[inline_capacity];

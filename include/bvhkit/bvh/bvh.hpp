@@ -62,6 +62,23 @@ BvhView<Volume> bvh_view(const Bvh<Volume>& bvh) {
     return {bvh.nodes, bvh.primitive_indices};
 }
 
+/// A Bvh's nodes as a BinaryNodeView (walk/walks.hpp) for the walk skeletons: a node by its
+/// index, the root at 0, an inner node's children at left() and left() + 1.
+template <class Node>
+struct BvhNodes {
+    using Ref = std::uint32_t;
+    const Node* nodes;
+    constexpr Ref root() const { return 0; }
+    constexpr bool is_leaf(Ref r) const { return nodes[r].is_leaf(); }
+    constexpr Ref child(Ref r, unsigned k) const { return nodes[r].left() + k; }
+    constexpr const Node& node(Ref r) const { return nodes[r]; }
+};
+
+template <class Node>
+BvhNodes<Node> bvh_nodes(std::span<const Node> nodes) {
+    return {nodes.data()};
+}
+
 template <class T, std::size_t N>
 using AabbBvh = Bvh<Aabb<T, N>>;
 using Bvh2f = AabbBvh<float, 2>;

@@ -1,5 +1,5 @@
 #pragma once
-// traverse_depth_first: walk_depth_first (bvh/walks.hpp) over a Bvh's nodes, handing the callbacks
+// traverse_depth_first: walk_depth_first (walk/walks.hpp) over a Bvh's nodes, handing the callbacks
 // the node as well as its index: `enter(index, node)` says whether the walk goes into a node (the
 // root included); a leaf it goes into is handed to `on_leaf(node)`, which returns false to stop
 // the whole walk. FirstChild says which child is entered first; the nodes are entered in the
@@ -14,7 +14,8 @@
 #include <span>
 
 #include "bvhkit/bvh/bvh.hpp"
-#include "bvhkit/bvh/walks.hpp"
+#include "bvhkit/bvh/traversal_stack.hpp"
+#include "bvhkit/walk/walks.hpp"
 
 namespace bvhkit {
 

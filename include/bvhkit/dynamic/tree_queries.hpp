@@ -1,10 +1,10 @@
 #pragma once
 // The dynamic tree's queries, written against a read-only view of its arrays: box overlap, point,
-// ray cast, box cast and tree against tree. None recurses: box and point queries walk on
-// walk_depth_first and tree against tree on walk_pairs (bvh/walks.hpp), with a SmallStack (on the
-// caller's frame); the casts keep their own loop, whose stack entries carry the entry fraction
-// that lets a shortened segment drop them. Leaves are reported when the proxy's own (tight) box
-// passes the test; the fat boxes in the nodes only steer the descent.
+// ray cast, box cast and tree against tree. None recurses: box and point queries and the casts walk
+// on walk_depth_first and tree against tree on walk_pairs (walk/walks.hpp), with a SmallStack (on
+// the caller's frame); a cast's node handles carry the entry fraction that lets a shortened
+// segment drop them. Leaves are reported when the proxy's own (tight) box passes the test; the fat
+// boxes in the nodes only steer the descent.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -12,10 +12,10 @@
 #include <type_traits>
 #include <utility>
 
-#include "bvhkit/bvh/walks.hpp"
 #include "bvhkit/dynamic/small_stack.hpp"
 #include "bvhkit/dynamic/tree_types.hpp"
 #include "bvhkit/math/ray.hpp"
+#include "bvhkit/walk/walks.hpp"
 
 namespace bvhkit::dynamic_detail {
 
@@ -26,7 +26,7 @@ struct TreeView {
     std::int32_t root;
 };
 
-/// The tree's shape as a NodeView (bvh/walks.hpp), for the walk skeletons. Its depth has no bound,
+/// The tree's shape as a NodeView (walk/walks.hpp), for the walk skeletons. Its depth has no bound,
 /// so the walks run on a SmallStack, which grows past its inline entries.
 template <class T, std::size_t N>
 struct DynamicNodes {
@@ -110,6 +110,13 @@ struct CastSegment {
     }
 };
 
+/// A node of a cast's walk and where the segment enters its box (a fraction of it).
+template <class T>
+struct CastRef {
+    std::int32_t node;
+    T entry;
+};
+
 /// Ray (or box) cast of `in` (every box grown by in.half_extent: zero for a ray, the cast box's
 /// half extents for a box cast) along `seg`, its slab form. The callback is either
 /// callback(ProxyId, T max_fraction) or callback(const CastInput&, ProxyId), returning T, as games
@@ -128,50 +135,54 @@ void cast(const TreeView<T, N, U>& t, const CastSegment<T, N>& seg, CastInput<T,
     const Vec<T, N> pad = in.half_extent;
     T& max_fraction = in.max_fraction;
     std::uint64_t visited = 1, tested = 0;
-    struct Pending {
-        std::int32_t node;
-        T entry;
-    };
     const T root_entry = seg.entry(t.nodes[t.root].box, pad, max_fraction);
     if (root_entry < T(0)) {
         if (stats) stats->nodes_visited += visited;
         return;
     }
-    SmallStack<Pending> stack;
-    stack.push({t.root, root_entry});
-    while (!stack.empty()) {
-        const Pending p = stack.pop();
-        if (p.entry > max_fraction) continue;  // clipped away since it was pushed
-        const Node<T, N>& n = t.nodes[p.node];
-        if (n.is_leaf()) {
-            ++tested;
-            if (seg.entry(t.proxies[n.value()].box, pad, max_fraction) < T(0)) continue;
-            T value;
-            if constexpr (std::is_invocable_v<F&, const CastInput<T, N>&, ProxyId>)
-                value = callback(std::as_const(in), proxy_id(t, n.value()));
-            else
-                value = callback(proxy_id(t, n.value()), max_fraction);
-            if (value == T(0)) break;
-            // A value above the current max leaves it: subtrees beyond it were dropped at push.
-            if (value > T(0)) max_fraction = std::min(max_fraction, value);
-            continue;
-        }
+    // A node stays pending with the fraction where the segment enters its box: popped after the
+    // segment was clipped short of that, it is dropped.
+    const auto enter = [&](const CastRef<T>& r) { return !(r.entry > max_fraction); };
+    const auto on_leaf = [&](const CastRef<T>& r) {
+        ++tested;
+        const std::int32_t slot = t.nodes[r.node].value();
+        if (seg.entry(t.proxies[slot].box, pad, max_fraction) < T(0)) return true;
+        T value;
+        if constexpr (std::is_invocable_v<F&, const CastInput<T, N>&, ProxyId>)
+            value = callback(std::as_const(in), proxy_id(t, slot));
+        else
+            value = callback(proxy_id(t, slot), max_fraction);
+        if (value == T(0)) return false;
+        // A value above the current max leaves it: subtrees beyond it were dropped at push.
+        if (value > T(0)) max_fraction = std::min(max_fraction, value);
+        return true;
+    };
+    // Both children clipped; the nearer (by entry fraction) is gone on with, the farther pushed.
+    const auto open = [&](CastRef<T>& r, SmallStack<CastRef<T>>& stack) -> bool {
+        const Node<T, N>& n = t.nodes[r.node];
         visited += 2;
         const T e1 = seg.entry(t.nodes[n.child1].box, pad, max_fraction);
         const T e2 = seg.entry(t.nodes[n.child2].box, pad, max_fraction);
-        // The farther child goes on the stack first, so the nearer is popped next.
         const bool first_is_1 = e1 <= e2;
-        const Pending near{first_is_1 ? n.child1 : n.child2, first_is_1 ? e1 : e2};
-        const Pending far{first_is_1 ? n.child2 : n.child1, first_is_1 ? e2 : e1};
+        const CastRef<T> near{first_is_1 ? n.child1 : n.child2, first_is_1 ? e1 : e2};
+        const CastRef<T> far{first_is_1 ? n.child2 : n.child1, first_is_1 ? e2 : e1};
         if (far.entry >= T(0)) {
+            if (near.entry < T(0)) {
+                r = far;
+                prefetch_next(t, t.nodes[far.node]);
+                return true;
+            }
             stack.push(far);
             prefetch_next(t, t.nodes[far.node]);
         }
-        if (near.entry >= T(0)) {
-            stack.push(near);
-            prefetch_next(t, t.nodes[near.node]);
-        }
-    }
+        if (near.entry < T(0)) return false;
+        r = near;
+        prefetch_next(t, t.nodes[near.node]);
+        return true;
+    };
+    SmallStack<CastRef<T>> stack;
+    walk_depth_first(CarryingNodes<Node<T, N>, CastRef<T>>{t.nodes, {t.root, root_entry}}, stack,
+                     enter, on_leaf, open);
     if (stats) stats->nodes_visited += visited, stats->leaves_tested += tested;
 }
 

@@ -21,10 +21,10 @@
 #include <span>
 #include <vector>
 
-#include "bvhkit/bvh/walks.hpp"
 #include "bvhkit/math/wide_length.hpp"
 #include "bvhkit/primitives/triangle_distance.hpp"
 #include "bvhkit/query/pairs_model.hpp"
+#include "bvhkit/walk/walks.hpp"
 
 namespace bvhkit {
 

@@ -94,7 +94,7 @@ T prune_radius2(const Distance& distance, const Vec<T, N>& p, K radius2) {
         return round_up_key<T>(radius2);
 }
 
-/// The best-first walk (walk_best_first, bvh/walks.hpp). `radius2()` is the current squared search
+/// The best-first walk (walk_best_first, walk/walks.hpp). `radius2()` is the current squared search
 /// radius (it shrinks as on_slot(slot, d2) finds closer primitives).
 template <class T, std::size_t N, class Radius, class OnSlot, class Stats>
 void best_first(const Bvh<Aabb<T, N>>& bvh, const Vec<T, N>& p, NearestScratch<T>& scratch,

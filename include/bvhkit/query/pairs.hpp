@@ -4,7 +4,7 @@
 // test under a pose, volumes/*.hpp); nothing of B is copied or transformed ahead of time.
 //
 // Iterative with an explicit stack of node pairs, each pushed only after its volumes were found to
-// overlap. Its own loop, not walk_pairs (bvh/walks.hpp): on that skeleton it took more
+// overlap. Its own loop, not walk_pairs (walk/walks.hpp): on that skeleton it took more
 // instructions on OBB and RSS (docs/benchmarks.md, "Walk skeletons"). Which node of a pair to open
 // is the descent rule (the usual choices of tree-vs-tree collision):
 //   Larger        open the node with the larger volume (default; keeps the pair balanced)

@@ -4,13 +4,13 @@
 // by construction and are left out; a mesh whose copies of one corner are separate vertices
 // (unwelded) reports its neighbours, so weld it first.
 //
-// The traversal is walk_pairs (bvh/walks.hpp), the tree against itself, in one frame: a node paired
-// with itself opens into its children's self pairs and the pair of its two children; each unordered
-// pair of triangles is tested once.
+// The traversal is walk_pairs (walk/walks.hpp), the tree against itself, in one frame: a node
+// paired with itself opens into its children's self pairs and the pair of its two children; each
+// unordered pair of triangles is tested once.
 #include <algorithm>
 
-#include "bvhkit/bvh/walks.hpp"
 #include "bvhkit/query/pairs_model.hpp"
+#include "bvhkit/walk/walks.hpp"
 
 namespace bvhkit {
 

@@ -4,8 +4,9 @@
 // per axis and bound, so one SSE pass clips the ray against all four (Wald, Benthin and Boulos,
 // "Getting rid of packets", 2008; Dammertz et al., "Shallow bounding volume hierarchies", 2008).
 // A top level has one instance a leaf and its leaves cost a whole bottom-level walk each, so
-// its nodes are few and the walk is the simple one: the children hit are sorted by entry distance
-// and pushed farthest first; an entry beyond the closest hit so far is dropped when popped.
+// its nodes are few and the walk is the simple one, on walk_depth_first (walk/walks.hpp): the
+// children hit are sorted by entry distance, the nearest gone on with and the others pushed
+// farthest first; an entry beyond the closest hit so far is dropped when popped.
 //
 // The slab test is RaySlabData's (math/ray.hpp) lane by lane: the near and far planes chosen by
 // the direction's signs, the far distance scaled up by 1 + 2 gamma(3) (so rounding never loses a
@@ -14,15 +15,32 @@
 // a ray that ignores an axis (a subnormal component: NaN distances) cannot enter it.
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "bvhkit/bvh/bvh.hpp"
+#include "bvhkit/bvh/traversal_stack.hpp"
 #include "bvhkit/math/ray.hpp"
 #include "bvhkit/simd/simd.hpp"
+#include "bvhkit/walk/walks.hpp"
 
 namespace bvhkit::scene_detail {
 
 #if BVHKIT_SIMD
+
+/// A node or leaf of the top level (child >= 0: a node; < 0: ~ the leaf's index) and the entry
+/// distance of the ray into its box.
+struct TopRef {
+    std::int32_t child;
+    float entry;
+};
+
+/// The top level as a NodeView: the walk opens the nodes itself (four children clipped at once).
+struct TopNodes {
+    using Ref = TopRef;
+    Ref root() const { return {0, -std::numeric_limits<float>::infinity()}; }
+    bool is_leaf(const Ref& r) const { return r.child < 0; }
+};
 
 class WideTop4 {
   public:
@@ -55,55 +73,49 @@ class WideTop4 {
             near_row[a] = (slab.octant >> a) & 1u;  // 1: the near plane is the box's max
         }
         const F scale(far_scale);
-        struct Pending {
-            std::int32_t child;
-            float entry;
+        // Each node pushes at most three besides the one gone on with: depth of the collapsed
+        // tree times three, with room to spare (a binary top level is at most max_bvh_depth deep).
+        FixedStack<TopRef, 3 * max_bvh_depth + 4> stack;
+        // A subtree or leaf entered beyond the closest hit so far is dropped.
+        const auto enter = [&](const TopRef& r) { return !(r.entry > tmax); };
+        const auto leaf_walk = [&](const TopRef& r) {
+            const Leaf leaf = leaves_[std::size_t(~r.child)];
+            for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i)
+                if (on_leaf(primitives_[i])) return false;
+            return true;
         };
-        // Depth of the collapsed tree times three (each node pushes at most three besides the
-        // one walked next), with room to spare: a binary top level is at most max_bvh_depth deep.
-        Pending stack[3 * max_bvh_depth + 4];
-        int size = 0;
-        std::int32_t current = 0;
-        while (true) {
-            if (current >= 0) {
-                const Node& n = nodes_[std::size_t(current)];
-                F t0(ray.tmin), t1(tmax);
-                for (std::size_t a = 0; a < 3; ++a) {
-                    const F lo = F::load(n.bound[near_row[a]][a]);
-                    const F hi = F::load(n.bound[1 - near_row[a]][a]);
-                    const F tn = (lo - origin[a]) * inv[a];
-                    const F tf = (hi - origin[a]) * inv[a] * scale;
-                    // max and min return their second operand when either is NaN: a NaN
-                    // distance leaves the interval as it was.
-                    t0 = max(tn, t0);
-                    t1 = min(tf, t1);
-                }
-                unsigned hits = (t0 <= t1).bits() & n.mask;
-                alignas(16) float entry[4];
-                t0.store(entry);
-                Pending found[4];
-                int k = 0;
-                for (; hits; hits &= hits - 1) {
-                    const int lane = __builtin_ctz(hits);
-                    found[k++] = {n.child[lane], entry[lane]};
-                }
-                if (NearestFirst)  // insertion sort, farthest first
-                    for (int i = 1; i < k; ++i)
-                        for (int j = i; j > 0 && found[j - 1].entry < found[j].entry; --j)
-                            std::swap(found[j - 1], found[j]);
-                for (int i = 0; i < k; ++i) stack[size++] = found[i];
-            } else {
-                const Leaf leaf = leaves_[std::size_t(~current)];
-                for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i)
-                    if (on_leaf(primitives_[i])) return;
+        const auto open = [&](TopRef& r, decltype(stack)& pending) -> bool {
+            const Node& n = nodes_[std::size_t(r.child)];
+            F t0(ray.tmin), t1(tmax);
+            for (std::size_t a = 0; a < 3; ++a) {
+                const F lo = F::load(n.bound[near_row[a]][a]);
+                const F hi = F::load(n.bound[1 - near_row[a]][a]);
+                const F tn = (lo - origin[a]) * inv[a];
+                const F tf = (hi - origin[a]) * inv[a] * scale;
+                // max and min return their second operand when either is NaN: a NaN
+                // distance leaves the interval as it was.
+                t0 = max(tn, t0);
+                t1 = min(tf, t1);
             }
-            // The next pending subtree or leaf still within [tmin, tmax].
-            do {
-                if (size == 0) return;
-                --size;
-            } while (stack[size].entry > tmax);
-            current = stack[size].child;
-        }
+            unsigned hits = (t0 <= t1).bits() & n.mask;
+            if (!hits) return false;
+            alignas(16) float entry[4];
+            t0.store(entry);
+            TopRef found[4];
+            int k = 0;
+            for (; hits; hits &= hits - 1) {
+                const int lane = __builtin_ctz(hits);
+                found[k++] = {n.child[lane], entry[lane]};
+            }
+            if (NearestFirst)  // insertion sort, farthest first
+                for (int i = 1; i < k; ++i)
+                    for (int j = i; j > 0 && found[j - 1].entry < found[j].entry; --j)
+                        std::swap(found[j - 1], found[j]);
+            for (int i = 0; i < k - 1; ++i) pending.push(found[i]);
+            r = found[k - 1];
+            return true;
+        };
+        walk_depth_first(TopNodes{}, stack, enter, leaf_walk, open);
     }
 
   private:

@@ -1,5 +1,5 @@
 #pragma once
-// A 4-ary min-heap over a caller's vector: the heap of the best-first walk (bvh/walks.hpp).
+// A 4-ary min-heap over a caller's vector: the heap of the best-first walk (walk/walks.hpp).
 // Against std::push_heap/pop_heap on a binary heap it halves the levels a pop sifts through, and
 // the least of four children is found with selects rather than jumps: the comparisons of a
 // best-first walk are unpredictable, and their mispredictions were the largest single cost of a
