@@ -2,7 +2,8 @@
 // The speed settings of bvhkit, in one place. Each value here is chosen for time or memory, not
 // for correctness: another value in its stated range still gives a valid tree and queries that
 // decide the same. The builders' settings and the leaf limits do shape the tree, so where two
-// triangles are hit at the same t, which one a query names may change with them. Each line says
+// answers tie, which one a query names may change with them (not for rays: at an equal t every
+// walk names the triangle of lower index). Each line says
 // why the value is what it is and which bench shows it; the figures, with their dates and
 // machines, are in docs/benchmarks.md. The headers that use a value name it from here, under their
 // own names where they had one.

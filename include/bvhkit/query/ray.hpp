@@ -135,7 +135,13 @@ Hit<T, N> closest_hit(BvhView<Aabb<T, N>> bvh, const Ray<T, N>& ray_in, Test&& t
             for (std::uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
                 stats.primitive();
                 TriangleHit<T> h;
-                if (test(s, ray, h)) {
+                // The test takes t up to ray.tmax, the best t so far: at an equal t the lower
+                // primitive index is kept, the rule of every walk (closer_hit, ray_wide.hpp), so
+                // which of two triangles hit at one t is named does not depend on the walk.
+                if (test(s, ray, h) &&
+                    (best.slot == invalid_index || h.t < best.hit.t ||
+                     (h.t == best.hit.t &&
+                      bvh.primitive_indices[s] < bvh.primitive_indices[best.slot]))) {
                     ray.tmax = h.t;
                     best.hit = h;
                     best.slot = s;

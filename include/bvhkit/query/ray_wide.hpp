@@ -115,7 +115,7 @@ struct alignas(16) SlabConstants {
 /// every leaf whose box the ray meets at or before the closest t (their pops drop only entries
 /// strictly beyond it), so both test the winner.
 inline bool closer_hit(float t, std::uint32_t slot, float best_t, std::uint32_t best_slot) {
-    return t < best_t || slot < best_slot;
+    return t < best_t || (t == best_t && slot < best_slot);
 }
 
 }  // namespace detail
