@@ -80,9 +80,8 @@ inline constexpr double spatial_split_alpha = 1e-3;
 /// `bvhkit-bench rays MESH --high-quality`.
 inline constexpr std::uint32_t spatial_split_bins = 16;
 /// TriangleBvhOptions::auto_spatial_splits: the child overlap (build/spatial_split_choice.hpp)
-/// from which the spatial-split build is made. The scans, a city and a height field measure 0.11
-/// to 0.16, where spatial splits gained nothing; rooms and triangle soups 0.22 to 0.38, where
-/// random rays became 1.03 (a room of 50 objects) to 1.8 times as fast.
+/// from which the spatial-split build is made: scans, height fields and a city measure below, and
+/// gained nothing from spatial splits; rooms and triangle soups above, where they pay.
 /// `bvhkit-bench rays MESH` (rows bvhkit-auto).
 inline constexpr double spatial_splits_from_overlap = 0.2;
 /// Spatial splits: nodes of at most this many references try object splits only (spatial binning
@@ -97,13 +96,9 @@ inline constexpr std::uint32_t spatial_split_min_count = 8;
 inline constexpr std::uint32_t wide8_leaf_block = 8;
 inline constexpr std::uint32_t wide4_leaf_block = 4;
 /// Costs of the wide collapses (make_wide_ray_bvh, collapse_to_wide_sah): a wide node's test in
-/// units of one triangle group's test. A node costs far more than its instructions: it is a
-/// dependent load that misses the caches once the tree outgrows them, and a push and pop whose
-/// branches mispredict, where a leaf's groups lie side by side. Priced so, the scans' leaves hold
-/// about as many triangles as a fixed limit of 48 (four wide: 24) gives them, and fewer where
-/// boxes overlap. Random rays measured within 2% for 24 to 32 (eight wide) and 8 to 32 (four
-/// wide) on the scans, a city, a room and a soup; 16 was slower on a 1.3M-triangle sphere.
-/// `bvhkit-bench rays MESH`.
+/// units of one triangle group's test, high because a node is a dependent load that misses the
+/// caches once the tree outgrows them, where a leaf's groups lie side by side; lower costs made
+/// the large scans slower, higher ones the soups and rooms. `bvhkit-bench rays MESH`.
 inline constexpr double wide8_node_cost = 32;
 inline constexpr double wide4_node_cost = 16;
 /// The most triangles a leaf child of the wide collapses holds whatever the costs say: bounds a
