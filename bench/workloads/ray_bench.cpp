@@ -47,11 +47,12 @@ double earlier_ms(const std::vector<Row>& rows, const Row& like, const std::stri
 /// R2-mt and R3-mt: the batch API (trace, occluded) on every core against the peer's one-ray calls
 /// (Embree's rtcIntersect1 and rtcOccluded1) made from the same chunks on every core, and against
 /// its stream calls (rtcIntersect1M and rtcOccluded1M, flagged incoherent) on those chunks. The
-/// speedup is over the faster of the two.
+/// speedup is over the faster of the two. The rows name the tree `library`; the peers' own rows
+/// only with `peer_rows`.
 template <class RowFor>
-void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
-                    const std::vector<Ray3f>& rays, RowFor&& row_for, int repetitions,
-                    const PeerRay& peer, const PeerStream& peer_stream) {
+void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree, const char* library,
+                    bool peer_rows, const std::vector<Ray3f>& rays, RowFor&& row_for,
+                    int repetitions, const PeerRay& peer, const PeerStream& peer_stream) {
     const Executor every_core(0);
     for (const Workload& w : {Workload{"R2-mt", &rays, false}, Workload{"R3-mt", &rays, true}}) {
         std::vector<Hit<float>> hits(rays.size());
@@ -90,14 +91,14 @@ void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
         const long long threads = have_parallel() ? (long long)hardware_threads() : 1;
         // scaling: the library's one-thread time for the same rays (row R2 or R3) over this one.
         const std::string one_thread = std::string(w.name).substr(0, 2);
-        Row row = row_for(w.name, "bvhkit");
+        Row row = row_for(w.name, library);
         row.set("rays", (long long)rays.size()).set("hits", found).set("threads", threads);
         row.set("ms", ms[0]).set("mrays_per_s", n / ms[0] / 1e3);
         if (peer) row.set("speedup", (peer_stream ? std::min(ms[1], ms[2]) : ms[1]) / ms[0]);
         if (const double t = earlier_ms(rows, row, one_thread); t > 0)
             row.set("scaling", t / ms[0]);
         rows.push_back(row);
-        if (peer) {
+        if (peer && peer_rows) {
             Row p = row_for(w.name, "embree3");
             p.set("rays", (long long)rays.size()).set("hits", peer_found).set("threads", threads);
             p.set("ms", ms[1]).set("mrays_per_s", n / ms[1] / 1e3);
@@ -105,7 +106,7 @@ void add_batch_rows(std::vector<Row>& rows, const TriangleBvh<float>& tree,
                 p.set("scaling", t / ms[1]);
             rows.push_back(p);
         }
-        if (peer_stream) {
+        if (peer_stream && peer_rows) {
             Row p = row_for(w.name, "embree3-1M");
             p.set("rays", (long long)rays.size()).set("hits", stream_found).set("threads", threads);
             p.set("ms", ms[2]).set("mrays_per_s", n / ms[2] / 1e3);
@@ -144,8 +145,12 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
             const char* name;
             RayLayout layout;
             bool spatial_splits = false;
+            bool auto_spatial_splits = false;
         };
-        std::vector<Layout> layouts{{"bvhkit", RayLayout::Auto}};
+        // bvhkit-auto: spatial splits where the tree's overlap says they pay (the same tree as
+        // bvhkit's elsewhere), against Embree's default build.
+        std::vector<Layout> layouts{{"bvhkit", RayLayout::Auto},
+                                    {"bvhkit-auto", RayLayout::Auto, false, true}};
         if (cpu_has_avx2()) layouts.push_back({"bvhkit-wide4", RayLayout::Wide4});
         layouts.push_back({"bvhkit-binary", RayLayout::Binary});
         if (options.high_quality) layouts.push_back({"bvhkit-sbvh", RayLayout::Auto, true});
@@ -156,6 +161,7 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
                 TriangleBvhOptions o(build_options);
                 o.ray_layout = layouts[i].layout;
                 o.spatial_splits = layouts[i].spatial_splits;
+                o.auto_spatial_splits = layouts[i].auto_spatial_splits;
                 trees[i] = TriangleBvh<float>(mesh, o);
             });
         // The peers: Embree's medium build, and its high-quality build (spatial splits) beside
@@ -248,7 +254,13 @@ std::vector<Row> run_ray_bench(const RayBenchOptions& options, std::FILE* progre
             embree_all.stream_hits(chunk, occlusion, found);
         };
 #endif
-        add_batch_rows(rows, trees[0], r2, row_for, options.repetitions, peer_ray, peer_stream);
+        add_batch_rows(rows, trees[0], "bvhkit", true, r2, row_for, options.repetitions, peer_ray,
+                       peer_stream);
+        // The automatic choice's batch rows, where it chose spatial splits (else its tree is
+        // bvhkit's).
+        if (trees[1].has_split_references())
+            add_batch_rows(rows, trees[1], "bvhkit-auto", false, r2, row_for, options.repetitions,
+                           peer_ray, peer_stream);
     }
     return rows;
 }

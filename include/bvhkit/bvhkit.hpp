@@ -10,6 +10,7 @@
 #include "bvhkit/bvh/statistics.hpp"
 #include "bvhkit/bvh/validate.hpp"
 #include "bvhkit/bvh/wide_bvh.hpp"
+#include "bvhkit/bvh/wide_bvh_sah.hpp"
 #include "bvhkit/convex/penetration.hpp"
 #include "bvhkit/dynamic/dynamic_tree.hpp"
 #include "bvhkit/error.hpp"

@@ -37,6 +37,7 @@
 
 #include "bvhkit/build/build.hpp"
 #include "bvhkit/build/refit.hpp"
+#include "bvhkit/build/spatial_split_choice.hpp"
 #include "bvhkit/build/spatial_splits.hpp"
 #include "bvhkit/exec/executor.hpp"
 #include "bvhkit/primitives/triangle_mesh.hpp"
@@ -145,6 +146,13 @@ struct TriangleBvhOptions : BuildOptions {
     /// parameters. Serial, several times the default build's time, and up to spatial.budget more
     /// triangle references; needs Builder::BinnedSah and no optimize (else bvhkit::Error).
     bool spatial_splits = false;
+    /// Spatial splits where they pay: the default build, then, if its child_overlap reaches
+    /// tuning::spatial_splits_from_overlap (build/spatial_split_choice.hpp: rooms, triangle soups,
+    /// not scans), the spatial-split build again with `spatial`; has_split_references() says
+    /// whether it was kept. Only with Builder::BinnedSah and no optimize (else the default build
+    /// alone). Off by default: that build takes several times as long, and such a tree cannot be
+    /// saved.
+    bool auto_spatial_splits = false;
     SpatialSplitOptions spatial{};
 
     TriangleBvhOptions() = default;
@@ -390,6 +398,12 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
                 centroids.push_back(boxes.back().centroid());
             }
             bvh_ = build_bvh<T, 3>(boxes, centroids, tree_options, &report_);
+            if (options.auto_spatial_splits && options.builder == Builder::BinnedSah &&
+                !options.optimize && spatial_splits_pay(child_overlap(bvh_))) {
+                report_ = {};
+                bvh_ = build_spatial_split_bvh<T>(triangle, count, tree_options, options.spatial,
+                                                  &report_);
+            }
         }
         split_references_ = bvh_.primitive_indices.size() + report_.skipped.size() != count;
         triangle_count_ = count;

@@ -80,6 +80,11 @@ inline constexpr double spatial_split_alpha = 1e-3;
 /// SpatialSplitOptions::bins: 16 built faster than 32 to the same SAH cost within 1%.
 /// `bvhkit-bench rays MESH --high-quality`.
 inline constexpr std::uint32_t spatial_split_bins = 16;
+/// TriangleBvhOptions::auto_spatial_splits: the child overlap (build/spatial_split_choice.hpp)
+/// from which the spatial-split build is made: scans, height fields and a city measure below, and
+/// gained nothing from spatial splits; rooms and triangle soups above, where they pay.
+/// `bvhkit-bench rays MESH` (rows bvhkit-auto).
+inline constexpr double spatial_splits_from_overlap = 0.2;
 /// Spatial splits: nodes of at most this many references try object splits only (spatial binning
 /// is most of the build, and few of its splits win in small nodes).
 inline constexpr std::uint32_t spatial_split_min_count = 8;
@@ -91,12 +96,17 @@ inline constexpr std::uint32_t spatial_split_min_count = 8;
 /// search (a faster build, the same rays). `bvhkit-bench rays MESH`.
 inline constexpr std::uint32_t wide8_leaf_block = 8;
 inline constexpr std::uint32_t wide4_leaf_block = 4;
-/// Leaf limits of the wide collapses (make_wide_ray_bvh): once the tree outgrows the caches a
-/// node costs more than the groups of a larger leaf, which lie side by side; the four-wide
-/// layout, whose groups are half as wide, gains less from large leaves.
-/// `bvhkit-bench rays MESH` (docs/benchmarks.md, "Leaf limits").
-inline constexpr std::uint32_t wide8_leaf_limit = 48;
-inline constexpr std::uint32_t wide4_leaf_limit = 24;
+/// Costs of the wide collapses (make_wide_ray_bvh, collapse_to_wide_sah): a wide node's test in
+/// units of one triangle group's test, high because a node is a dependent load that misses the
+/// caches once the tree outgrows them, where a leaf's groups lie side by side; lower costs made
+/// the large scans slower, higher ones the soups and rooms. `bvhkit-bench rays MESH`.
+inline constexpr double wide8_node_cost = 32;
+inline constexpr double wide4_node_cost = 16;
+/// The most triangles a leaf child of the wide collapses holds whatever the costs say: bounds a
+/// leaf's tests where boxes of zero area (flat, axis-aligned groups) make any leaf look free.
+/// `bvhkit-bench rays MESH`.
+inline constexpr std::uint32_t wide8_leaf_limit = 64;
+inline constexpr std::uint32_t wide4_leaf_limit = 32;
 /// Rays a stream keeps in flight (query/ray_stream.hpp): four to sixteen measured alike; eight.
 /// `bvhkit-bench rays MESH` (rows R2-mt, R3-mt).
 inline constexpr int stream_width = 8;

@@ -323,6 +323,45 @@ TYPED_TEST(SpatialSplitTrees, RaysEqualBruteForceOnEveryLayout) {
     }
 }
 
+TEST(SpatialSplits, AutomaticWhereTheOverlapSaysAndRaysEqualBruteForce) {
+    // A room and a soup overlap enough (spatial_split_choice.hpp), a sphere does not; far from the
+    // origin too. The tree kept answers as brute force does.
+    struct Case {
+        TriangleMesh mesh;
+        bool splits;
+    };
+    std::vector<Case> cases;
+    cases.push_back({make_room(30, 4), true});
+    cases.push_back({make_procedural("soup:n=3000,seed=3"), true});
+    cases.push_back({make_procedural("sphere:subdiv=4"), false});
+    for (const auto& [mesh, splits] : cases)
+        for (const double offset : {0.0, 1e5}) {
+            const auto tris = test::placed<float>(mesh, 1.0, offset);
+            Aabb<float, 3> bounds;
+            for (const auto& t : tris) bounds.grow(t.bounds());
+            const auto rays = test::random_rays<float>(test::scaled(2000, 10), bounds, 22);
+            TriangleBvhOptions o;
+            o.auto_spatial_splits = true;
+            const TriangleBvh<float> bvh(tris, o);
+            EXPECT_EQ(bvh.has_split_references(), splits) << "offset " << offset;
+            EXPECT_EQ(spatial_splits_pay(child_overlap(TriangleBvh<float>(tris).bvh())), splits);
+            for (const auto& ray : rays) {
+                const Hit<float> want = brute_closest(tris, ray), got = bvh.closest_hit(ray);
+                ASSERT_EQ(bool(want), bool(got));
+                EXPECT_EQ(bvh.any_hit(ray), bool(want));
+                if (want) {
+                    EXPECT_EQ(got.t, want.t);
+                }
+            }
+            // Other builders and the optimizer keep the default build alone.
+            o.builder = Builder::SweepSah;
+            EXPECT_FALSE(TriangleBvh<float>(tris, o).has_split_references());
+            o.builder = Builder::BinnedSah;
+            o.optimize = true;
+            EXPECT_FALSE(TriangleBvh<float>(tris, o).has_split_references());
+        }
+}
+
 TEST(SpatialSplits, RefitKeepsRaysRight) {
     TriangleMesh mesh = make_room(20, 6);
     TriangleBvhOptions o;

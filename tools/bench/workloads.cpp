@@ -38,8 +38,11 @@ constexpr const char* kRaysHelp =
 Workload R of docs/workloads.md for bvhkit and Embree 3 (when installed), in this process, one thread
 each: build, R1 (camera rays, SIZE x SIZE), R2 (random rays), R3 (R2 as occlusion queries).
 Times are medians of N repetitions; speedup = Embree ms / bvhkit ms (> 1: bvhkit is faster).
+Rows bvhkit-auto: TriangleBvhOptions::auto_spatial_splits (spatial splits where the tree's overlap
+says they pay; the bvhkit tree elsewhere), against Embree's default build.
 MESH is a file (OBJ, PLY, STL) or a generator spec such as sphere:subdiv=7; the default is the
-shared bunny and igea meshes when present, else a procedural sphere.
+shared bunny and igea meshes when present (else a procedural sphere), then scenes that are not
+scans: room:objects=200, city:blocks=8 and soup:n=100000.
 
   --json          print a JSON array of rows instead of a table
   --reps N        repetitions per figure (default 5)
@@ -61,7 +64,13 @@ int bench_rays(int argc, char** argv) {
     }
     bench::RayBenchOptions o;
     o.meshes = args.positional();
-    if (o.meshes.empty()) o.meshes = default_bench_meshes();
+    if (o.meshes.empty()) {
+        // The scans, then architecture-like scenes, whose trees differ (walls and floors that
+        // overlap many boxes, sizes over orders of magnitude, unconnected triangles).
+        o.meshes = default_bench_meshes();
+        for (const char* scene : {"room:objects=200", "city:blocks=8", "soup:n=100000"})
+            o.meshes.emplace_back(scene);
+    }
     o.repetitions = int(args.integer("--reps", 5, 1, 1000));
     o.random_rays = std::size_t(args.integer("--rays", 1000000, 1, 100000000));
     o.camera_size = std::uint32_t(args.integer("--size", 1024, 1, 16384));
@@ -215,7 +224,13 @@ int bench_files(int argc, char** argv) {
     }
     bench::FileBenchOptions o;
     o.meshes = args.positional();
-    if (o.meshes.empty()) o.meshes = default_bench_meshes();
+    if (o.meshes.empty()) {
+        // The scans, then architecture-like scenes, whose trees differ (walls and floors that
+        // overlap many boxes, sizes over orders of magnitude, unconnected triangles).
+        o.meshes = default_bench_meshes();
+        for (const char* scene : {"room:objects=200", "city:blocks=8", "soup:n=100000"})
+            o.meshes.emplace_back(scene);
+    }
     o.repetitions = int(args.integer("--reps", 5, 1, 1000));
     o.random_rays = std::size_t(args.integer("--rays", 200000, 1, 100000000));
     const auto rows = bench::run_file_bench(o, args.flag("--json") ? nullptr : stderr);

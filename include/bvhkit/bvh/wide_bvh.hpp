@@ -115,24 +115,15 @@ void append_leaf_groups(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t n,
 
 }  // namespace wide_detail
 
-/// Collapses `bvh` into a WideSlotBvh<T, W>. An inner binary node takes up to W children by
-/// opening, of its children and grandchildren, the one of largest area until W or none is left to
-/// open; a subtree of at most `leaf_limit` primitives becomes one leaf child. With `fill_lanes`,
-/// any inner binary node may open to fill a node's lanes, also one of at most `leaf_limit`
-/// primitives (whose halves then become two leaf children): the nodes come out full, as a builder
-/// that splits the largest child until the node is full makes them, where without it a node whose
-/// children are all small enough to be leaves stays at two or three lanes (igea, eight wide,
-/// leaf_limit 8: 3.7 lanes a node on average without, 6.9 with).
-template <class T, int W = 4>
-WideSlotBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4,
-                                   bool fill_lanes = false) {
+namespace wide_detail {
+
+/// collapse_to_wide's loop: `opens(n)` says whether binary node n becomes a wide node (else a leaf
+/// child); with `fill_lanes`, any inner binary node may open to fill a node's lanes.
+template <class T, int W, class Opens>
+WideSlotBvh<T, W> collapse(const Bvh<Aabb<T, 3>>& bvh, Opens&& opens, bool fill_lanes) {
     WideSlotBvh<T, W> out;
     if (bvh.empty()) return out;
     const auto& nodes = bvh.nodes;
-    const std::vector<std::uint32_t> under = wide_detail::primitives_under(bvh);
-    const auto opens = [&](std::uint32_t n) {
-        return !nodes[n].is_leaf() && under[n] > leaf_limit;
-    };
     const auto fills = [&](std::uint32_t n) { return !nodes[n].is_leaf(); };
     out.group_slots.reserve(bvh.primitive_indices.size() + bvh.primitive_indices.size() / 2);
     std::vector<std::uint32_t> todo;
@@ -146,8 +137,8 @@ WideSlotBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t lea
         std::uint32_t lanes[W];
         lanes[0] = b;
         const int size = !opens(b)    ? 1
-                         : fill_lanes ? wide_detail::pick_lanes<W>(bvh, b, fills, lanes)
-                                      : wide_detail::pick_lanes<W>(bvh, b, opens, lanes);
+                         : fill_lanes ? pick_lanes<W>(bvh, b, fills, lanes)
+                                      : pick_lanes<W>(bvh, b, opens, lanes);
         WideSlotNode<T, W> node{};
         for (int c = 0; c < W; ++c) {
             node.child[c] = invalid_index;
@@ -162,13 +153,33 @@ WideSlotBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t lea
                 out.nodes.emplace_back();
                 work.emplace_back(n, node.child[c]);
             } else {
-                wide_detail::append_leaf_groups(bvh, n, out.group_slots, todo, node.child[c],
-                                                node.groups[c]);
+                append_leaf_groups(bvh, n, out.group_slots, todo, node.child[c], node.groups[c]);
             }
         }
         out.nodes[w] = node;
     }
     return out;
+}
+
+}  // namespace wide_detail
+
+/// Collapses `bvh` into a WideSlotBvh<T, W>. An inner binary node takes up to W children by
+/// opening, of its children and grandchildren, the one of largest area until W or none is left to
+/// open; a subtree of at most `leaf_limit` primitives becomes one leaf child. With `fill_lanes`,
+/// any inner binary node may open to fill a node's lanes, also one of at most `leaf_limit`
+/// primitives (whose halves then become two leaf children): the nodes come out full, as a builder
+/// that splits the largest child until the node is full makes them, where without it a node whose
+/// children are all small enough to be leaves stays at two or three lanes (igea, eight wide,
+/// leaf_limit 8: 3.7 lanes a node on average without, 6.9 with).
+template <class T, int W = 4>
+WideSlotBvh<T, W> collapse_to_wide(const Bvh<Aabb<T, 3>>& bvh, std::uint32_t leaf_limit = 4,
+                                   bool fill_lanes = false) {
+    if (bvh.empty()) return {};
+    const std::vector<std::uint32_t> under = wide_detail::primitives_under(bvh);
+    const auto opens = [&](std::uint32_t n) {
+        return !bvh.nodes[n].is_leaf() && under[n] > leaf_limit;
+    };
+    return wide_detail::collapse<T, W>(bvh, opens, fill_lanes);
 }
 
 /// Throws Error unless `wide` holds every slot of [0, slot_boxes.size()) exactly once, each inside

@@ -11,6 +11,7 @@
 
 #include "bvhkit/bvh/huge_page_allocator.hpp"
 #include "bvhkit/bvh/wide_bvh.hpp"
+#include "bvhkit/bvh/wide_bvh_sah.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/primitives/triangle_group.hpp"
 #include "bvhkit/simd/config.hpp"
@@ -81,13 +82,16 @@ template <int W, class TriangleAtSlot, class IndexAtSlot>
 WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&& triangle_at_slot,
                                 IndexAtSlot&& index_at_slot) {
     WideRayBvh<W> out;
-    // Every node's lanes filled (collapse_to_wide's fill_lanes), and a lane of up to leaf_limit
-    // triangles not opened further is a leaf child. Large leaves for the eight-wide layout, since
-    // once the tree outgrows the caches a node costs more than the groups of a larger leaf, which
-    // lie side by side; smaller ones for the four-wide layout (tuning.hpp).
-    constexpr std::uint32_t leaf_limit =
-        W == 8 ? tuning::wide8_leaf_limit : tuning::wide4_leaf_limit;
-    const WideSlotBvh<float, W> wide = collapse_to_wide<float, W>(bvh, leaf_limit, true);
+    // Every node's lanes filled (collapse_to_wide's fill_lanes), and each leaf child chosen by
+    // the surface area cost of collapse_to_wide_sah in the layout's own units, a node's clip
+    // against a group's test (tuning.hpp): the leaves grow where the tree's boxes overlap little
+    // and stay small where they overlap much, up to a limit.
+    WideCollapseCosts costs;
+    costs.node = W == 8 ? tuning::wide8_node_cost : tuning::wide4_node_cost;
+    costs.group = 1;
+    costs.group_lanes = WideRayBvh<W>::Group::lanes;
+    costs.max_leaf = W == 8 ? tuning::wide8_leaf_limit : tuning::wide4_leaf_limit;
+    const WideSlotBvh<float, W> wide = collapse_to_wide_sah<float, W>(bvh, costs, true);
     out.nodes.resize(wide.nodes.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
     for (std::size_t i = 0; i < wide.nodes.size(); ++i) {
