@@ -294,8 +294,10 @@ class TriangleBvh : public RayBatches<TriangleBvh<T>, T> {
     std::size_t ray_layout_bytes() const {
         return wide8_.empty() ? wide4_.bytes() : wide8_.bytes();
     }
-    /// Whether trace batches walk several rays at once (query/ray_stream.hpp): on the eight-wide
-    /// layout once it is 2 MB or more (about 45,000 triangles), or as batch_path() says.
+    /// Whether trace batches walk their incoherent rays several at once (query/ray_stream.hpp):
+    /// on the eight-wide layout once it is 2 MB or more (about 45,000 triangles), or as
+    /// batch_path() says. Coherent runs walk as packets on any eight-wide layout, whatever this
+    /// says (RayBatchPath::Auto and Packets, trace_packets).
     /// Occlusion batches on the eight-wide layout do unless batch_path() is OneByOne: in octant
     /// streams below 8 MB (query/ray_octant_stream.hpp), as trace batches above.
     bool streams_rays() const {

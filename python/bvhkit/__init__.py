@@ -224,7 +224,9 @@ class TriangleMesh:
         threads: int = 0,
     ) -> RayHits:
         """:meth:`intersect` for rays the caller knows to be coherent (camera rays, shadow rays
-        towards one light): every 32 consecutive rays walk the tree together as one packet.
+        towards one light): every 32 consecutive rays walk the tree together as one packet
+        (float32 meshes with the watertight test on a CPU with AVX2; elsewhere the rays walk one
+        by one, with the same answers).
 
         The answers are :meth:`intersect`'s, bit for bit; only the speed depends on the order.
         Give camera rays in tiles: 32 consecutive rays an 8x4 block of pixels (or two rows of a

@@ -37,7 +37,8 @@ enum class RayBatchPath {
     OneByOne,       // each ray walks alone, as closest_hit / any_hit
     Streams,        // eight rays in flight (query/ray_stream.hpp); needs the eight-wide layout
     OctantStreams,  // occlusion batches in octant streams (query/ray_octant_stream.hpp), trace
-                    // batches as Auto; needs the eight-wide layout
+                    // batches one by one or in streams as Auto chooses for rays it finds
+                    // incoherent (no packets); needs the eight-wide layout
     Packets,        // trace and occlusion batches in octant streams, whatever the rays (for
                     // coherent rays: query/ray_octant_stream.hpp); needs the eight-wide layout
 };
