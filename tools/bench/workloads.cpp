@@ -224,13 +224,7 @@ int bench_files(int argc, char** argv) {
     }
     bench::FileBenchOptions o;
     o.meshes = args.positional();
-    if (o.meshes.empty()) {
-        // The scans, then architecture-like scenes, whose trees differ (walls and floors that
-        // overlap many boxes, sizes over orders of magnitude, unconnected triangles).
-        o.meshes = default_bench_meshes();
-        for (const char* scene : {"room:objects=200", "city:blocks=8", "soup:n=100000"})
-            o.meshes.emplace_back(scene);
-    }
+    if (o.meshes.empty()) o.meshes = default_bench_meshes();
     o.repetitions = int(args.integer("--reps", 5, 1, 1000));
     o.random_rays = std::size_t(args.integer("--rays", 200000, 1, 100000000));
     const auto rows = bench::run_file_bench(o, args.flag("--json") ? nullptr : stderr);

@@ -37,20 +37,15 @@ std::vector<std::uint8_t> sah_leaf_choice(const Bvh<Aabb<T, 3>>& bvh,
     std::vector<double> best(n, 0);
     // Groups of four slots under each node (a leaf child pads each binary leaf to four, see
     // append_leaf_groups), and primitives under it.
-    std::vector<std::uint32_t> fours(n, 0), under(n, 0);
+    std::vector<std::uint32_t> fours(n, 0);
+    const std::vector<std::uint32_t> under = primitives_under(bvh);
     // A wide node replaces W - 1 inner binary nodes: each opened one carries that share of its
     // test.
     const double open_share = costs.node / double(W - 1);
     const std::uint32_t lanes = costs.group_lanes;
     for (std::size_t i = n; i-- > 0;) {
         const auto& b = nodes[i];
-        if (b.is_leaf()) {
-            fours[i] = (b.count + 3) / 4;
-            under[i] = b.count;
-        } else {
-            fours[i] = fours[b.left()] + fours[b.right()];
-            under[i] = under[b.left()] + under[b.right()];
-        }
+        fours[i] = b.is_leaf() ? (b.count + 3) / 4 : fours[b.left()] + fours[b.right()];
         const double area = double(b.bounds.area());
         const double groups = double((4 * std::uint64_t(fours[i]) + lanes - 1) / lanes);
         const double as_leaf = area * costs.group * groups;
