@@ -2,9 +2,9 @@
 // (checked on every 0-1 input, which by the 0-1 principle of sorting networks covers every input,
 // and on random keys with repeats and extremes); a closest-hit push makes the nearest hit lane
 // current and stacks every other hit lane, with its own child, groups and distance, so that they
-// pop nearest first; an any-hit push takes the first hit lane and stacks the others in lane
-// order. The walks' answers do not depend on this order (only ties between equally distant
-// triangles do), so only these tests see a network or a key that orders wrongly.
+// pop nearest first; an any-hit push takes the first hit lane and stacks the others so that they
+// pop in lane order. The walks' answers do not depend on this order (only ties between equally
+// distant triangles do), so only these tests see a network or a key that orders wrongly.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -174,8 +174,9 @@ TEST(WideStack, AnyHitPushKeepsLaneOrder) {
         ASSERT_EQ(current.child, node.child[lanes[0]]);
         EXPECT_EQ(current.t, entry[lanes[0]]);
         ASSERT_EQ(size, 3u + lanes.size() - 1);
+        // They pop in lane order: the second lane on top.
         for (std::size_t k = 1; k < lanes.size(); ++k) {
-            const detail::WideEntry e = stack.entry(std::uint32_t(3 + k - 1));
+            const detail::WideEntry e = stack.entry(std::uint32_t(size - k));
             EXPECT_EQ(e.child, node.child[lanes[k]]);
             EXPECT_EQ(e.groups, node.groups[lanes[k]]);
             EXPECT_EQ(e.t, entry[lanes[k]]);

@@ -14,6 +14,7 @@
 #include "bvhkit/bvh/wide_bvh_sah.hpp"
 #include "bvhkit/error.hpp"
 #include "bvhkit/primitives/triangle_group.hpp"
+#include "bvhkit/query/ray_wide_occlusion_order.hpp"
 #include "bvhkit/simd/config.hpp"
 #include "bvhkit/tuning.hpp"
 
@@ -144,6 +145,7 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
                 out.nodes[i].child[c] = first_of[g];
                 out.nodes[i].groups[c] = cut(run_of[g]);
             }
+    order_lanes_for_occlusion(out.nodes, out.groups.data(), costs.node, costs.group);
     return out;
 }
 

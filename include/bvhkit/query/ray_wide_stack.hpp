@@ -88,9 +88,11 @@ template <class Line>
     ask_for_next(current, line);
 }
 
-/// take_hits for any hit, which needs no order: the first hit lane becomes `current`, the others
-/// are pushed as they come. Sorting them cost instructions and mispredicted branches and bought
-/// nothing: no entry is ever dropped for being farther than a hit, the walk stops at the first one.
+/// take_hits for any hit, which needs no distance order: the hit lanes are visited in lane order,
+/// the first becomes `current` and the others are pushed last lane first, so that they pop in
+/// lane order (the layout's order for occlusion rays, query/ray_wide_occlusion_order.hpp). Sorting
+/// by distance cost instructions and mispredicted branches and bought nothing: no entry is ever
+/// dropped for being farther than a hit, the walk stops at the first one.
 template <class Line>
 [[gnu::always_inline]] inline void take_hits_unordered(unsigned mask, const float* entry,
                                                        const RayNode<4>& node, WideEntry& current,
@@ -99,8 +101,8 @@ template <class Line>
     const int first = __builtin_ctz(mask);
     mask &= mask - 1;
     current = WideEntry{node.child[first], node.groups[first], entry[first]};
-    for (; mask; mask &= mask - 1) {
-        const int c = __builtin_ctz(mask);
+    for (; mask; mask &= ~(1u << (31 - __builtin_clz(mask)))) {  // the last lane deepest
+        const int c = 31 - __builtin_clz(mask);
         const WideEntry e{node.child[c], node.groups[c], entry[c]};
         stack[size++] = e;
         simd::prefetch(line(e));
@@ -190,12 +192,12 @@ BVHKIT_SIMD_INLINE_AVX2 simd::Int<8> sort8_descending(simd::Int<8> v) {
     return v;
 }
 
-/// The lanes of each eight-bit mask in increasing order, four bits a lane (lane k of the mask's
-/// set bits in bits 4k..4k+3).
-inline constexpr std::array<std::uint32_t, 256> set_lanes = [] {
+/// The lanes of each eight-bit mask in decreasing order, four bits a lane (the mask's k-th
+/// highest set bit in bits 4k..4k+3).
+inline constexpr std::array<std::uint32_t, 256> set_lanes_descending = [] {
     std::array<std::uint32_t, 256> table{};
     for (unsigned mask = 0; mask < 256; ++mask)
-        for (unsigned lane = 0, k = 0; lane < 8; ++lane)
+        for (unsigned lane = 8, k = 0; lane-- > 0;)
             if ((mask >> lane) & 1u) table[mask] |= lane << (4 * k++);
     return table;
 }();
@@ -262,7 +264,7 @@ BVHKIT_SIMD_INLINE_AVX2 void push_nearest_first8(simd::Float<8> entry, simd::Mas
 }
 
 /// take_hits_unordered for the eight-wide walks: the first hit lane becomes `current`, the others
-/// go on the stack in lane order.
+/// go on the stack last lane first, so that they pop in lane order.
 template <class Line>
 BVHKIT_SIMD_INLINE_AVX2 void push_in_lane_order8(simd::Float<8> entry, unsigned mask,
                                                  const RayNode<8>& node, WideEntry& current,
@@ -271,7 +273,7 @@ BVHKIT_SIMD_INLINE_AVX2 void push_in_lane_order8(simd::Float<8> entry, unsigned 
     const int first = __builtin_ctz(mask);
     const unsigned rest = mask & (mask - 1);
     const simd::Int<8> order =
-        shift_right_logical(simd::Int<8>(std::int32_t(set_lanes[rest])),
+        shift_right_logical(simd::Int<8>(std::int32_t(set_lanes_descending[rest])),
                             simd::Int<8>::lanes(0, 4, 8, 12, 16, 20, 24, 28)) &
         simd::Int<8>(7);
     put8(stack, size, order, node, entry);

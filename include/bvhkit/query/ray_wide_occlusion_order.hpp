@@ -1,0 +1,111 @@
+#pragma once
+// The lane order of a wide ray layout's nodes, chosen for occlusion rays. An any-hit walk may take
+// a node's hit children in any order, and it stops at the first triangle it meets, so it takes
+// them in lane order (query/ray_wide_stack.hpp) and the layout puts first the children most
+// likely to end the walk soon: by the odds that a ray through the child's box meets one of its
+// triangles, over the expected cost of finding out, highest first (Ize and Hansen 2011, "RTSAH
+// traversal order for occlusion rays"). Closest hits sort the children by distance at every
+// node, so this order costs them nothing; in a city it puts the ground ahead of the towers.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <iterator>
+#include <limits>
+#include <vector>
+
+#include "bvhkit/math/vec.hpp"
+#include "bvhkit/primitives/hit.hpp"
+#include "bvhkit/primitives/triangle.hpp"
+
+namespace bvhkit {
+
+namespace detail {
+
+/// The surface area of lane c's box (a lane with a child).
+template <class Node>
+double lane_box_area(const Node& n, int c) {
+    const double dx = double(n.lo[3][c]) - n.lo[0][c];
+    const double dy = double(n.lo[4][c]) - n.lo[1][c];
+    const double dz = double(n.lo[5][c]) - n.lo[2][c];
+    return 2.0 * (dx * dy + dy * dz + dz * dx);
+}
+
+/// The area of a leaf's triangles (its groups from `first`, `count` of them).
+template <class Group>
+double leaf_triangle_area(const Group* groups, std::uint32_t first, std::uint32_t count) {
+    double sum = 0.0;
+    for (std::uint32_t g = first; g < first + count; ++g)
+        for (int l = 0; l < Group::lanes; ++l) {
+            if (groups[g].slot[l] == invalid_index) continue;
+            const Triangle<float> t = groups[g].triangle(l);
+            Vec<double, 3> e1, e2;
+            for (int a = 0; a < 3; ++a) {
+                e1[a] = double(t.p1[a]) - t.p0[a];
+                e2[a] = double(t.p2[a]) - t.p0[a];
+            }
+            const Vec<double, 3> n = cross(e1, e2);
+            sum += 0.5 * std::sqrt(dot(n, n));
+        }
+    return sum;
+}
+
+}  // namespace detail
+
+/// Reorders the lanes of every node of `layout` for occlusion rays (see above), empty lanes last.
+/// The odds of a child are those of a random line through its box meeting its triangles: twice
+/// their area over the box's surface area (Cauchy-Crofton), at most 1, and 1 for a flat box. Its
+/// cost is the surface area cost of its subtree in the collapse's units: `node_cost` a node and
+/// `group_cost` a group of triangles.
+/// `nodes` are RayNode<W> (query/ray_wide_layout.hpp), `groups` the layout's triangle groups.
+template <class Nodes, class Group>
+void order_lanes_for_occlusion(Nodes& nodes, const Group* groups, double node_cost,
+                               double group_cost) {
+    using Node = typename Nodes::value_type;
+    constexpr int W = int(std::size(Node{}.child));
+    // Per node, once its lanes are ordered: its triangles' area and its subtree's cost.
+    std::vector<double> area(nodes.size(), 0.0), cost(nodes.size(), 0.0);
+    // Children lie after their parents (collapse_to_wide): backwards, every child comes first.
+    for (std::size_t i = nodes.size(); i-- > 0;) {
+        Node& n = nodes[i];
+        double lane_area[W] = {}, lane_cost[W] = {}, box[W] = {}, key[W];
+        double lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::numeric_limits<double>::infinity();
+            hi[a] = -lo[a];
+        }
+        for (int c = 0; c < W; ++c) {
+            key[c] = -1.0;  // empty lanes last
+            if (n.child[c] == invalid_index) continue;
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = std::min(lo[a], double(n.lo[a][c]));
+                hi[a] = std::max(hi[a], double(n.lo[3 + a][c]));
+            }
+            box[c] = detail::lane_box_area(n, c);
+            const bool leaf = n.groups[c] > 0;
+            lane_area[c] = leaf ? detail::leaf_triangle_area(groups, n.child[c], n.groups[c])
+                                : area[n.child[c]];
+            lane_cost[c] = leaf ? group_cost * n.groups[c] : cost[n.child[c]];
+            const double odds = box[c] > 0.0 ? std::min(1.0, 2.0 * lane_area[c] / box[c]) : 1.0;
+            key[c] = odds / lane_cost[c];
+        }
+        const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
+        const double node_box = 2.0 * (dx * dy + dy * dz + dz * dx);
+        cost[i] = node_cost;
+        for (int c = 0; c < W; ++c)
+            if (n.child[c] != invalid_index) {
+                area[i] += lane_area[c];
+                cost[i] += (node_box > 0.0 ? box[c] / node_box : 1.0) * lane_cost[c];
+            }
+        int order[W];
+        for (int c = 0; c < W; ++c) order[c] = c;
+        std::stable_sort(order, order + W, [&](int a, int b) { return key[a] > key[b]; });
+        const Node old = n;
+        for (int c = 0; c < W; ++c) {
+            for (int r = 0; r < 6; ++r) n.lo[r][c] = old.lo[r][order[c]];
+            n.child[c] = old.child[order[c]];
+            n.groups[c] = old.groups[order[c]];
+        }
+    }
+}
+
+}  // namespace bvhkit
