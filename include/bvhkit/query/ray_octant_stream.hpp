@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "bvhkit/query/ray_constants8.hpp"
 #include "bvhkit/query/ray_wide.hpp"
 #include "bvhkit/tuning.hpp"
 
@@ -58,28 +59,22 @@ struct OctantStream {
     int hit_lane[octant_stream_size];
     int count = 0;
 
-    /// Adds a ray wide_ray_usable accepts, with its slab constants k.
-    void add(const Ray<float, 3>& ray, const SlabConstants& k, std::size_t i) {
-        const int r = count++;
+    /// Adds lane r of `c` (a ray the walk takes), ray i of the batch: the same constants.
+    void add(const EightRayConstants& c, int r, std::size_t i) {
+        const int at = count++;
         for (int a = 0; a < 3; ++a) {
-            origin[a][r] = k.origin[a];
-            inv[a][r] = k.inv[a];
-            inv_far[a][r] = k.inv_far[a];
+            origin[a][at] = c.origin[a][r];
+            inv[a][at] = c.inv[a][r];
+            inv_far[a][at] = c.inv_far[a][r];
         }
-        tmin[r] = ray.tmin;
-        tmax[r] = ray.tmax;
-        prep[r] = WatertightRay<float>(ray, WatertightRay<float>::KnownValid{});
-        index[r] = i;
-        hit_group[r] = nullptr;
-        hit_lane[r] = 0;
+        tmin[at] = c.tmin[r];
+        tmax[at] = c.tmax[r];
+        prep[at] = c.watertight(r);
+        index[at] = i;
+        hit_group[at] = nullptr;
+        hit_lane[at] = 0;
     }
 };
-
-/// The octant of a ray's direction: bit a set when component a's sign bit is (-0 included, as
-/// SlabConstants reads its planes).
-inline int direction_octant(const SlabConstants& k) {
-    return int(k.near[0] >= 3) | int(k.near[1] >= 3) << 1 | int(k.near[2] >= 3) << 2;
-}
 
 /// The rays of `mask` (of the stream's) whose range still reaches t: tmax[r] >= t. Reads tmax
 /// in blocks of eight up to the count's: the walk sets the last block's unused slots.
@@ -232,15 +227,18 @@ done:
 template <bool AnyHit>
 class OctantStreams {
   public:
-    /// Adds ray i (one wide_ray_usable accepts, with its slab constants k); walks its octant's
-    /// stream if that is now full.
+    /// Adds the rays of `c` that the walk takes (c.walk), lane r ray first + r of the batch; walks
+    /// each stream that fills.
     template <class Done>
-    void add(WideRayView<8> tree, const Ray<float, 3>& ray, const SlabConstants& k, std::size_t i,
-             Done&& done) {
-        const int octant = direction_octant(k);
-        OctantStream& s = streams_[octant];
-        s.add(ray, k, i);
-        if (s.count == octant_stream_size) walk(tree, s, octant, done);
+    void add_eight(WideRayView<8> tree, const EightRayConstants& c, std::size_t first,
+                   Done&& done) {
+        for (unsigned m = c.walk; m; m &= m - 1) {
+            const int r = __builtin_ctz(m);
+            const int octant = c.octant(r);
+            OctantStream& s = streams_[octant];
+            s.add(c, r, first + std::size_t(r));
+            if (s.count == octant_stream_size) walk(tree, s, octant, done);
+        }
     }
     /// Walks the rays still waiting.
     template <class Done>

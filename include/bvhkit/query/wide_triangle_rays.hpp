@@ -286,7 +286,8 @@ class WideTriangleRays {
                 found ? wide_hit(s.best[r], *s.hit_group[r], s.hit_lane[r]) : Hit<float>{};
         };
         detail::OctantStreams<false> streams;
-        detail::SlabConstants k;
+        detail::EightRayConstants eight;
+        const Aabb<float, 3>& bounds = binary_.bvh().nodes[0].bounds;
         const std::size_t n = detail::octant_stream_size;
         std::size_t rest = first;  // the first ray neither in a packet nor traced
         for (std::size_t b = first; b < rays.size(); b += n) {
@@ -294,13 +295,16 @@ class WideTriangleRays {
             trace_one_way(rays.subspan(rest, b - rest), hits.subspan(rest, b - rest));
             const std::size_t count = std::min(n, rays.size() - b);
             rest = b + count;
-            for (std::size_t i = b; i < b + count; ++i) {
-                const Ray<float, 3>& ray = rays[i];
-                const Route route = route_wide(ray, k);
-                if (route == Route::Walk)
-                    streams.add(wide8_, ray, k, i, done);
-                else
-                    hits[i] = route == Route::Binary ? binary_.closest_hit(ray) : Hit<float>{};
+            // route_wide's routes and the walk's constants, eight rays at a time.
+            for (std::size_t i = b; i < b + count; i += 8) {
+                const int m = int(std::min<std::size_t>(8, b + count - i));
+                detail::make_eight_ray_constants(rays.data() + i, m, bounds, eight);
+                streams.add_eight(wide8_, eight, i, done);
+                for (unsigned other = ~eight.walk & ((1u << m) - 1); other; other &= other - 1) {
+                    const int r = __builtin_ctz(other);
+                    const bool usable = (eight.usable >> r) & 1u;  // else the binary walk's
+                    hits[i + r] = usable ? Hit<float>{} : binary_.closest_hit(rays[i + r]);
+                }
             }
         }
         trace_one_way(rays.subspan(rest), hits.subspan(rest));
@@ -315,14 +319,17 @@ class WideTriangleRays {
             occluded[s.index[r]] = b ? 1 : 0;
         };
         detail::OctantStreams<true> streams;
-        detail::SlabConstants k;
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-            const Ray<float, 3>& ray = rays[i];
-            const Route route = route_wide(ray, k);
-            if (route == Route::Walk)
-                streams.add(wide8_, ray, k, i, blocked);
-            else
-                occluded[i] = route == Route::Binary && binary_.any_hit(ray) ? 1 : 0;
+        detail::EightRayConstants eight;
+        const Aabb<float, 3>& bounds = binary_.bvh().nodes[0].bounds;
+        for (std::size_t i = 0; i < rays.size(); i += 8) {
+            const int m = int(std::min<std::size_t>(8, rays.size() - i));
+            detail::make_eight_ray_constants(rays.data() + i, m, bounds, eight);
+            streams.add_eight(wide8_, eight, i, blocked);
+            for (unsigned other = ~eight.walk & ((1u << m) - 1); other; other &= other - 1) {
+                const int r = __builtin_ctz(other);
+                const bool usable = (eight.usable >> r) & 1u;  // else the binary walk's
+                occluded[i + r] = !usable && binary_.any_hit(rays[i + r]) ? 1 : 0;
+            }
         }
         streams.finish(wide8_, blocked);
     }

@@ -89,6 +89,22 @@ BVHKIT_SIMD_INLINE_AVX2 Float<8> operator-(Float<8> a, Float<8> b) {
 BVHKIT_SIMD_INLINE_AVX2 Float<8> operator*(Float<8> a, Float<8> b) {
     return Float<8>(_mm256_mul_ps(a.r, b.r));
 }
+/// The IEEE quotient in every lane, as the scalar division and Float<4>'s give it.
+BVHKIT_SIMD_INLINE_AVX2 Float<8> operator/(Float<8> a, Float<8> b) {
+    return Float<8>(_mm256_div_ps(a.r, b.r));
+}
+/// |a|: the sign bit cleared.
+BVHKIT_SIMD_INLINE_AVX2 Float<8> abs(Float<8> a) {
+    return Float<8>(_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a.r));
+}
+/// Lanes of `yes` where `m` is set, of `no` elsewhere.
+BVHKIT_SIMD_INLINE_AVX2 Float<8> select(Mask<8> m, Float<8> yes, Float<8> no) {
+    return Float<8>(_mm256_blendv_ps(no.r, yes.r, m.r));
+}
+/// The lanes' sign bits, lane 0 lowest (-0 and negative NaNs included).
+BVHKIT_SIMD_INLINE_AVX2 unsigned sign_bits(Float<8> a) {
+    return unsigned(_mm256_movemask_ps(a.r));
+}
 /// vminps: b where either is NaN.
 BVHKIT_SIMD_INLINE_AVX2 Float<8> min(Float<8> a, Float<8> b) {
     return Float<8>(_mm256_min_ps(a.r, b.r));
@@ -112,12 +128,22 @@ BVHKIT_SIMD_INLINE_AVX2 Mask<8> operator<(Float<8> a, Float<8> b) {
 BVHKIT_SIMD_INLINE_AVX2 Mask<8> operator>(Float<8> a, Float<8> b) {
     return {_mm256_cmp_ps(a.r, b.r, _CMP_GT_OQ)};
 }
+BVHKIT_SIMD_INLINE_AVX2 Mask<8> operator>=(Float<8> a, Float<8> b) {
+    return {_mm256_cmp_ps(a.r, b.r, _CMP_GE_OQ)};
+}
+BVHKIT_SIMD_INLINE_AVX2 Mask<8> operator==(Float<8> a, Float<8> b) {
+    return {_mm256_cmp_ps(a.r, b.r, _CMP_EQ_OQ)};
+}
 
 BVHKIT_SIMD_INLINE_AVX2 Mask<8> operator&(Mask<8> a, Mask<8> b) {
     return {_mm256_and_ps(a.r, b.r)};
 }
 BVHKIT_SIMD_INLINE_AVX2 Mask<8> operator|(Mask<8> a, Mask<8> b) {
     return {_mm256_or_ps(a.r, b.r)};
+}
+/// The lanes set in `b` and not in `a`.
+BVHKIT_SIMD_INLINE_AVX2 Mask<8> andnot(Mask<8> a, Mask<8> b) {
+    return {_mm256_andnot_ps(a.r, b.r)};
 }
 
 BVHKIT_SIMD_INLINE_AVX2 Int<8> operator&(Int<8> a, Int<8> b) {
