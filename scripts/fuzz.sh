@@ -46,7 +46,8 @@ cmake --build "$build" --target fuzz_obj fuzz_ply fuzz_stl fuzz_tree_file tree_f
 
 # Seed corpus: one tiny valid file per format (and variant), written fresh each run.
 work="$(mktemp -d)"
-trap 'rm -rf "$work"' EXIT
+pids=()  # the fuzzers running: the trap stops them too if the script is killed
+trap 'kill "${pids[@]}" 2>/dev/null || true; rm -rf "$work"' EXIT
 mkdir -p "$work/obj" "$work/ply" "$work/stl"
 "$build/tests/fuzz/tree_file_seeds" "$work/tree_file"
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n' > "$work/obj/quad.obj"
@@ -81,14 +82,31 @@ printf 'solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nver
 } > "$work/stl/binary.stl"
 
 mkdir -p "$build/artifacts"
+# The fuzzers run side by side, as many at once as there are cores (each is one process of one
+# thread), and their reports are printed in turn once each is done.
+jobs=$(nproc 2>/dev/null || echo 1)
+formats=(obj ply stl tree_file)
 failed=()
-for format in obj ply stl tree_file; do
-    echo "== fuzz_$format for ${seconds}s"
-    if ! "$build/tests/fuzz/fuzz_$format" "$work/$format" -max_total_time="$seconds" -max_len=4096 \
+run_fuzzer() {
+    "$build/tests/fuzz/fuzz_$1" "$work/$1" -max_total_time="$seconds" -max_len=4096 \
         -rss_limit_mb=1024 -timeout=5 -print_final_stats=1 \
-        -artifact_prefix="$build/artifacts/${format}-" 2>&1 | tail -n 25; then
-        failed+=("$format")
-    fi
+        -artifact_prefix="$build/artifacts/${1}-" > "$work/$1.log" 2>&1
+}
+for ((first = 0; first < ${#formats[@]}; first += jobs)); do
+    batch=("${formats[@]:first:jobs}")
+    pids=()
+    for format in "${batch[@]}"; do
+        run_fuzzer "$format" &
+        pids+=($!)
+    done
+    for i in "${!batch[@]}"; do
+        format="${batch[$i]}"
+        status=0
+        wait "${pids[$i]}" || status=$?
+        echo "== fuzz_$format for ${seconds}s"
+        tail -n 25 "$work/$format.log"
+        if [ "$status" -ne 0 ]; then failed+=("$format"); fi
+    done
 done
 if ((${#failed[@]})); then
     echo "fuzz.sh: findings in: ${failed[*]} (reproducers in $build/artifacts)" >&2

@@ -134,7 +134,10 @@ class TriangleMesh:
     Dietrich 2009; ``builder="binned_sah"`` only): 6-21x the build time (serial), for faster rays
     on meshes of long, thin or very unequal triangles (CAD tessellations, architecture, soups;
     on even scans it buys nothing). The same hits, but that among faces hit at the same t up to
-    rounding another may be named; docs/python.md has the figures.
+    rounding another may be named; docs/python.md has the figures. ``spatial_splits="auto"``
+    builds the default tree and, where its sibling boxes overlap enough for splits to pay
+    (rooms, soups; not scans), the split tree instead (``stats()["spatial_splits"]`` says
+    which); with another builder than ``"binned_sah"`` it is the default build.
 
     Faces with a NaN or infinite coordinate at the build are left out of every query (see
     :meth:`skipped`), and stay out after a :meth:`refit`; zero-area faces are never hit by rays.
@@ -149,14 +152,21 @@ class TriangleMesh:
         dtype: _npt.DTypeLike = _np.float32,
         ray_test: _a.RayTest = "watertight",
         threads: int = 0,
-        spatial_splits: bool = False,
+        spatial_splits: _typing.Union[bool, _typing.Literal["auto"]] = False,
     ) -> None:
         self.dtype: _np.dtype = _a.scalar_type(dtype)
         _a.text("builder", builder)
         _a.option("ray_test", ray_test, _a.RAY_TESTS)
-        splits = _a.flag("spatial_splits", spatial_splits)
+        if isinstance(spatial_splits, str) and spatial_splits == "auto":
+            splits = "auto"
+        elif spatial_splits is True or spatial_splits is False or isinstance(spatial_splits,
+                                                                             _np.bool_):
+            splits = "on" if spatial_splits else "off"
+        else:
+            raise TypeError("spatial_splits: must be True, False or 'auto', not "
+                            f"{spatial_splits!r}")
         n = _a.threads(threads)
-        if splits and builder.replace("-", "_") != "binned_sah":
+        if splits == "on" and builder.replace("-", "_") != "binned_sah":
             raise ValueError(f"spatial_splits: needs builder='binned_sah', not {builder!r}")
         v = _a.vertices("vertices", vertices, self.dtype)
         f = _a.faces(faces, len(v))

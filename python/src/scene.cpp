@@ -48,16 +48,21 @@ Vec<T, 3> row(const T* p, std::size_t i) {
 template <class T>
 class Scene {
   public:
-    /// With `spatial_splits` the ray tree is the high-quality build (TriangleBvhOptions::
-    /// spatial_splits), which needs the binned SAH builder without the optimizer.
+    /// `spatial_splits` "on": the ray tree is the high-quality build (TriangleBvhOptions::
+    /// spatial_splits), which needs the binned SAH builder without the optimizer; "auto": that
+    /// build where the default tree's boxes overlap enough to pay (TriangleBvhOptions::
+    /// auto_spatial_splits; with another builder the default build); "off": the default build.
     Scene(const Rows<T, 3>& vertices, const Faces& faces, const std::string& builder,
-          const std::string& ray_test, unsigned threads, bool spatial_splits)
+          const std::string& ray_test, unsigned threads, const std::string& spatial_splits)
         : mesh_(make_mesh<T>(vertices, faces)), options_(parse_builder(builder)) {
         if (ray_test != "fast" && ray_test != "watertight")
             throw Error("ray_test: '" + ray_test + "' is not one of 'fast', 'watertight'");
+        if (spatial_splits != "off" && spatial_splits != "on" && spatial_splits != "auto")
+            throw Error("spatial_splits: '" + spatial_splits +
+                        "' is not one of 'off', 'on', 'auto'");
         options_.threads = threads;
         nb::gil_scoped_release release;
-        build_rays(ray_test == "fast", spatial_splits);
+        build_rays(ray_test == "fast", spatial_splits == "on", {}, spatial_splits == "auto");
     }
 
     /// A scene from the parts state() gave (bvhkit/_scene_file.py holds them in one container):
@@ -423,10 +428,12 @@ class Scene {
   private:
     /// The ray tree over the mesh, by the scene's builder, without the faces of `left_out` (the
     /// caller has released the GIL).
-    void build_rays(bool fast, bool spatial_splits, std::span<const std::uint32_t> left_out = {}) {
+    void build_rays(bool fast, bool spatial_splits, std::span<const std::uint32_t> left_out = {},
+                    bool auto_splits = false) {
         TriangleBvhOptions ray_options(options_);
         ray_options.triangle_test = fast ? TriangleTest::Fast : TriangleTest::Watertight;
         ray_options.spatial_splits = spatial_splits;
+        ray_options.auto_spatial_splits = auto_splits;
         if (left_out.empty()) {
             rays_ = TriangleBvh<T>(mesh_, ray_options);
         } else {
@@ -438,7 +445,9 @@ class Scene {
                 triangles[face].p0[0] = std::numeric_limits<T>::quiet_NaN();
             rays_ = TriangleBvh<T>(triangles, ray_options);
         }
-        spatial_splits_ = spatial_splits;
+        // An automatic choice that kept the split tree is saved and loaded as a forced one: the
+        // same options, and the build is deterministic.
+        spatial_splits_ = spatial_splits || rays_.has_split_references();
     }
 
     /// The faces a spatial-split scene's data says were left out of its ray tree: u32
@@ -516,7 +525,7 @@ void bind_scene_type(nb::module_& m, const char* name) {
     nb::class_<S>(m, name,
                   "A triangle mesh ready for ray and proximity queries (see bvhkit.TriangleMesh).")
         .def(nb::init<const Rows<T, 3>&, const Faces&, const std::string&, const std::string&,
-                      unsigned, bool>(),
+                      unsigned, const std::string&>(),
              nb::arg("vertices"), nb::arg("faces"), nb::arg("builder"), nb::arg("ray_test"),
              nb::arg("threads"), nb::arg("spatial_splits"), "Builds the ray tree over the mesh.")
         .def(nb::init<const Rows<T, 3>&, const Faces&, const std::string&, unsigned,

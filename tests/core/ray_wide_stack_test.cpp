@@ -184,3 +184,37 @@ TEST(WideStack, AnyHitPushKeepsLaneOrder) {
     }
 }
 #endif
+
+#if BVHKIT_SIMD
+// The four-wide walk's any-hit push: the first hit lane becomes current, the others pop in lane
+// order (the layout's order for occlusion rays), each with its own child, groups and distance.
+TEST(WideStack, FourWideAnyHitPushKeepsLaneOrder) {
+    RayNode<4> node{};
+    for (int c = 0; c < 4; ++c) {
+        node.child[c] = 200 + 5 * std::uint32_t(c);
+        node.groups[c] = std::uint32_t(c % 2);
+    }
+    const float entry[4] = {3, 2, 1, 0};
+    const auto no_line4 = [](const detail::WideEntry&) {
+        static const char lines[192] = {};
+        return lines;
+    };
+    for (unsigned mask = 1; mask < 16; ++mask) {
+        detail::WideEntry stack[8];
+        std::uint32_t size = 2;
+        detail::WideEntry current{};
+        detail::take_hits_unordered(mask, entry, node, current, stack, size, no_line4);
+        std::vector<int> lanes;
+        for (int c = 0; c < 4; ++c)
+            if ((mask >> c) & 1u) lanes.push_back(c);
+        ASSERT_EQ(current.child, node.child[lanes[0]]);
+        ASSERT_EQ(size, 2u + lanes.size() - 1);
+        for (std::size_t k = 1; k < lanes.size(); ++k) {  // popped from the top: lane order
+            const detail::WideEntry& e = stack[size - k];
+            EXPECT_EQ(e.child, node.child[lanes[k]]) << "mask " << mask;
+            EXPECT_EQ(e.groups, node.groups[lanes[k]]);
+            EXPECT_EQ(e.t, entry[lanes[k]]);
+        }
+    }
+}
+#endif

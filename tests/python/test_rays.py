@@ -257,6 +257,35 @@ def test_spatial_splits_bad_arguments():
     assert bvhkit.TriangleMesh(v, f, spatial_splits=np.bool_(True)).stats()["spatial_splits"]
 
 
+def test_spatial_splits_auto_decides_per_mesh():
+    # A soup's boxes overlap enough for the split tree, a sphere's do not; where the split tree
+    # is kept its answers are the forced one's (the same options, a deterministic build), and a
+    # pickled scene keeps the choice. With another builder "auto" is the default build.
+    rng = np.random.default_rng(31)
+    soup_v, soup_f = bvhkit.load_mesh("soup:n=3000")
+    sphere_v, sphere_f = bvhkit.load_mesh("sphere:subdiv=4")
+    auto_soup = bvhkit.TriangleMesh(soup_v, soup_f, spatial_splits="auto")
+    forced = bvhkit.TriangleMesh(soup_v, soup_f, spatial_splits=True)
+    assert auto_soup.stats()["spatial_splits"]
+    assert auto_soup.stats()["references"] == forced.stats()["references"] > len(soup_f)
+    sphere = bvhkit.TriangleMesh(sphere_v, sphere_f, spatial_splits="auto")
+    assert not sphere.stats()["spatial_splits"]
+    assert not bvhkit.TriangleMesh(soup_v, soup_f, builder="lbvh",
+                                   spatial_splits="auto").stats()["spatial_splits"]
+    o, d = random_rays(rng, 2000, spread=1.0)
+    o = (o * 0.5 + 0.5).astype(np.float32)
+    d = d.astype(np.float32)
+    a, b = auto_soup.intersect(o, d), forced.intersect(o, d)
+    assert np.isfinite(a.t).sum() > 200
+    np.testing.assert_array_equal(a.t, b.t)
+    np.testing.assert_array_equal(a.face, b.face)
+    loaded = pickle.loads(pickle.dumps(auto_soup))
+    assert loaded.stats()["spatial_splits"]
+    np.testing.assert_array_equal(loaded.intersect(o, d).face, a.face)
+    with pytest.raises(TypeError, match="spatial_splits"):
+        bvhkit.TriangleMesh(soup_v, soup_f, spatial_splits="always")
+
+
 @pytest.mark.parametrize("scale", [1e-300, 1e-200, 1e-120, 1e120, 1e200, 1e300])
 def test_float64_rays_at_extreme_scales(scale):
     # t does not change when the mesh, the origins and the directions are scaled together, so the

@@ -2,7 +2,8 @@
 // traces through it bit for bit as the tree in memory does, on every path; a version-1 file (one
 // written before the layout was stored, kept here as bytes) still loads; a layout of another
 // width than this CPU walks is derived again (copying load) or left for the binary walk (mapped);
-// and wide sections that lie are Errors from both loaders, with validation on or off.
+// a layout written in the collapse's own lane order (before the order for occlusion rays) still
+// loads; and wide sections that lie are Errors from both loaders, with validation on or off.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -344,6 +345,47 @@ TEST(WideLayoutFile, AnotherWidthIsDerivedOrWalkedBinary) {
     }
 }
 
+// A layout written in the collapse's own lane order (lane order 0, as files were written before
+// the order for occlusion rays) loads by both loaders, validated or not: the copying load takes it
+// with the order applied (so it saves again as a tree built now does), the mapped one walks it as
+// it lies; both answer as the tree in memory. The same layout claiming the current order is not
+// the derived one, and a validating load refuses it.
+TEST(WideLayoutFile, CollapseOrderFilesStillLoad) {
+    const auto tris = placed<float>(make_sphere(3), 1, 0);
+    const TriangleBvh<float> tree(tris);
+    if (tree.ray_width() == 2) GTEST_SKIP() << "no wide layout on this CPU";
+    const auto at = [&](std::uint32_t s) { return tris[tree.bvh().primitive_indices[s]]; };
+    const auto index = [&](std::uint32_t s) { return tree.bvh().primitive_indices[s]; };
+    const std::vector<std::uint8_t> now = to_bytes(tree);
+    const auto old_file = [&](auto layout) {
+        std::vector<std::uint8_t> file = with_wide(now, layout);
+        EXPECT_NE(file, now);  // the two orders differ, else this test shows nothing
+        const std::size_t header = wide_header_at(file);
+        EXPECT_EQ(file[header + 4], 1);  // written as the current order
+        file[header + 4] = 0;
+        serial_detail::reseal_tree_file(file);
+        return file;
+    };
+    const std::vector<std::uint8_t> file =
+        tree.ray_width() == 8 ? old_file(make_wide_ray_bvh<8>(tree.bvh(), at, index, false))
+                              : old_file(make_wide_ray_bvh<4>(tree.bvh(), at, index, false));
+    const auto rays = file_test_rays(tris, 2000, 5);
+    for (const bool validate : {true, false}) {
+        SCOPED_TRACE(validate ? "validated" : "not validated");
+        const auto loaded = triangle_bvh_from_bytes<float>(file, LoadOptions{validate});
+        EXPECT_EQ(to_bytes(loaded), now);
+        expect_same_answers(tree, loaded, rays);
+        const auto mapped = view_triangle_bvh<float>(file, LoadOptions{validate});
+        EXPECT_EQ(mapped.ray_width(), tree.ray_width());
+        expect_same_answers(tree, mapped, rays);
+    }
+    std::vector<std::uint8_t> claimed = file;
+    claimed[wide_header_at(claimed) + 4] = 1;
+    serial_detail::reseal_tree_file(claimed);
+    expect_refused(claimed, "the collapse's order as the current one",
+                   "not the one the tree derives", false);
+}
+
 TEST(WideLayoutFile, LyingWideSectionsAreErrors) {
     TriangleBvhOptions options;
     options.ray_layout = RayLayout::Wide4;
@@ -363,7 +405,7 @@ TEST(WideLayoutFile, LyingWideSectionsAreErrors) {
     const auto put32 = [](std::uint8_t* p, std::uint32_t v) { std::memcpy(p, &v, 4); };
     const auto put64 = [](std::uint8_t* p, std::uint64_t v) { std::memcpy(p, &v, 8); };
     expect_refused(changed(at, [&](auto* p) { put32(p, 3); }), "width 3", "width 3");
-    expect_refused(changed(at + 4, [&](auto* p) { put32(p, 1); }), "reserved", "reserved");
+    expect_refused(changed(at + 4, [&](auto* p) { put32(p, 2); }), "lane order 2", "lane order 2");
     expect_refused(changed(at + 8, [&](auto* p) { put64(p, std::uint64_t(1) << 60); }),
                    "huge node count", "do not fill");
     expect_refused(changed(at + 16, [&](auto* p) { put64(p, ~std::uint64_t(0)); }),

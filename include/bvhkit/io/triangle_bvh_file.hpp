@@ -200,18 +200,25 @@ struct TriangleBvhAccess {
         check_wide_structure<4>(stored4, triangle_count, what);
         check_wide_structure<8>(stored8, triangle_count, what);
         // The stored layout where it is the one this CPU walks and is trusted or proved the
-        // derived one; else derived from the tree, whose structure was checked above.
+        // derived one; else derived from the tree, whose structure was checked above. A layout
+        // stored in the collapse's own lane order (written before the order for occlusion rays)
+        // is taken with that order applied, and checked so.
+        const bool reorder = wide.lane_order == wide_lane_order_collapse;
         if (wide.width != 0 && wide.width == f.wide_width_here<T>() && !options.validate) {
             tree.wide4_.nodes.assign(stored4.nodes.begin(), stored4.nodes.end());
             tree.wide4_.groups.assign(stored4.groups.begin(), stored4.groups.end());
             tree.wide8_.nodes.assign(stored8.nodes.begin(), stored8.nodes.end());
             tree.wide8_.groups.assign(stored8.groups.begin(), stored8.groups.end());
+            if (reorder && !tree.wide4_.empty()) order_for_occlusion(tree.wide4_);
+            if (reorder && !tree.wide8_.empty()) order_for_occlusion(tree.wide8_);
             return tree;
         }
         tree.make_ray_layout();
+        WideRayBvh<4> held4;
+        WideRayBvh<8> held8;
         if (wide.width != 0 && wide.width == f.wide_width_here<T>() &&
-            !(same_wide_layout<4>(tree.wide4_, stored4) &&
-              same_wide_layout<8>(tree.wide8_, stored8)))
+            !(same_wide_layout<4>(tree.wide4_, ordered_as_now(stored4, reorder, held4)) &&
+              same_wide_layout<8>(tree.wide8_, ordered_as_now(stored8, reorder, held8))))
             throw Error(std::string(what) +
                         ": the stored wide ray layout is not the one the tree derives");
         return tree;

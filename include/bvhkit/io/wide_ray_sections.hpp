@@ -37,8 +37,16 @@ static_assert(sizeof(RayNode<4>) == ray_node_record_bytes<4> &&
 static_assert(sizeof(RayGroup<4>) == ray_group_record_bytes<4> &&
               sizeof(RayGroup<8>) == ray_group_record_bytes<8>);
 
+/// The lane order a stored layout was written with (the wide header's second field): 0, the
+/// collapse's own order (files written before the order for occlusion rays); 1, each node's
+/// lanes ordered for occlusion rays (query/ray_wide_occlusion_order.hpp), as layouts are now made.
+/// The answers do not depend on it; a load derives or checks the layout of the order it states.
+inline constexpr std::uint32_t wide_lane_order_collapse = 0;
+inline constexpr std::uint32_t wide_lane_order_occlusion = 1;
+
 struct WideSectionHeader {
     int width = 0;  // 0: no wide layout stored
+    std::uint32_t lane_order = wide_lane_order_occlusion;
     std::uint64_t nodes = 0, groups = 0;
 };
 
@@ -52,7 +60,7 @@ inline std::size_t wide_padding(std::size_t payload_offset) {
 template <int W>
 void put_wide_layout(ByteWriter& w, WideRayView<W> wide) {
     w.u32(wide.empty() ? 0 : std::uint32_t(W));
-    w.u32(0);
+    w.u32(wide.empty() ? 0 : wide_lane_order_occlusion);
     w.u64(wide.nodes.size());
     w.u64(wide.groups.size());
     if (wide.empty()) return;
@@ -76,7 +84,9 @@ inline WideSectionHeader get_wide_header(ByteReader& r) {
     WideSectionHeader h;
     const std::uint32_t width = r.u32();
     if (width != 0 && width != 4 && width != 8) fail("width " + std::to_string(width));
-    if (r.u32() != 0) fail("reserved bytes are not zero");
+    h.lane_order = r.u32();
+    if (h.lane_order > wide_lane_order_occlusion || (width == 0 && h.lane_order != 0))
+        fail("lane order " + std::to_string(h.lane_order));
     h.width = int(width);
     h.nodes = r.u64();
     h.groups = r.u64();
@@ -141,6 +151,19 @@ WideRayView<W> read_wide_layout(ByteReader& r, const WideSectionHeader& h, WideR
     }
     get_wide_layout(r, h, copy);
     return copy.view();
+}
+
+/// `stored` in the lane order layouts are made in now: itself, or, when `reorder` (it was written
+/// in the collapse's own order), a copy in `held` (not the storage `stored` views) with the order
+/// for occlusion rays applied. Only for a layout check_wide_structure accepted (children after
+/// their parents, runs of groups inside the groups).
+template <int W>
+WideRayView<W> ordered_as_now(WideRayView<W> stored, bool reorder, WideRayBvh<W>& held) {
+    if (!reorder || stored.empty()) return stored;
+    held.nodes.assign(stored.nodes.begin(), stored.nodes.end());
+    held.groups.assign(stored.groups.begin(), stored.groups.end());
+    order_for_occlusion(held);
+    return held.view();
 }
 
 /// What a walk needs, whatever the boxes hold: an empty lane (child invalid_index, groups 0) has

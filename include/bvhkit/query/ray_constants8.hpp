@@ -1,12 +1,12 @@
 #pragma once
 // The constants the eight-wide walks need, made for eight rays at once: whether the wide walk takes
 // a ray (wide_ray_usable), whether it meets the tree's bounds (SlabConstants::meets), its slab
-// constants (SlabConstants) and its watertight test's (WatertightRay's KnownValid form). Made one
-// ray at a time, these were a large share of a packet's instructions (most camera rays around a
-// model miss its bounds, and cost nothing else); across eight lanes each is a few. Each lane runs the one-ray code's IEEE operations on the same operands (the
-// quotients, the products, the compares, max and min with the same operand order), so every
-// decision and every constant is the one-ray code's, bit for bit; the packet tests compare the
-// answers to the one-ray calls'.
+// constants (SlabConstants) and its watertight test's (WatertightRay's KnownValid form). Why:
+// most camera rays around a model miss its bounds and cost nothing but these constants, which one
+// ray at a time take several times the instructions they take across eight lanes. Each lane runs
+// the one-ray code's IEEE operations on the same operands (the quotients, the products, the
+// compares, max and min with the same operand order), so every decision and every constant is the
+// one-ray code's, bit for bit; the packet tests compare the answers to the one-ray calls'.
 #include <cstddef>
 #include <cstdint>
 #include <limits>

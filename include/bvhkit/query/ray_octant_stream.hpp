@@ -156,8 +156,8 @@ template <bool AnyHit, class Done>
                         for (; j > 0 && t[order[j - 1]] > t[c]; --j) order[j] = order[j - 1];
                     order[j] = c;
                 }
-                // The nearest goes on, the others wait, the farthest deepest (occlusion: any
-                // order serves).
+                // The nearest goes on, the others wait, the farthest deepest (occlusion: in lane
+                // order, the layout's order for occlusion rays).
                 const int first = order[0];
                 current = Entry{node.child[first], node.groups[first], mask[first], t[first]};
                 // The next entry's first three lines, as the walk asks for them, so that they

@@ -57,7 +57,7 @@ struct StreamRay {
 /// the next ray that needs a walk (its index, ray, SlabConstants and WatertightRay) or returns
 /// false when there is none; finish(const StreamRay&) takes a ray whose walk ended (start may
 /// pass it rays it answers without a walk: the slot then holds no hit). AnyHit: stop
-/// at the first hit, children in any order (the walk with AnyLeaves); else the closest hit
+/// at the first hit, children in lane order (the walk with AnyLeaves); else the closest hit
 /// (ClosestLeaves).
 template <bool AnyHit, class Start, class Finish>
 [[gnu::target("avx2")]] void stream8(WideRayView<8> tree, StreamRay* slots, Start&& start,

@@ -11,10 +11,11 @@
 // planes are chosen once per ray (SlabConstants). For a closest hit the hit children are visited
 // nearest first: the others go on a stack with their entry distances, and an entry farther than
 // the closest hit so far is dropped when popped, without reading its node (an any-hit query
-// pushes them unordered). The stacks and pushes are in query/ray_wide_stack.hpp, the layouts in
-// query/ray_wide_layout.hpp. A leaf child is a run of triangle groups as wide as the walk: four
-// triangles tested at once in the four-wide walk, eight in the eight-wide one
-// (primitives/triangle_group_kernels.hpp), with the answers of the scalar watertight test.
+// takes them in lane order, which the layout chose for occlusion rays). The stacks and pushes are
+// in query/ray_wide_stack.hpp, the layouts in query/ray_wide_layout.hpp. A leaf child is a run of
+// triangle groups as wide as the walk: four triangles tested at once in the four-wide walk, eight
+// in the eight-wide one (primitives/triangle_group_kernels.hpp), with the answers of the scalar
+// watertight test.
 //
 // An empty lane has the inverted box (+inf, -inf), which every ray misses; rays with a subnormal
 // direction component (a NaN reciprocal, which the slab test ignores) take the binary tree instead,

@@ -77,11 +77,22 @@ inline bool cpu_has_avx2() {
 #endif
 }
 
+/// Orders the lanes of `layout` for occlusion rays (query/ray_wide_occlusion_order.hpp) with the
+/// costs make_wide_ray_bvh collapses by: what it does last, and what a load does to a layout
+/// stored in the collapse's own order.
+template <int W>
+void order_for_occlusion(WideRayBvh<W>& layout) {
+    order_lanes_for_occlusion(layout.nodes, layout.groups.data(),
+                              W == 8 ? tuning::wide8_node_cost : tuning::wide4_node_cost, 1.0);
+}
+
 /// The ray layout of width W of a binary tree whose leaf slot s holds triangle_at_slot(s); its
-/// groups name that triangle index_at_slot(s) (TriangleGroup::slot), which a hit reports.
+/// groups name that triangle index_at_slot(s) (TriangleGroup::slot), which a hit reports. Its
+/// lanes are ordered for occlusion rays unless `occlusion_order` is false (the collapse's own
+/// order, as layouts were made before: for tests of files written then).
 template <int W, class TriangleAtSlot, class IndexAtSlot>
 WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&& triangle_at_slot,
-                                IndexAtSlot&& index_at_slot) {
+                                IndexAtSlot&& index_at_slot, bool occlusion_order = true) {
     WideRayBvh<W> out;
     // Every node's lanes filled (collapse_to_wide's fill_lanes), and each leaf child chosen by
     // the surface area cost of collapse_to_wide_sah in the layout's own units, a node's clip
@@ -145,7 +156,7 @@ WideRayBvh<W> make_wide_ray_bvh(const Bvh<Aabb<float, 3>>& bvh, TriangleAtSlot&&
                 out.nodes[i].child[c] = first_of[g];
                 out.nodes[i].groups[c] = cut(run_of[g]);
             }
-    order_lanes_for_occlusion(out.nodes, out.groups.data(), costs.node, costs.group);
+    if (occlusion_order) order_for_occlusion(out);
     return out;
 }
 

@@ -81,7 +81,7 @@ struct ClosestLeaves {
 template <int W, class Stats>
 struct AnyLeaves {
     using Group = typename WideRayView<W>::Group;
-    static constexpr bool any_hit = true;  // the walk visits hit children in any order
+    static constexpr bool any_hit = true;  // hit children in lane order, not by distance
     const Group* groups;
     const WatertightRay<float>& prep;
     const Ray<float, 3>& ray;
