@@ -103,9 +103,14 @@ void order_lanes_for_occlusion(Nodes& nodes, const Group* groups, double node_co
                 area[i] += lane_area[c];
                 cost[i] += (node_box > 0.0 ? box[c] / node_box : 1.0) * lane_cost[c];
             }
+        // Highest key first, equal keys in lane order: an insertion sort of at most eight lanes
+        // (std::stable_sort would allocate a buffer at every node).
         int order[W];
-        for (int c = 0; c < W; ++c) order[c] = c;
-        std::stable_sort(order, order + W, [&](int a, int b) { return key[a] > key[b]; });
+        for (int c = 0; c < W; ++c) {
+            int j = c;
+            for (; j > 0 && key[order[j - 1]] < key[c]; --j) order[j] = order[j - 1];
+            order[j] = c;
+        }
         const Node old = n;
         for (int c = 0; c < W; ++c) {
             for (int r = 0; r < 6; ++r) n.lo[r][c] = old.lo[r][order[c]];
