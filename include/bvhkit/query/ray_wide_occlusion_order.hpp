@@ -13,19 +13,17 @@
 #include <limits>
 #include <vector>
 
+#include "bvhkit/math/aabb.hpp"
 #include "bvhkit/primitives/hit.hpp"
 
 namespace bvhkit {
 
 namespace detail {
 
-/// The surface area of lane c's box (a lane with a child).
+/// Lane c's box (a lane with a child), in double so that its area cannot overflow.
 template <class Node>
-double lane_box_area(const Node& n, int c) {
-    const double dx = double(n.lo[3][c]) - n.lo[0][c];
-    const double dy = double(n.lo[4][c]) - n.lo[1][c];
-    const double dz = double(n.lo[5][c]) - n.lo[2][c];
-    return 2.0 * (dx * dy + dy * dz + dz * dx);
+Aabb<double, 3> lane_box(const Node& n, int c) {
+    return {{n.lo[0][c], n.lo[1][c], n.lo[2][c]}, {n.lo[3][c], n.lo[4][c], n.lo[5][c]}};
 }
 
 /// About twice the area of a leaf's triangles (its groups from `first`, `count` of them): each
@@ -70,19 +68,13 @@ void order_lanes_for_occlusion(Nodes& nodes, const Group* groups, double node_co
     for (std::size_t i = nodes.size(); i-- > 0;) {
         Node& n = nodes[i];
         double lane_area[W] = {}, lane_cost[W] = {}, box[W] = {}, key[W];
-        double lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = std::numeric_limits<double>::infinity();
-            hi[a] = -lo[a];
-        }
+        Aabb<double, 3> node_bounds;  // empty, grown by each child's box
         for (int c = 0; c < W; ++c) {
             key[c] = -1.0;  // empty lanes last
             if (n.child[c] == invalid_index) continue;
-            for (int a = 0; a < 3; ++a) {
-                lo[a] = std::min(lo[a], double(n.lo[a][c]));
-                hi[a] = std::max(hi[a], double(n.lo[3 + a][c]));
-            }
-            box[c] = detail::lane_box_area(n, c);
+            const Aabb<double, 3> child_box = detail::lane_box(n, c);
+            node_bounds.grow(child_box);
+            box[c] = child_box.area();
             const bool leaf = n.groups[c] > 0;
             lane_area[c] = leaf ? detail::leaf_crossed_area(groups, n.child[c], n.groups[c])
                                 : area[n.child[c]];
@@ -95,8 +87,7 @@ void order_lanes_for_occlusion(Nodes& nodes, const Group* groups, double node_co
             // lane goes after the others with children, so that the sort sees a strict order.
             if (!(key[c] >= 0.0) || key[c] == std::numeric_limits<double>::infinity()) key[c] = 0.0;
         }
-        const double dx = hi[0] - lo[0], dy = hi[1] - lo[1], dz = hi[2] - lo[2];
-        const double node_box = 2.0 * (dx * dy + dy * dz + dz * dx);
+        const double node_box = node_bounds.area();
         cost[i] = node_cost;
         for (int c = 0; c < W; ++c)
             if (n.child[c] != invalid_index) {
